@@ -1,0 +1,147 @@
+// Backward pass: the per-segment 6x6 inverse dynamics of Federico & Alhasadi (2022),
+// solved from the leaves to the root.
+#pragma once
+
+#include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/model.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+#include <string>
+
+namespace jle {
+
+/// The frame a wrench is expressed in.
+enum class WrenchFrame : std::uint8_t {
+  kChild,   ///< the joint's child link (segment) frame
+  kParent,  ///< the joint's URDF parent link frame
+  kWorld,   ///< the world frame
+  kLocal,   ///< for an applied wrench: the frame of the link it is applied at
+};
+
+/// A force and a moment [N, N m]; which frame and which point is said where it is used.
+template <typename Scalar>
+struct Wrench {
+  Eigen::Matrix<Scalar, 3, 1> force = Eigen::Matrix<Scalar, 3, 1>::Zero();
+  Eigen::Matrix<Scalar, 3, 1> moment = Eigen::Matrix<Scalar, 3, 1>::Zero();
+};
+
+/// Adds a wrench applied TO the robot at the origin of frame `frame` (an index into
+/// model.frames), expressed in that frame (kLocal) or in the world (kWorld). Call after
+/// forwardKinematics (which clears the previous ones) and before inverseDynamics.
+template <typename Scalar>
+void addExternalWrench(const Model<Scalar>& model, Data<Scalar>& data, int frame,
+                       const Eigen::Matrix<Scalar, 3, 1>& force,
+                       const Eigen::Matrix<Scalar, 3, 1>& moment, WrenchFrame expressed_in) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  if (frame < 0 || frame >= static_cast<int>(model.frames.size()))
+    throw std::invalid_argument("external wrench on frame index " + std::to_string(frame) +
+                                ", the model has " + std::to_string(model.frames.size()));
+  const Frame<Scalar>& fr = model.frames[frame];
+  const int s = fr.segment;
+  Vector3 f, n;
+  if (expressed_in == WrenchFrame::kLocal) {
+    f.noalias() = fr.R_segment_frame * force;
+    n.noalias() = fr.R_segment_frame * moment;
+  } else if (expressed_in == WrenchFrame::kWorld) {
+    f.noalias() = data.R_world[s].transpose() * force;
+    n.noalias() = data.R_world[s].transpose() * moment;
+  } else {
+    throw std::invalid_argument("an external wrench on '" + fr.name +
+                                "' must be expressed in its link frame or the world");
+  }
+  data.f_ext[s] += f;
+  data.n_ext[s] += n + fr.p_segment_frame.cross(f);
+}
+
+/// Backward pass over the kinematics in data (forwardKinematics) and the external
+/// wrenches added since. For each segment, in its own frame (the paper's equations are
+/// frame-independent; in the segment frame J'_G is constant and no world offset enters),
+///   F = m (a_G - g) - F_0
+///   M = J_G alpha + omega x J_G omega - xi_n x F - M_0,
+/// with F_0, M_0 the resultants of the applied wrenches and of the children's joint
+/// wrenches (reversed), and xi_n = joint origin - x_G. The moment is accumulated directly
+/// about the joint origin, which is the same sum rearranged: no large lever arm cancels.
+/// Fills data.force, data.moment (child frame, about the joint origin) and data.effort.
+template <typename Scalar>
+void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  const int n = model.nsegments();
+  for (int i = 0; i < n; ++i) {
+    data.force[i] = -data.f_ext[i];
+    data.moment[i] = -data.n_ext[i];
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    const Vector3& c = model.com[i];
+    const Vector3& w = data.omega[i];
+    const Vector3& al = data.alpha[i];
+    const Vector3 m_a_com =
+        model.mass[i] * (data.acc[i] + al.cross(c) + w.cross(w.cross(c)));
+    const Vector3 Jw = model.inertia_com[i] * w;
+    Vector3& f = data.force[i];
+    Vector3& m = data.moment[i];
+    f += m_a_com;
+    m.noalias() += model.inertia_com[i] * al;
+    m += w.cross(Jw) + c.cross(m_a_com);
+
+    switch (model.joint_type[i]) {
+      case JointType::kRevolute: data.effort[i] = model.axis[i].dot(m); break;
+      case JointType::kPrismatic: data.effort[i] = model.axis[i].dot(f); break;
+      default: data.effort[i] = Scalar(0); break;
+    }
+    const int p = model.parent[i];
+    if (p < 0) continue;
+    // The child's joint wrench acts on the parent reversed; in the parent's sum it
+    // enters with a plus sign (F = m a - F_0 with F_0 holding -F_child).
+    const Vector3 f_p = data.R_parent_child[i] * f;
+    data.force[p] += f_p;
+    data.moment[p].noalias() += data.R_parent_child[i] * m;
+    data.moment[p] += data.p_parent_child[i].cross(f_p);
+  }
+}
+
+/// The joint wrench of segment i (exerted by its parent, moment about the joint
+/// origin), expressed in the child, the URDF parent-link or the world frame.
+template <typename Scalar>
+Wrench<Scalar> jointWrench(const Model<Scalar>& model, const Data<Scalar>& data, int i,
+                           WrenchFrame frame) {
+  Wrench<Scalar> out;
+  switch (frame) {
+    case WrenchFrame::kChild:
+    case WrenchFrame::kLocal:
+      out.force = data.force[i];
+      out.moment = data.moment[i];
+      break;
+    case WrenchFrame::kParent: {
+      if (i == 0) {  // the root's "parent" is the world
+        out.force = data.R_world[0] * data.force[0];
+        out.moment = data.R_world[0] * data.moment[0];
+        break;
+      }
+      const Eigen::Matrix<Scalar, 3, 3> R =
+          model.R_parentsegment_parentlink[i].transpose() * data.R_parent_child[i];
+      out.force = R * data.force[i];
+      out.moment = R * data.moment[i];
+      break;
+    }
+    case WrenchFrame::kWorld:
+      out.force = data.R_world[i] * data.force[i];
+      out.moment = data.R_world[i] * data.moment[i];
+      break;
+  }
+  return out;
+}
+
+/// forwardKinematics + inverseDynamics with no external wrench.
+template <typename Scalar>
+void rnea(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+          const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+          const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  forwardKinematics(model, data, q, qd, qdd, gravity_world);
+  inverseDynamics(model, data);
+}
+
+}  // namespace jle

@@ -1,0 +1,142 @@
+// The immutable multibody model: a tree of rigid segments joined by 1-DOF joints.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace jle {
+
+/// Kind of the joint that enters a segment from its parent.
+enum class JointType : std::uint8_t {
+  kRoot,       ///< segment 0 of a fixed-base model: its pose is given (identity by default)
+  kFloating,   ///< segment 0 of a floating-base model: pose, twist, acceleration given
+  kFixed,      ///< a fixed joint kept as its own segment (so that its wrench is an output)
+  kRevolute,   ///< revolute or continuous: rotation q [rad] about the axis
+  kPrismatic,  ///< translation q [m] along the axis
+};
+
+/// Whether the joint entering a segment has a coordinate.
+inline bool isMoving(JointType type) {
+  return type == JointType::kRevolute || type == JointType::kPrismatic;
+}
+
+/// A named frame rigidly attached to a segment: every URDF link is one (a link lumped
+/// into its parent through fixed joints is a frame of that parent's segment).
+template <typename Scalar>
+struct Frame {
+  std::string name;
+  int segment = 0;
+  Eigen::Matrix<Scalar, 3, 3> R_segment_frame = Eigen::Matrix<Scalar, 3, 3>::Identity();
+  Eigen::Matrix<Scalar, 3, 1> p_segment_frame = Eigen::Matrix<Scalar, 3, 1>::Zero();
+};
+
+/// The model, built once (see urdf_reader.hpp) and never changed by the algorithms.
+///
+/// Segments are numbered depth first from the root in the order the URDF lists its
+/// joints, so parent[i] < i for every i > 0 and parent[0] == -1: the forward pass is a
+/// loop up the indices, the backward pass a loop down. A segment's frame is the frame
+/// of its URDF child link, whose origin is the joint origin.
+template <typename Scalar>
+struct Model {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+
+  int nq = 0;  ///< number of independent coordinates (moving joints that are not mimics)
+  bool floating_base = false;
+
+  // Per segment, size nsegments().
+  std::vector<int> parent;
+  std::vector<JointType> joint_type;
+  std::vector<std::string> link_name;   ///< URDF link whose frame is the segment frame
+  std::vector<std::string> joint_name;  ///< URDF joint entering the segment ("" for the root)
+  std::vector<Matrix3> R_parent_joint;  ///< joint frame at q = 0 in the parent segment frame
+  std::vector<Vector3> p_parent_joint;  ///< joint origin in the parent segment frame [m]
+  /// Orientation of the joint's URDF parent link in the parent segment frame (identity
+  /// unless the parent link was lumped): turns a child-frame wrench into the parent-link frame.
+  std::vector<Matrix3> R_parentsegment_parentlink;
+  std::vector<Vector3> axis;  ///< unit joint axis in the segment frame (zero if not moving)
+  /// q_segment = multiplier * q[coordinate] + offset (a mimic joint follows its leader's
+  /// coordinate); coordinate == -1 when the joint does not move.
+  std::vector<int> coordinate;
+  std::vector<Scalar> multiplier;
+  std::vector<Scalar> offset;
+  std::vector<Scalar> mass;          ///< lumped mass [kg]
+  std::vector<Vector3> com;          ///< lumped centre of mass in the segment frame [m]
+  std::vector<Matrix3> inertia_com;  ///< lumped inertia about the com, segment axes [kg m^2]
+
+  /// Names of the independent coordinates, index = position in q, size nq.
+  std::vector<std::string> coordinate_names;
+  /// Segments whose joint moves (revolute, continuous, prismatic, mimics included), in
+  /// URDF tree order: the joints whose loads are reported.
+  std::vector<int> moving_segments;
+  /// Every URDF link, as a frame on the segment it was lumped into.
+  std::vector<Frame<Scalar>> frames;
+  /// What the reader accepted but a user should know (e.g. a slightly unphysical inertia).
+  std::vector<std::string> warnings;
+
+  int nsegments() const { return static_cast<int>(parent.size()); }
+
+  /// Index into frames of the URDF link `name`; throws std::invalid_argument if unknown.
+  int frameIndex(const std::string& name) const {
+    for (int i = 0; i < static_cast<int>(frames.size()); ++i)
+      if (frames[i].name == name) return i;
+    throw std::invalid_argument("unknown link '" + name + "'");
+  }
+  /// Index of the segment entered by joint `name`; throws std::invalid_argument if unknown
+  /// or if the joint was lumped away (keep it with ModelOptions::keep_fixed_joints).
+  int segmentOfJoint(const std::string& name) const {
+    for (int i = 1; i < nsegments(); ++i)
+      if (joint_name[i] == name) return i;
+    throw std::invalid_argument("no segment for joint '" + name +
+                                "' (unknown, or a fixed joint that was lumped)");
+  }
+  /// Total mass [kg].
+  Scalar totalMass() const {
+    Scalar total(0);
+    for (Scalar m : mass) total += m;
+    return total;
+  }
+
+  /// The same model in another scalar type.
+  template <typename Other>
+  Model<Other> cast() const {
+    Model<Other> out;
+    out.nq = nq;
+    out.floating_base = floating_base;
+    out.parent = parent;
+    out.joint_type = joint_type;
+    out.link_name = link_name;
+    out.joint_name = joint_name;
+    out.coordinate = coordinate;
+    out.coordinate_names = coordinate_names;
+    out.moving_segments = moving_segments;
+    out.warnings = warnings;
+    for (int i = 0; i < nsegments(); ++i) {
+      out.R_parent_joint.push_back(R_parent_joint[i].template cast<Other>());
+      out.p_parent_joint.push_back(p_parent_joint[i].template cast<Other>());
+      out.R_parentsegment_parentlink.push_back(
+          R_parentsegment_parentlink[i].template cast<Other>());
+      out.axis.push_back(axis[i].template cast<Other>());
+      out.multiplier.push_back(static_cast<Other>(multiplier[i]));
+      out.offset.push_back(static_cast<Other>(offset[i]));
+      out.mass.push_back(static_cast<Other>(mass[i]));
+      out.com.push_back(com[i].template cast<Other>());
+      out.inertia_com.push_back(inertia_com[i].template cast<Other>());
+    }
+    for (const Frame<Scalar>& f : frames) {
+      Frame<Other> g;
+      g.name = f.name;
+      g.segment = f.segment;
+      g.R_segment_frame = f.R_segment_frame.template cast<Other>();
+      g.p_segment_frame = f.p_segment_frame.template cast<Other>();
+      out.frames.push_back(g);
+    }
+    return out;
+  }
+};
+
+}  // namespace jle

@@ -1,0 +1,432 @@
+// URDF -> Model: parsing with tinyxml2 (the document order of the joints fixes the
+// segment order), validation with the culprit's name, lumping of fixed joints.
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace jle {
+namespace {
+
+using Vector3 = Eigen::Vector3d;
+using Matrix3 = Eigen::Matrix3d;
+
+struct Pose {
+  Matrix3 R = Matrix3::Identity();
+  Vector3 p = Vector3::Zero();
+  Pose operator*(const Pose& o) const { return {R * o.R, p + R * o.p}; }
+};
+
+struct LinkDesc {
+  std::string name;
+  int line = 0;
+  bool has_inertial = false;
+  double mass = 0.0;
+  Pose inertial_origin;  // com frame in the link frame
+  Matrix3 inertia = Matrix3::Zero();  // about the com, in the inertial frame
+  std::vector<int> child_joints;  // document order
+  int parent_joint = -1;
+};
+
+struct JointDesc {
+  std::string name;
+  std::string type;
+  int line = 0;
+  std::string parent, child;
+  Pose origin;
+  Vector3 axis = Vector3::UnitX();
+  bool mimic = false;
+  std::string mimic_joint;
+  double multiplier = 1.0, offset = 0.0;
+};
+
+[[noreturn]] void fail(const std::string& what) { throw ModelError(what); }
+
+std::string where(const tinyxml2::XMLElement* e) {
+  return " (line " + std::to_string(e->GetLineNum()) + ")";
+}
+
+// Whitespace-separated finite numbers; `count` of them exactly.
+std::vector<double> numbers(const char* text, std::size_t count, const std::string& what) {
+  std::vector<double> out;
+  const char* s = text;
+  while (true) {
+    while (*s == ' ' || *s == '\t' || *s == '\n' || *s == '\r') ++s;
+    if (*s == '\0') break;
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s, &end);
+    if (end == s || (*end != '\0' && *end != ' ' && *end != '\t' && *end != '\n' && *end != '\r'))
+      fail(what + ": '" + text + "' is not a list of numbers");
+    if (!std::isfinite(v)) fail(what + ": '" + text + "' is not finite");
+    out.push_back(v);
+    s = end;
+  }
+  if (out.size() != count)
+    fail(what + ": expected " + std::to_string(count) + " numbers, got '" + text + "'");
+  return out;
+}
+
+double number(const tinyxml2::XMLElement* e, const char* attribute, const std::string& what,
+              bool required, double fallback) {
+  const char* text = e->Attribute(attribute);
+  if (!text) {
+    if (required) fail(what + ": missing attribute '" + attribute + "'" + where(e));
+    return fallback;
+  }
+  return numbers(text, 1, what + " attribute '" + attribute + "'" + where(e))[0];
+}
+
+Vector3 vector3(const tinyxml2::XMLElement* e, const char* attribute, const std::string& what,
+                const Vector3& fallback) {
+  const char* text = e->Attribute(attribute);
+  if (!text) return fallback;
+  const std::vector<double> v = numbers(text, 3, what + " attribute '" + attribute + "'" + where(e));
+  return Vector3(v[0], v[1], v[2]);
+}
+
+Pose origin(const tinyxml2::XMLElement* parent, const std::string& what) {
+  Pose pose;
+  const tinyxml2::XMLElement* e = parent->FirstChildElement("origin");
+  if (!e) return pose;
+  pose.p = vector3(e, "xyz", what + " origin", Vector3::Zero());
+  const Vector3 rpy = vector3(e, "rpy", what + " origin", Vector3::Zero());
+  // URDF: fixed-axis roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll).
+  pose.R = (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) *
+            Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
+            Eigen::AngleAxisd(rpy.x(), Vector3::UnitX()))
+               .toRotationMatrix();
+  return pose;
+}
+
+std::string requiredName(const tinyxml2::XMLElement* e, const char* attribute,
+                         const std::string& what) {
+  const char* text = e->Attribute(attribute);
+  if (!text || !*text) fail(what + ": missing attribute '" + attribute + "'" + where(e));
+  return text;
+}
+
+LinkDesc parseLink(const tinyxml2::XMLElement* e) {
+  LinkDesc link;
+  link.name = requiredName(e, "name", "<link>");
+  link.line = e->GetLineNum();
+  const std::string what = "link '" + link.name + "'";
+  const tinyxml2::XMLElement* in = e->FirstChildElement("inertial");
+  if (!in) return link;
+  link.has_inertial = true;
+  link.inertial_origin = origin(in, what + " inertial");
+  const tinyxml2::XMLElement* m = in->FirstChildElement("mass");
+  if (!m) fail(what + ": <inertial> without <mass>" + where(in));
+  link.mass = number(m, "value", what + " mass", true, 0.0);
+  const tinyxml2::XMLElement* i = in->FirstChildElement("inertia");
+  if (!i) fail(what + ": <inertial> without <inertia>" + where(in));
+  const std::string wi = what + " inertia";
+  const double ixx = number(i, "ixx", wi, true, 0.0), ixy = number(i, "ixy", wi, true, 0.0),
+               ixz = number(i, "ixz", wi, true, 0.0), iyy = number(i, "iyy", wi, true, 0.0),
+               iyz = number(i, "iyz", wi, true, 0.0), izz = number(i, "izz", wi, true, 0.0);
+  link.inertia << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+  return link;
+}
+
+JointDesc parseJoint(const tinyxml2::XMLElement* e) {
+  JointDesc joint;
+  joint.name = requiredName(e, "name", "<joint>");
+  joint.line = e->GetLineNum();
+  const std::string what = "joint '" + joint.name + "'";
+  joint.type = requiredName(e, "type", what);
+  const tinyxml2::XMLElement* parent = e->FirstChildElement("parent");
+  const tinyxml2::XMLElement* child = e->FirstChildElement("child");
+  if (!parent) fail(what + ": missing <parent>" + where(e));
+  if (!child) fail(what + ": missing <child>" + where(e));
+  joint.parent = requiredName(parent, "link", what + " <parent>");
+  joint.child = requiredName(child, "link", what + " <child>");
+  joint.origin = origin(e, what);
+  if (const tinyxml2::XMLElement* a = e->FirstChildElement("axis"))
+    joint.axis = vector3(a, "xyz", what + " axis", Vector3::UnitX());
+  if (const tinyxml2::XMLElement* m = e->FirstChildElement("mimic")) {
+    joint.mimic = true;
+    joint.mimic_joint = requiredName(m, "joint", what + " <mimic>");
+    joint.multiplier = number(m, "multiplier", what + " mimic", false, 1.0);
+    joint.offset = number(m, "offset", what + " mimic", false, 0.0);
+  }
+  return joint;
+}
+
+// A link's inertia must be that of some mass distribution: symmetric positive
+// semi-definite, and its principal moments must satisfy the triangle inequality.
+// Violations of the triangle inequality up to `triangle_tolerance` (relative to the
+// largest principal moment) are accepted with a warning: published models have them
+// (Talos' gripper motors by 2.5%), and the method solves them all the same.
+void checkInertia(const LinkDesc& link, double triangle_tolerance,
+                  std::vector<std::string>& warnings) {
+  const std::string what = "link '" + link.name + "'";
+  if (link.mass < 0.0) fail(what + ": negative mass " + std::to_string(link.mass));
+  Eigen::SelfAdjointEigenSolver<Matrix3> eig(link.inertia, Eigen::EigenvaluesOnly);
+  const Vector3 l = eig.eigenvalues();  // ascending
+  // Relative tolerance: the URDFs we read print their inertias with 6 to 9 digits.
+  const double tol = 1e-6 * std::max(l.cwiseAbs().maxCoeff(), 1e-300);
+  if (l[0] < -tol) {
+    std::ostringstream os;
+    os << what << ": inertia is not positive semi-definite (principal moments " << l[0] << ", "
+       << l[1] << ", " << l[2] << ")";
+    fail(os.str());
+  }
+  if (l[0] + l[1] < l[2] - tol) {
+    std::ostringstream os;
+    os << what << ": inertia violates the triangle inequality (principal moments " << l[0]
+       << " + " << l[1] << " < " << l[2] << ", by " << 100.0 * (l[2] - l[0] - l[1]) / l[2]
+       << "%)";
+    if (l[0] + l[1] < l[2] * (1.0 - triangle_tolerance)) fail(os.str());
+    warnings.push_back(os.str());
+  }
+}
+
+struct Builder {
+  const std::vector<LinkDesc>& links;
+  const std::vector<JointDesc>& joints;
+  const ModelOptions& options;
+  std::map<std::string, int> link_index;
+  Model<double> model;
+  // Per segment: accumulated mass, first moment and inertia about the segment origin.
+  std::vector<double> mass;
+  std::vector<Vector3> first_moment;
+  std::vector<Matrix3> inertia_origin;
+
+  int addSegment(int parent, JointType type, const std::string& link, const std::string& joint) {
+    model.parent.push_back(parent);
+    model.joint_type.push_back(type);
+    model.link_name.push_back(link);
+    model.joint_name.push_back(joint);
+    model.R_parent_joint.push_back(Matrix3::Identity());
+    model.p_parent_joint.push_back(Vector3::Zero());
+    model.R_parentsegment_parentlink.push_back(Matrix3::Identity());
+    model.axis.push_back(Vector3::Zero());
+    model.coordinate.push_back(-1);
+    model.multiplier.push_back(1.0);
+    model.offset.push_back(0.0);
+    mass.push_back(0.0);
+    first_moment.push_back(Vector3::Zero());
+    inertia_origin.push_back(Matrix3::Zero());
+    return static_cast<int>(model.parent.size()) - 1;
+  }
+
+  void addLink(int link, int segment, const Pose& X_segment_link) {
+    const LinkDesc& l = links[link];
+    Frame<double> frame;
+    frame.name = l.name;
+    frame.segment = segment;
+    frame.R_segment_frame = X_segment_link.R;
+    frame.p_segment_frame = X_segment_link.p;
+    model.frames.push_back(frame);
+    if (!l.has_inertial) return;
+    checkInertia(l, options.triangle_tolerance, model.warnings);
+    const Pose X = X_segment_link * l.inertial_origin;
+    const Matrix3 I = X.R * l.inertia * X.R.transpose();
+    mass[segment] += l.mass;
+    first_moment[segment] += l.mass * X.p;
+    // Parallel-axis theorem to the segment origin.
+    inertia_origin[segment] +=
+        I + l.mass * (X.p.squaredNorm() * Matrix3::Identity() - X.p * X.p.transpose());
+  }
+
+  void visit(int link, int segment, const Pose& X_segment_link) {
+    addLink(link, segment, X_segment_link);
+    for (int j : links[link].child_joints) {
+      const JointDesc& joint = joints[j];
+      const int child = link_index.at(joint.child);
+      const std::string what = "joint '" + joint.name + "'";
+      const bool keep = std::find(options.keep_fixed_joints.begin(),
+                                  options.keep_fixed_joints.end(),
+                                  joint.name) != options.keep_fixed_joints.end();
+      if (joint.type == "fixed" && !keep) {
+        visit(child, segment, X_segment_link * joint.origin);
+        continue;
+      }
+      JointType type;
+      if (joint.type == "revolute" || joint.type == "continuous")
+        type = JointType::kRevolute;
+      else if (joint.type == "prismatic")
+        type = JointType::kPrismatic;
+      else if (joint.type == "fixed")
+        type = JointType::kFixed;
+      else if (joint.type == "floating")
+        fail(what + ": a floating joint must be the only joint of the root link");
+      else
+        fail(what + ": unsupported joint type '" + joint.type + "'");
+      const int s = addSegment(segment, type, joint.child, joint.name);
+      const Pose X = X_segment_link * joint.origin;
+      model.R_parent_joint[s] = X.R;
+      model.p_parent_joint[s] = X.p;
+      model.R_parentsegment_parentlink[s] = X_segment_link.R;
+      if (isMoving(type)) {
+        const double norm = joint.axis.norm();
+        if (!(norm > 1e-12)) fail(what + ": axis of zero length");
+        model.axis[s] = joint.axis / norm;
+      }
+      visit(child, s, Pose());
+    }
+  }
+
+  void resolveMimics() {
+    // Leader of each moving segment: itself, or (through a chain of mimics) another.
+    std::map<std::string, int> segment_of;
+    std::map<std::string, const JointDesc*> desc;
+    for (const JointDesc& j : joints) desc[j.name] = &j;
+    for (int s = 1; s < model.nsegments(); ++s) segment_of[model.joint_name[s]] = s;
+    for (int s = 1; s < model.nsegments(); ++s) {
+      if (!isMoving(model.joint_type[s]) || desc.at(model.joint_name[s])->mimic) continue;
+      model.coordinate[s] = model.nq++;
+      model.coordinate_names.push_back(model.joint_name[s]);
+    }
+    for (int s = 1; s < model.nsegments(); ++s) {
+      if (!isMoving(model.joint_type[s])) continue;
+      double multiplier = 1.0, offset = 0.0;
+      std::string name = model.joint_name[s];
+      for (int hops = 0; desc.at(name)->mimic; ++hops) {
+        const JointDesc* d = desc.at(name);
+        if (hops > model.nsegments())
+          fail("joint '" + model.joint_name[s] + "': its mimic chain is a loop");
+        auto leader = segment_of.find(d->mimic_joint);
+        if (leader == segment_of.end() || !isMoving(model.joint_type[leader->second]))
+          fail("joint '" + d->name + "' mimics '" + d->mimic_joint +
+               "', which is not a moving joint of the model");
+        // q = m1 (m2 q_leader + o2) + o1
+        offset = multiplier * d->offset + offset;
+        multiplier *= d->multiplier;
+        name = d->mimic_joint;
+      }
+      const int leader = segment_of.at(name);
+      model.coordinate[s] = model.coordinate[leader];
+      model.multiplier[s] = multiplier;
+      model.offset[s] = offset;
+    }
+  }
+
+  void finish() {
+    for (int s = 0; s < model.nsegments(); ++s) {
+      const double m = mass[s];
+      const Vector3 c = m > 0.0 ? Vector3(first_moment[s] / m) : Vector3::Zero();
+      model.mass.push_back(m);
+      model.com.push_back(c);
+      model.inertia_com.push_back(inertia_origin[s] -
+                                  m * (c.squaredNorm() * Matrix3::Identity() - c * c.transpose()));
+      if (isMoving(model.joint_type[s])) model.moving_segments.push_back(s);
+    }
+    if (!(model.totalMass() > 0.0))
+      fail("robot: total mass is zero; no link has an <inertial> with a positive mass");
+  }
+};
+
+}  // namespace
+
+Model<double> modelFromUrdfString(const std::string& xml, const ModelOptions& options) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS)
+    fail(std::string("malformed XML: ") + doc.ErrorStr());
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (!robot) fail("no <robot> element");
+
+  std::vector<LinkDesc> links;
+  std::vector<JointDesc> joints;
+  std::map<std::string, int> link_index, joint_index;
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e;
+       e = e->NextSiblingElement("link")) {
+    links.push_back(parseLink(e));
+    if (!link_index.emplace(links.back().name, static_cast<int>(links.size()) - 1).second)
+      fail("link '" + links.back().name + "' is defined twice" + where(e));
+  }
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e;
+       e = e->NextSiblingElement("joint")) {
+    joints.push_back(parseJoint(e));
+    if (!joint_index.emplace(joints.back().name, static_cast<int>(joints.size()) - 1).second)
+      fail("joint '" + joints.back().name + "' is defined twice" + where(e));
+  }
+  if (links.empty()) fail("robot has no <link>");
+  for (const std::string& name : options.keep_fixed_joints) {
+    auto it = joint_index.find(name);
+    if (it == joint_index.end()) fail("keep_fixed_joints: unknown joint '" + name + "'");
+    if (joints[it->second].type != "fixed")
+      fail("keep_fixed_joints: joint '" + name + "' is not fixed");
+  }
+
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
+    const JointDesc& joint = joints[j];
+    for (const std::string* l : {&joint.parent, &joint.child})
+      if (!link_index.count(*l))
+        fail("joint '" + joint.name + "': unknown link '" + *l + "' (line " +
+             std::to_string(joint.line) + ")");
+    LinkDesc& child = links[link_index[joint.child]];
+    if (child.parent_joint >= 0)
+      fail("link '" + child.name + "' is the child of two joints, '" +
+           joints[child.parent_joint].name + "' and '" + joint.name + "' (a loop)");
+    child.parent_joint = j;
+    links[link_index[joint.parent]].child_joints.push_back(j);
+  }
+  std::vector<int> roots;
+  for (int l = 0; l < static_cast<int>(links.size()); ++l)
+    if (links[l].parent_joint < 0) roots.push_back(l);
+  if (roots.empty()) fail("no root link: every link has a parent joint (a loop)");
+  if (roots.size() > 1) {
+    std::string names;
+    for (int r : roots) names += (names.empty() ? "'" : ", '") + links[r].name + "'";
+    fail("several root links: " + names + "; a URDF is a single tree");
+  }
+
+  Builder b{links, joints, options, link_index, {}, {}, {}, {}};
+  const int root = roots[0];
+  const LinkDesc& root_link = links[root];
+  const bool root_floats =
+      root_link.child_joints.size() == 1 && joints[root_link.child_joints[0]].type == "floating";
+  if (root_floats) {
+    // world --floating--> base: the base link is segment 0 and its pose is an input.
+    const JointDesc& j = joints[root_link.child_joints[0]];
+    if (root_link.has_inertial && root_link.mass != 0.0)
+      fail("link '" + root_link.name + "': the parent of floating joint '" + j.name +
+           "' must be massless");
+    b.model.floating_base = true;
+    b.addSegment(-1, JointType::kFloating, j.child, "");
+    b.visit(link_index.at(j.child), 0, Pose());
+  } else {
+    b.model.floating_base = options.floating_base;
+    b.addSegment(-1, options.floating_base ? JointType::kFloating : JointType::kRoot,
+                 root_link.name, "");
+    b.visit(root, 0, Pose());
+  }
+  const std::size_t reached = b.model.frames.size() + (root_floats ? 1 : 0);
+  if (reached != links.size()) {
+    std::string names;
+    for (const LinkDesc& l : links) {
+      bool seen = root_floats && l.name == root_link.name;
+      for (const Frame<double>& f : b.model.frames) seen = seen || f.name == l.name;
+      if (!seen) names += (names.empty() ? "'" : ", '") + l.name + "'";
+    }
+    fail("links " + names + " are not reachable from the root '" + root_link.name +
+         "' (a loop)");
+  }
+  b.resolveMimics();
+  b.finish();
+  return b.model;
+}
+
+Model<double> modelFromUrdfFile(const std::string& path, const ModelOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ModelError(path + ": cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    return modelFromUrdfString(text.str(), options);
+  } catch (const ModelError& e) {
+    throw ModelError(path + ": " + e.what());
+  }
+}
+
+}  // namespace jle

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Builds the package in a catkin workspace beside nothing but this repository.
+# JLE_WS (default: build/ws inside the repository) holds the workspace.
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=${JLE_WS:-$repo/build/ws}
+mkdir -p "$ws/src"
+ln -sfn "$repo" "$ws/src/joint_load_estimator"
+# Debian's catkin needs the system python (with catkin_pkg), not a pyenv shim.
+export PATH=/usr/bin:$PATH
+cd "$ws"
+catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release "$@"

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs what the package needs to build, run and test, from Debian 12's own
+# packages (ROS 1 Noetic-era in /usr). Safe to run again: apt skips what is there.
+set -euo pipefail
+packages=(
+  build-essential cmake catkin python3-catkin-pkg
+  ros-base-dev libroscpp-dev ros-message-generation libstd-msgs-dev
+  libsensor-msgs-dev libgeometry-msgs-dev libtf2-ros-dev libtf2-eigen-dev
+  libdiagnostic-updater-dev librosbag-dev libnodelet-dev pluginlib-dev
+  libeigen3-dev libtinyxml2-dev
+  libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch
+  python3-rosbag python3-sensor-msgs python3-geometry-msgs python3-std-msgs
+  liborocos-kdl-dev libkdl-parser-dev liburdf-dev
+  ros-robot-state-publisher
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "installing: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -q
+  apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
