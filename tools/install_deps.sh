@@ -7,11 +7,11 @@ packages=(
   ros-base-dev libroscpp-dev ros-message-generation libstd-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libtf2-ros-dev libtf2-eigen-dev
   libdiagnostic-updater-dev librosbag-dev libnodelet-dev pluginlib-dev
-  libeigen3-dev libtinyxml2-dev
+  libeigen3-dev libtinyxml2-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch
   python3-rosbag python3-sensor-msgs python3-geometry-msgs python3-std-msgs
   liborocos-kdl-dev libkdl-parser-dev liburdf-dev
-  ros-robot-state-publisher
+  ros-robot-state-publisher rosbash
 )
 missing=()
 for p in "${packages[@]}"; do

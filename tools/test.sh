@@ -2,7 +2,7 @@
 # Installs what is missing, builds, and runs every test; exits non-zero on a failure.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${JLE_WS:-$repo/build/ws}
+ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 bash "$repo/tools/install_deps.sh"
 bash "$repo/tools/build.sh" -j2
 bash "$repo/tools/build.sh" -j2 tests

@@ -1,1 +1,434 @@
-// placeholder
+// CSV reading and writing for the offline tools (csv.hpp): POSIX getline into one
+// reused buffer, cells split and parsed in place with strtod; output formatted with
+// 17 significant digits into one reused line.
+#include <joint_load_estimator/csv.hpp>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+namespace jle {
+namespace {
+
+bool isBlank(char c) { return c == ' ' || c == '\t'; }
+
+// Calls fn(begin, end) with the trimmed bounds of each comma-separated cell of
+// text[0, length); returns the number of cells (a line always has at least one).
+template <typename Fn>
+int forEachCell(const char* text, std::size_t length, Fn&& fn) {
+  int count = 0;
+  std::size_t start = 0;
+  while (true) {
+    std::size_t stop = start;
+    while (stop < length && text[stop] != ',') ++stop;
+    std::size_t b = start, e = stop;
+    while (b < e && isBlank(text[b])) ++b;
+    while (e > b && isBlank(text[e - 1])) --e;
+    fn(count, b, e);
+    ++count;
+    if (stop >= length) return count;
+    start = stop + 1;
+  }
+}
+
+// A cell quoted for a message; a runaway cell is shortened.
+std::string quoted(std::string_view text) {
+  constexpr std::size_t kMax = 40;
+  if (text.size() <= kMax) return "'" + std::string(text) + "'";
+  return "'" + std::string(text.substr(0, kMax)) + "...'";
+}
+
+// 'a', 'b', 'c' (a long list shortened: a whole header of the wrong robot stays readable).
+std::string nameList(const std::vector<std::string>& names) {
+  constexpr std::size_t kMax = 6;
+  std::string out;
+  for (std::size_t i = 0; i < names.size() && i < kMax; ++i)
+    out += (out.empty() ? "'" : ", '") + names[i] + "'";
+  if (names.size() > kMax) out += " and " + std::to_string(names.size() - kMax) + " more";
+  return out;
+}
+
+// The header's defects, the columns that share a reason listed together, in the order
+// of their first column.
+class HeaderProblems {
+ public:
+  void add(const std::string& column, const std::string& reason) {
+    for (auto& p : problems_)
+      if (!p.first.empty() && p.second == reason) {
+        p.first.push_back(column);
+        return;
+      }
+    problems_.push_back({{column}, reason});
+  }
+  void add(const std::string& problem) { problems_.push_back({{}, problem}); }
+  bool empty() const { return problems_.empty(); }
+  std::string message() const {
+    constexpr std::size_t kMax = 6;
+    std::string out;
+    for (std::size_t i = 0; i < problems_.size() && i < kMax; ++i) {
+      const auto& p = problems_[i];
+      if (!out.empty()) out += "; ";
+      if (!p.first.empty())
+        out += (p.first.size() == 1 ? "column " : "columns ") + nameList(p.first) + ": ";
+      out += p.second;
+    }
+    if (problems_.size() > kMax)
+      out += "; and " + std::to_string(problems_.size() - kMax) + " more problems";
+    return out;
+  }
+
+ private:
+  std::vector<std::pair<std::vector<std::string>, std::string>> problems_;
+};
+
+std::string errnoText() { return std::strerror(errno); }
+
+constexpr std::array<const char*, 6> kWrenchComponents = {"fx", "fy", "fz", "mx", "my", "mz"};
+constexpr std::array<const char*, 3> kStateSuffixes = {"q", "qd", "qdd"};
+constexpr std::array<const char*, 7> kLoadSuffixes = {"fx", "fy", "fz", "mx",
+                                                      "my", "mz", "effort"};
+const std::string kWrenchPrefix = "wrench@";
+
+template <std::size_t N>
+int indexOf(const std::array<const char*, N>& names, std::string_view name) {
+  for (std::size_t i = 0; i < N; ++i)
+    if (name == names[i]) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------- reader
+
+CsvReader::CsvReader(const std::string& path) : path_(path) {
+  file_ = std::fopen(path.c_str(), "rb");
+  if (!file_) throw CsvError(path_ + ": cannot open: " + errnoText());
+  try {
+    readHeader();
+  } catch (...) {
+    // The destructor does not run for an object whose constructor throws.
+    std::fclose(file_);
+    std::free(buffer_);
+    throw;
+  }
+}
+
+void CsvReader::readHeader() {
+  if (!readLine()) throw CsvError(path_ + ":1: empty file, expected a header row");
+  // A byte-order mark, as spreadsheet programs write, is not part of the first name.
+  if (length_ >= 3 && std::memcmp(buffer_, "\xEF\xBB\xBF", 3) == 0) {
+    std::memmove(buffer_, buffer_ + 3, length_ - 3 + 1);
+    length_ -= 3;
+  }
+  line_ = physical_line_;
+  forEachCell(buffer_, length_, [&](int, std::size_t b, std::size_t e) {
+    header_.emplace_back(buffer_ + b, e - b);
+  });
+  if (header_.size() == 1 && header_[0].empty())
+    failHeader("blank header row, expected the column names");
+  for (int c = 0; c < columns(); ++c) {
+    if (header_[c].empty()) failHeader("column " + std::to_string(c + 1) + " has no name");
+    for (int d = 0; d < c; ++d)
+      if (header_[d] == header_[c])
+        failHeader("column '" + header_[c] + "' appears twice (columns " +
+                   std::to_string(d + 1) + " and " + std::to_string(c + 1) + ")");
+  }
+  begin_.assign(header_.size(), 0);
+  end_.assign(header_.size(), 0);
+}
+
+CsvReader::~CsvReader() {
+  if (file_) std::fclose(file_);
+  std::free(buffer_);
+}
+
+int CsvReader::column(std::string_view name) const {
+  for (int c = 0; c < columns(); ++c)
+    if (header_[c] == name) return c;
+  return -1;
+}
+
+bool CsvReader::readLine() {
+  errno = 0;
+  const ssize_t n = ::getline(&buffer_, &capacity_, file_);
+  if (n < 0) {
+    if (std::ferror(file_)) throw CsvError(path_ + ": cannot read: " + errnoText());
+    return false;
+  }
+  ++physical_line_;
+  std::size_t length = static_cast<std::size_t>(n);
+  if (length > 0 && buffer_[length - 1] == '\n') --length;
+  if (length > 0 && buffer_[length - 1] == '\r') --length;
+  buffer_[length] = '\0';
+  length_ = length;
+  return true;
+}
+
+bool CsvReader::next() {
+  const auto blank = [this] {
+    return std::all_of(buffer_, buffer_ + length_, [](char c) { return isBlank(c); });
+  };
+  if (!readLine()) return false;
+  if (blank()) {
+    // Blank lines end the file; anything after them is a defect.
+    const long blank_line = physical_line_;
+    while (readLine())
+      if (!blank()) {
+        line_ = blank_line;
+        throw CsvError(path_ + ":" + std::to_string(blank_line) + ": blank line, but line " +
+                       std::to_string(physical_line_) + " holds another record");
+      }
+    return false;
+  }
+  line_ = physical_line_;
+  const std::size_t n = header_.size();
+  const int count = forEachCell(buffer_, length_, [this, n](int c, std::size_t b, std::size_t e) {
+    if (static_cast<std::size_t>(c) < n) {
+      begin_[c] = b;
+      end_[c] = e;
+    }
+  });
+  const std::string where = path_ + ":" + std::to_string(line_) + ": ";
+  if (count < columns())
+    throw CsvError(where + "row has " + std::to_string(count) + " cells, the header has " +
+                   std::to_string(columns()) + " (no cell for column '" + header_[count] + "')");
+  if (count > columns())
+    throw CsvError(where + "row has " + std::to_string(count) + " cells, the header has " +
+                   std::to_string(columns()) + " (cell " + std::to_string(columns() + 1) +
+                   " is beyond the last column '" + header_.back() + "')");
+  // Terminate every cell in place so that strtod stops at its end at the latest.
+  for (std::size_t c = 0; c < n; ++c) buffer_[end_[c]] = '\0';
+  return true;
+}
+
+std::string_view CsvReader::cell(int c) const {
+  return std::string_view(buffer_ + begin_[c], end_[c] - begin_[c]);
+}
+
+double CsvReader::number(int c) const {
+  const char* begin = buffer_ + begin_[c];
+  const char* end = buffer_ + end_[c];
+  if (begin == end) failAt(c, "empty cell");
+  char* stop = nullptr;
+  const double value = std::strtod(begin, &stop);
+  if (stop != end) failAt(c, quoted(cell(c)) + " is not a number");
+  if (!std::isfinite(value)) failAt(c, quoted(cell(c)) + " is not a finite number");
+  return value;
+}
+
+void CsvReader::numbers(double* out) const {
+  for (int c = 0; c < columns(); ++c) out[c] = number(c);
+}
+
+void CsvReader::failAt(int c, const std::string& what) const {
+  throw CsvError(path_ + ":" + std::to_string(line_) + ": column '" + header_[c] + "': " + what);
+}
+
+void CsvReader::failHeader(const std::string& what) const {
+  throw CsvError(path_ + ":1: " + what);
+}
+
+// ---------------------------------------------------------------------------- writer
+
+CsvWriter::CsvWriter(const std::string& path) : path_(path) {
+  if (path_.empty()) {
+    file_ = stdout;
+    return;
+  }
+  struct stat existing;
+  if (::stat(path_.c_str(), &existing) == 0 && S_ISDIR(existing.st_mode))
+    throw CsvError(path_ + ": is a directory");
+  const std::size_t slash = path_.rfind('/');
+  const std::string directory = slash == std::string::npos ? "." : path_.substr(0, slash + 1);
+  const std::string base = slash == std::string::npos ? path_ : path_.substr(slash + 1);
+  std::string name = (slash == std::string::npos ? std::string() : directory) + "." + base +
+                     ".tmp.XXXXXX";
+  const int fd = ::mkstemp(name.data());
+  if (fd < 0)
+    throw CsvError(path_ + ": cannot create a temporary file in '" + directory +
+                   "': " + errnoText());
+  temporary_path_ = name;
+  // mkstemp creates the file 0600; give it the mode a plain fopen would.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  if (::fchmod(fd, 0666 & ~mask) != 0 || !(file_ = ::fdopen(fd, "wb"))) {
+    const std::string reason = errnoText();
+    ::close(fd);
+    ::unlink(temporary_path_.c_str());
+    throw CsvError(path_ + ": cannot open '" + temporary_path_ + "': " + reason);
+  }
+}
+
+CsvWriter::~CsvWriter() {
+  if (file_ && file_ != stdout) std::fclose(file_);
+  if (!temporary_path_.empty()) ::unlink(temporary_path_.c_str());
+}
+
+void CsvWriter::put() {
+  if (std::fwrite(line_.data(), 1, line_.size(), file_) != line_.size())
+    throw CsvError((path_.empty() ? std::string("standard output") : path_) +
+                   ": cannot write: " + errnoText());
+}
+
+void CsvWriter::writeHeader(const std::vector<std::string>& names) {
+  line_.clear();
+  for (const std::string& name : names) {
+    if (name.find_first_of(",\"\r\n") != std::string::npos)
+      throw std::invalid_argument("column name '" + name +
+                                  "' holds a comma, a quote or a line break");
+    if (!line_.empty()) line_ += ',';
+    line_ += name;
+  }
+  line_ += '\n';
+  put();
+}
+
+void CsvWriter::writeRow(const double* values, std::size_t count) {
+  // %.17g is at most 24 characters ("-1.2345678901234567e-308"), plus the separator.
+  line_.reserve(count * 25 + 1);
+  line_.clear();
+  char buffer[32];
+  for (std::size_t i = 0; i < count; ++i) {
+    if (i > 0) line_ += ',';
+#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
+    // Specified as printf's %.17g in the C locale, and several times faster.
+    const std::to_chars_result r = std::to_chars(buffer, buffer + sizeof buffer, values[i],
+                                                 std::chars_format::general, 17);
+    line_.append(buffer, r.ptr);
+#else
+    const int n = std::snprintf(buffer, sizeof buffer, "%.17g", values[i]);
+    line_.append(buffer, static_cast<std::size_t>(n));
+#endif
+  }
+  line_ += '\n';
+  put();
+}
+
+void CsvWriter::commit() {
+  const std::string where = path_.empty() ? std::string("standard output") : path_;
+  if (std::fflush(file_) != 0 || std::ferror(file_))
+    throw CsvError(where + ": cannot write: " + errnoText());
+  if (path_.empty()) return;
+  if (::fsync(::fileno(file_)) != 0) throw CsvError(where + ": cannot sync: " + errnoText());
+  std::FILE* file = file_;
+  file_ = nullptr;
+  if (std::fclose(file) != 0) throw CsvError(where + ": cannot write: " + errnoText());
+  if (std::rename(temporary_path_.c_str(), path_.c_str()) != 0)
+    throw CsvError(where + ": cannot rename '" + temporary_path_ + "' onto it: " + errnoText());
+  temporary_path_.clear();
+}
+
+// ---------------------------------------------------------------------------- layout
+
+StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader) {
+  StateColumns out;
+  out.q.assign(static_cast<std::size_t>(model.nq), -1);
+  out.qd.assign(static_cast<std::size_t>(model.nq), -1);
+  out.qdd.assign(static_cast<std::size_t>(model.nq), -1);
+  HeaderProblems problems;
+
+  for (int c = 0; c < reader.columns(); ++c) {
+    const std::string& name = reader.header()[c];
+    if (name == "t") {
+      out.t = c;
+      continue;
+    }
+    const std::size_t dot = name.rfind('.');
+    const std::string suffix = dot == std::string::npos ? "" : name.substr(dot + 1);
+    if (name.compare(0, kWrenchPrefix.size(), kWrenchPrefix) == 0) {
+      const int component = indexOf(kWrenchComponents, suffix);
+      if (dot == std::string::npos || dot <= kWrenchPrefix.size() || component < 0) {
+        problems.add(name, "expected wrench@LINK.fx, .fy, .fz, .mx, .my or .mz");
+        continue;
+      }
+      const std::string link = name.substr(kWrenchPrefix.size(), dot - kWrenchPrefix.size());
+      int frame = -1;
+      for (int f = 0; f < static_cast<int>(model.frames.size()); ++f)
+        if (model.frames[f].name == link) frame = f;
+      if (frame < 0) {
+        problems.add(name, "unknown link '" + link + "'");
+        continue;
+      }
+      auto w = std::find_if(out.wrenches.begin(), out.wrenches.end(),
+                            [&](const StateColumns::WrenchColumns& x) { return x.link == link; });
+      if (w == out.wrenches.end()) {
+        StateColumns::WrenchColumns added;
+        added.link = link;
+        added.frame = frame;
+        added.column.fill(-1);
+        out.wrenches.push_back(added);
+        w = out.wrenches.end() - 1;
+      }
+      w->column[static_cast<std::size_t>(component)] = c;
+      continue;
+    }
+    const int kind = indexOf(kStateSuffixes, suffix);
+    if (dot == std::string::npos || kind < 0) {
+      problems.add(name, "unknown column (expected t, JOINT.q, JOINT.qd, JOINT.qdd or "
+                         "wrench@LINK.fx ... .mz)");
+      continue;
+    }
+    const std::string joint = name.substr(0, dot);
+    int segment = -1;
+    for (int s : model.moving_segments)
+      if (model.joint_name[s] == joint) segment = s;
+    if (segment < 0) {
+      problems.add(name, "unknown joint (no revolute, continuous or prismatic joint of that "
+                         "name in the model)");
+      continue;
+    }
+    const int k = model.coordinate[segment];
+    if (model.coordinate_names[k] != joint) continue;  // a mimic: follows its leader
+    std::vector<int>& slot = kind == 0 ? out.q : kind == 1 ? out.qd : out.qdd;
+    slot[k] = c;
+  }
+
+  std::vector<std::string> missing;
+  if (out.t < 0) missing.push_back("t");
+  for (int k = 0; k < model.nq; ++k)
+    for (int kind = 0; kind < 3; ++kind) {
+      const std::vector<int>& slot = kind == 0 ? out.q : kind == 1 ? out.qd : out.qdd;
+      if (slot[k] < 0) missing.push_back(model.coordinate_names[k] + "." + kStateSuffixes[kind]);
+    }
+  if (!missing.empty())
+    problems.add((missing.size() == 1 ? "missing column " : "missing columns ") +
+                 nameList(missing));
+  for (const StateColumns::WrenchColumns& w : out.wrenches) {
+    std::vector<std::string> absent;
+    for (std::size_t i = 0; i < 6; ++i)
+      if (w.column[i] < 0) absent.push_back(kWrenchPrefix + w.link + "." + kWrenchComponents[i]);
+    if (!absent.empty())
+      problems.add("wrench@" + w.link + ": missing " +
+                   (absent.size() == 1 ? "column " : "columns ") + nameList(absent) +
+                   " (all six components are required)");
+  }
+  if (!problems.empty()) reader.failHeader(problems.message());
+  return out;
+}
+
+std::vector<std::string> stateColumnNames(const Model<double>& model,
+                                          const std::vector<std::string>& wrench_links) {
+  std::vector<std::string> names{"t"};
+  for (const std::string& joint : model.coordinate_names)
+    for (const char* suffix : kStateSuffixes) names.push_back(joint + "." + suffix);
+  for (const std::string& link : wrench_links)
+    for (const char* component : kWrenchComponents)
+      names.push_back(kWrenchPrefix + link + "." + component);
+  return names;
+}
+
+std::vector<std::string> jointLoadColumns(const Model<double>& model) {
+  std::vector<std::string> names{"t"};
+  for (int s : model.moving_segments)
+    for (const char* suffix : kLoadSuffixes) names.push_back(model.joint_name[s] + "." + suffix);
+  return names;
+}
+
+}  // namespace jle

@@ -1,0 +1,148 @@
+// CSV files of numbers for the offline tools: a streaming reader that locates every
+// defect as FILE:LINE and column, an atomic writer, and the column layout of the
+// joint-state and joint-load files (docs/joint_loads.md). ROS-free.
+#pragma once
+
+#include <joint_load_estimator/model.hpp>
+
+#include <array>
+#include <cstddef>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace jle {
+
+/// A defect in a CSV file, or a failure to read or write one. The message is complete
+/// and starts with the file: "FILE: ...", "FILE:LINE: ..." or
+/// "FILE:LINE: column 'NAME': ...".
+class CsvError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads a comma-separated file of numbers with a header row, one record per line,
+/// without holding it in memory. Cells are trimmed of spaces and tabs; CRLF line ends,
+/// a UTF-8 byte-order mark and blank lines at the end of the file are accepted. There is
+/// no quoting (a cell holds a name or a number). Once the header is read, reading a
+/// record does not allocate.
+class CsvReader {
+ public:
+  /// Opens `path` and reads its header (line 1). Throws CsvError if the file cannot be
+  /// read or is empty, or if a column name is empty or repeated.
+  explicit CsvReader(const std::string& path);
+  ~CsvReader();
+  CsvReader(const CsvReader&) = delete;
+  CsvReader& operator=(const CsvReader&) = delete;
+
+  /// The path as given, which starts every error message.
+  const std::string& path() const { return path_; }
+  /// Column names, trimmed, in file order.
+  const std::vector<std::string>& header() const { return header_; }
+  int columns() const { return static_cast<int>(header_.size()); }
+  /// Index of column `name`, or -1 if the header has none.
+  int column(std::string_view name) const;
+
+  /// Reads the next record; false at the end of the file. Throws CsvError (with its
+  /// line) on a record whose cell count differs from the header's, or on a blank line
+  /// followed by more records.
+  bool next();
+  /// Line number (1-based, the header is line 1) of the current record.
+  long line() const { return line_; }
+  /// Cell `c` of the current record, trimmed; valid until the next call to next().
+  std::string_view cell(int c) const;
+  /// Cell `c` of the current record as a finite double (strtod, the whole cell). Throws
+  /// CsvError "FILE:LINE: column 'NAME': 'abc' is not a number" (or "empty cell", or
+  /// "is not a finite number" for nan, inf and overflow).
+  double number(int c) const;
+  /// Every cell of the current record as numbers (as number()): out[0 .. columns()).
+  void numbers(double* out) const;
+
+  /// Throws CsvError "FILE:LINE: column 'NAME': what" at the current record.
+  [[noreturn]] void failAt(int c, const std::string& what) const;
+  /// Throws CsvError "FILE:1: what" (a defect of the header).
+  [[noreturn]] void failHeader(const std::string& what) const;
+
+ private:
+  void readHeader();
+  bool readLine();  // the next physical line into buffer_, terminator stripped
+  int split();      // cells of buffer_ into begin_/end_ (first columns() of them), count
+
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  char* buffer_ = nullptr;  // POSIX getline buffer, reused
+  std::size_t capacity_ = 0;
+  std::size_t length_ = 0;
+  long line_ = 0;          // line of the current record
+  long physical_line_ = 0;  // lines read so far
+  std::vector<std::string> header_;
+  std::vector<std::size_t> begin_, end_;  // current record's cells, size columns()
+};
+
+/// Writes a CSV of numbers, each printed with 17 significant digits (%.17g, which
+/// reads back to the same double). To a file: the rows go to a temporary file in the
+/// same directory, renamed onto the path by commit(); if commit() is never reached
+/// (an error, an exception) the temporary file is removed and an existing file at the
+/// path is untouched. To standard output when the path is empty.
+class CsvWriter {
+ public:
+  /// Throws CsvError if the temporary file cannot be created.
+  explicit CsvWriter(const std::string& path);
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+
+  /// The header row; throws std::invalid_argument on a name holding a comma, a quote
+  /// or a line break.
+  void writeHeader(const std::vector<std::string>& names);
+  /// One record of `count` numbers. Does not allocate once the first row is written.
+  void writeRow(const double* values, std::size_t count);
+  /// Flushes, syncs and renames the file onto the path (flushes standard output).
+  /// Throws CsvError on any write error.
+  void commit();
+
+ private:
+  void put();  // line_ to the stream; throws on a write error
+
+  std::string path_;  // empty: standard output
+  std::string temporary_path_;
+  std::FILE* file_ = nullptr;
+  std::string line_;
+};
+
+/// Where the inputs of one sample are in a joint-state CSV (docs/joint_loads.md):
+/// column indices into the record.
+struct StateColumns {
+  /// An external wrench applied to the robot at the origin of a URDF link, in that
+  /// link's frame: columns wrench@LINK.fx, .fy, .fz, .mx, .my, .mz.
+  struct WrenchColumns {
+    std::string link;
+    int frame = -1;  ///< index into Model::frames
+    std::array<int, 6> column{};
+  };
+  int t = -1;
+  /// Per coordinate (size model.nq, the order of model.coordinate_names): the columns of
+  /// JOINT.q, JOINT.qd, JOINT.qdd.
+  std::vector<int> q, qd, qdd;
+  std::vector<WrenchColumns> wrenches;  ///< in the order of their first column
+};
+
+/// Maps a joint-state CSV header onto `model`. Throws CsvError at line 1 naming the
+/// culprits: unknown columns (unknown joints, non-moving joints, unknown components),
+/// unknown links in wrench@LINK, missing t or JOINT.q/qd/qdd of a joint that has its
+/// own coordinate, an incomplete wrench. Columns of mimic joints are accepted and
+/// ignored (a mimic follows its leader).
+StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader);
+
+/// Header of a joint-state CSV: t, JOINT.q, JOINT.qd, JOINT.qdd per coordinate (the
+/// order of model.coordinate_names), then the six columns of each wrench link.
+std::vector<std::string> stateColumnNames(const Model<double>& model,
+                                          const std::vector<std::string>& wrench_links);
+
+/// Header of a joint-load CSV: t, then JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort for
+/// each moving joint in model.moving_segments order.
+std::vector<std::string> jointLoadColumns(const Model<double>& model);
+
+}  // namespace jle

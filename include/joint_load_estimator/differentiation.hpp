@@ -1,0 +1,253 @@
+// Online estimation of a signal's value, rate and second derivative from its samples:
+// Savitzky-Golay fits (finite differences are the smallest of them) and Kalman filters.
+// A bank filters many channels that share their sample times (all the joints of one
+// JointState, the components of the wrenches resampled at the same stamps) at the cost
+// of one set of coefficients.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace jle {
+
+enum class DifferentiatorType : std::uint8_t {
+  kFiniteDifference,  ///< exact through order+1 points (3-point, 2nd order by default)
+  kSavitzkyGolay,     ///< least-squares polynomial of `order` over `window` samples
+  kKalman,            ///< white-noise acceleration or jerk model
+};
+
+enum class KalmanModel : std::uint8_t {
+  kConstantAcceleration,  ///< state (x, x', x''), white noise on x'''
+  kConstantJerk,          ///< state (x, x', x'', x'''), white noise on x''''
+};
+
+struct DifferentiatorConfig {
+  DifferentiatorType type = DifferentiatorType::kSavitzkyGolay;
+  /// Savitzky-Golay: samples in the fit and degree of the polynomial (2..5). The
+  /// estimate describes the sample `delay` steps before the newest: 0 is causal,
+  /// (window - 1) / 2 is centred. Finite differences use window = order + 1.
+  int window = 9;
+  int order = 2;
+  int delay = 0;
+  /// Kalman: spectral density of the white noise driving the highest derivative
+  /// [unit^2 / s^(2n-1)], and standard deviation of the position measurement [unit].
+  KalmanModel kalman_model = KalmanModel::kConstantAcceleration;
+  double process_noise = 1e3;
+  double measurement_noise = 1e-4;
+  /// A gap between samples longer than this [s] restarts the filter (its memory no
+  /// longer describes the signal).
+  double max_gap = 0.5;
+};
+
+/// Checks a configuration once; throws std::invalid_argument naming the field.
+inline void validate(const DifferentiatorConfig& c) {
+  if (c.type == DifferentiatorType::kKalman) {
+    if (!(c.process_noise > 0.0) || !std::isfinite(c.process_noise))
+      throw std::invalid_argument("differentiator.process_noise must be positive");
+    if (!(c.measurement_noise > 0.0) || !std::isfinite(c.measurement_noise))
+      throw std::invalid_argument("differentiator.measurement_noise must be positive");
+  } else {
+    if (c.order < 2 || c.order > 5)
+      throw std::invalid_argument("differentiator.order must be 2..5 (a second derivative "
+                                  "needs a quadratic), got " + std::to_string(c.order));
+    const int window = c.type == DifferentiatorType::kFiniteDifference ? c.order + 1 : c.window;
+    if (window < c.order + 1 || window > 101)
+      throw std::invalid_argument("differentiator.window must be order+1..101, got " +
+                                  std::to_string(c.window));
+    if (c.delay < 0 || c.delay >= window)
+      throw std::invalid_argument("differentiator.delay must be 0..window-1, got " +
+                                  std::to_string(c.delay));
+  }
+  if (!(c.max_gap > 0.0)) throw std::invalid_argument("differentiator.max_gap must be positive");
+}
+
+/// A bank of identical filters over `channels` signals sampled at common times.
+/// update() takes the newest sample; after it returns true, stamp() is the time the
+/// estimate describes (earlier than the newest sample by the configured delay) and
+/// value/rate/accel(c) the estimate for channel c. Memory is allocated in the
+/// constructor only. Times must increase: the caller resets on a backward jump and
+/// drops duplicates (update() refuses them).
+class DifferentiatorBank {
+ public:
+  static constexpr int kMaxOrder = 5;
+  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1,
+                                    kMaxOrder + 1>;
+
+  DifferentiatorBank(const DifferentiatorConfig& config, int channels)
+      : config_(config), channels_(channels) {
+    validate(config_);
+    if (config_.type == DifferentiatorType::kFiniteDifference) {
+      config_.window = config_.order + 1;
+    }
+    if (config_.type == DifferentiatorType::kKalman) {
+      n_ = config_.kalman_model == KalmanModel::kConstantAcceleration ? 3 : 4;
+      config_.window = 1;
+      config_.delay = 0;
+      state_.setZero(n_, channels_);
+      P_.setZero(n_, n_);
+    } else {
+      n_ = config_.order + 1;
+      coeff_.setZero(3, config_.window);
+      tau_prev_.setConstant(config_.window, std::nan(""));
+    }
+    times_.setZero(config_.window);
+    values_.setZero(config_.window, channels_);
+    out_.setZero(3, channels_);
+  }
+
+  const DifferentiatorConfig& config() const { return config_; }
+  int channels() const { return channels_; }
+  /// Samples needed after a reset before the first estimate.
+  int warmup() const { return config_.type == DifferentiatorType::kKalman ? n_ : config_.window; }
+
+  void reset() {
+    count_ = 0;
+    head_ = 0;
+    if (config_.type != DifferentiatorType::kKalman) tau_prev_.setConstant(std::nan(""));
+  }
+
+  /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.
+  /// Throws std::invalid_argument if t does not increase (the caller's duty).
+  bool update(double t, const double* x) {
+    if (count_ > 0) {
+      const double dt = t - last_time_;
+      if (!(dt > 0.0))
+        throw std::invalid_argument("differentiator: sample time does not increase");
+      if (dt > config_.max_gap) reset();
+    }
+    last_time_ = t;
+    if (config_.type == DifferentiatorType::kKalman) return updateKalman(t, x);
+    // Ring buffer of the last `window` samples.
+    times_[head_] = t;
+    for (int c = 0; c < channels_; ++c) values_(head_, c) = x[c];
+    head_ = (head_ + 1) % config_.window;
+    if (count_ < config_.window) ++count_;
+    if (count_ < config_.window) return false;
+    fitSavitzkyGolay();
+    return true;
+  }
+
+  double stamp() const { return stamp_; }
+  double value(int c) const { return out_(0, c); }
+  double rate(int c) const { return out_(1, c); }
+  double accel(int c) const { return out_(2, c); }
+
+ private:
+  // Index in the ring of the sample k steps before the newest.
+  int ring(int k) const { return (head_ - 1 - k + 2 * config_.window) % config_.window; }
+
+  void fitSavitzkyGolay() {
+    const int w = config_.window;
+    const int eval = ring(config_.delay);
+    stamp_ = times_[eval];
+    // Times relative to the evaluation point, scaled by the window's span so that the
+    // normal equations stay well conditioned at any rate.
+    const double span = times_[ring(0)] - times_[ring(w - 1)];
+    bool same = true;
+    for (int k = 0; k < w; ++k) {
+      const double tau = (times_[ring(k)] - stamp_) / span;
+      same = same && std::abs(tau - tau_prev_[k]) <= 1e-12;
+      tau_[k] = tau;
+    }
+    if (!same || span != span_prev_) {
+      // Coefficients of the least-squares polynomial at tau = 0: value = row 0 . x,
+      // first derivative = row 1 . x / span, second = 2 row 2 . x / span^2.
+      V_.resize(w, n_);
+      for (int k = 0; k < w; ++k) {
+        double p = 1.0;
+        for (int j = 0; j < n_; ++j, p *= tau_[k]) V_(k, j) = p;
+      }
+      SmallMatrix normal = V_.transpose() * V_;
+      Eigen::LDLT<SmallMatrix> ldlt(normal);
+      SmallMatrix inv = ldlt.solve(SmallMatrix::Identity(n_, n_));
+      for (int k = 0; k < w; ++k) {
+        const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> row =
+            inv * V_.row(k).transpose();
+        coeff_(0, k) = row[0];
+        coeff_(1, k) = row[1] / span;
+        coeff_(2, k) = 2.0 * row[2] / (span * span);
+      }
+      tau_prev_.head(w) = tau_.head(w);
+      span_prev_ = span;
+    }
+    out_.setZero();
+    for (int k = 0; k < w; ++k) out_.noalias() += coeff_.col(k) * values_.row(ring(k));
+  }
+
+  bool updateKalman(double t, const double* x) {
+    const int n = n_;
+    if (count_ == 0) {
+      // Start at the first measurement, at rest, with a wide prior on the derivatives.
+      state_.setZero();
+      for (int c = 0; c < channels_; ++c) state_(0, c) = x[c];
+      P_.setZero();
+      const double r2 = config_.measurement_noise * config_.measurement_noise;
+      P_(0, 0) = r2;
+      for (int i = 1; i < n; ++i) P_(i, i) = 1e12 * r2;
+      prev_t_ = t;
+      count_ = 1;
+      stamp_ = t;
+      out_.topRows(std::min(3, n)) = state_.topRows(std::min(3, n));
+      return false;
+    }
+    const double dt = t - prev_t_;
+    prev_t_ = t;
+    // Exact discretisation for this dt: F = exp(A dt) of the integrator chain, Q the
+    // integrated white noise of density q on the highest derivative.
+    SmallMatrix F = SmallMatrix::Identity(n, n);
+    SmallMatrix Q(n, n);
+    double fact[2 * kMaxOrder + 2];
+    fact[0] = 1.0;
+    for (int i = 1; i < 2 * kMaxOrder + 2; ++i) fact[i] = fact[i - 1] * i;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) F(i, j) = std::pow(dt, j - i) / fact[j - i];
+    const double q = config_.process_noise;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int a = n - 1 - i, b = n - 1 - j;
+        Q(i, j) = q * std::pow(dt, a + b + 1) / (fact[a] * fact[b] * (a + b + 1));
+      }
+    // Predict, then update with the position measurement: the gain is the same for
+    // every channel, so the covariance is propagated once.
+    P_ = F * P_ * F.transpose() + Q;
+    const double S = P_(0, 0) + config_.measurement_noise * config_.measurement_noise;
+    const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
+    P_ -= K * P_.row(0);
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    for (int c = 0; c < channels_; ++c) {
+      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> s = F * state_.col(c);
+      s += K * (x[c] - s[0]);
+      state_.col(c) = s;
+    }
+    stamp_ = t;
+    out_ = state_.topRows(3);
+    if (count_ < n) ++count_;
+    return count_ >= n;
+  }
+
+  DifferentiatorConfig config_;
+  int channels_;
+  int n_ = 3;
+  int count_ = 0;
+  int head_ = 0;
+  double last_time_ = 0.0;
+  double stamp_ = 0.0;
+  double prev_t_ = 0.0;
+  double span_prev_ = 0.0;
+  Eigen::VectorXd times_;
+  Eigen::MatrixXd values_;  // window x channels
+  Eigen::MatrixXd coeff_;   // 3 x window
+  Eigen::MatrixXd out_;     // 3 x channels
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_{101};
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_prev_;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 101, kMaxOrder + 1> V_;
+  Eigen::MatrixXd state_;  // Kalman: n x channels
+  SmallMatrix P_;
+};
+
+}  // namespace jle

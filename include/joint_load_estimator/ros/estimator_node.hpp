@@ -1,0 +1,91 @@
+// The ROS wrapper: owns the Estimator, forwards messages to it, publishes its loads.
+#pragma once
+
+#include <joint_load_estimator/JointLoads.h>
+#include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/ros/settings.hpp>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/WrenchStamped.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <deque>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace jle {
+
+/// Counters shown in diagnostics and used by the tests.
+struct NodeCounters {
+  long joint_states = 0;   ///< JointState messages received
+  long wrenches = 0;       ///< WrenchStamped messages received
+  long published = 0;      ///< JointLoads published
+  long dropped_invalid = 0;    ///< malformed or non-finite messages
+  long dropped_order = 0;      ///< duplicate or out-of-order stamps
+  long dropped_frame = 0;      ///< wrenches in a frame that could not be resolved
+  long unknown_joints = 0;     ///< messages naming joints the model does not have
+  long stale = 0;              ///< samples not published because an input was stale
+  long resets = 0;             ///< backward time jumps
+};
+
+class EstimatorNode {
+ public:
+  /// Reads the parameters and the model, subscribes and advertises. Throws
+  /// SettingsError or ModelError (naming the key, link or joint) on bad configuration.
+  EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+  const NodeCounters& counters() const { return counters_; }
+
+ private:
+  struct WrenchTopic {
+    WrenchTopicSettings settings;
+    ros::Subscriber subscriber;
+    std::string last_frame;  // cache of the constant frame resolution
+    bool rigid = false;      // expressed-in frame rigidly attached to the target link
+    Eigen::Matrix3d R_link_frame = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d p_link_frame = Eigen::Vector3d::Zero();
+  };
+
+  void onJointState(const sensor_msgs::JointState::ConstPtr& msg);
+  void onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
+  bool resolveFrame(WrenchTopic& topic, const std::string& frame, const ros::Time& stamp,
+                    Eigen::Matrix3d& R, Eigen::Vector3d& p);
+  bool checkTimeJump(const ros::Time& stamp);
+  void publish(const ros::Time& received);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  ros::NodeHandle nh_, private_nh_;
+  NodeSettings settings_;
+  std::unique_ptr<Estimator> estimator_;
+  std::unordered_map<std::string, int> coordinate_of_;  // joint name -> index in q
+  std::unordered_map<std::string, int> segment_of_;     // moving joint name -> segment
+  std::vector<int> published_segments_;
+  std::vector<double> q_;            // latest position of each coordinate
+  std::vector<bool> q_received_;
+  std::vector<double> effort_;       // latest measured effort per published joint (NaN: none)
+  // Measured efforts by stamp, to pair them with a delayed estimate.
+  std::deque<std::pair<double, std::vector<double>>> effort_history_;
+  ros::Subscriber joint_sub_;
+  std::vector<std::unique_ptr<WrenchTopic>> wrench_topics_;
+  ros::Publisher loads_pub_, residual_pub_;
+  std::vector<ros::Publisher> wrench_pubs_;
+  joint_load_estimator::JointLoads loads_msg_;
+  geometry_msgs::WrenchStamped wrench_msg_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  diagnostic_updater::Updater updater_;
+  ros::Time last_stamp_;
+  ros::Time last_now_;
+  NodeCounters counters_;
+  long published_at_last_diag_ = 0, received_at_last_diag_ = 0;
+  ros::WallTime last_diag_ = ros::WallTime::now();
+  double latency_sum_ = 0.0, latency_max_ = 0.0;
+  long latency_count_ = 0;
+};
+
+}  // namespace jle

@@ -1,0 +1,410 @@
+#include <joint_load_estimator/ros/estimator_node.hpp>
+
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <cmath>
+#include <limits>
+
+namespace jle {
+namespace {
+
+constexpr double kThrottle = 2.0;  // [s] between repeats of one error message
+constexpr std::size_t kEffortHistory = 128;
+
+bool allFinite(const std::vector<double>& v, std::size_t& bad) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i])) {
+      bad = i;
+      return false;
+    }
+  return true;
+}
+
+}  // namespace
+
+EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh), private_nh_(private_nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
+  XmlRpc::XmlRpcValue params;
+  if (!private_nh_.getParam(private_nh_.getNamespace(), params)) params = XmlRpc::XmlRpcValue();
+  settings_ = parseSettings(params);
+
+  std::string urdf;
+  if (!nh_.getParam(settings_.robot_description, urdf))
+    throw SettingsError("parameter '" + nh_.resolveName(settings_.robot_description) +
+                        "' (robot_description) is not set or is not a string");
+  ModelOptions options;
+  options.floating_base = settings_.floating_base;
+  options.keep_fixed_joints = settings_.keep_fixed_joints;
+  Model<double> model;
+  try {
+    model = modelFromUrdfString(urdf, options);
+  } catch (const ModelError& e) {
+    throw ModelError("robot_description '" + nh_.resolveName(settings_.robot_description) +
+                     "': " + e.what());
+  }
+  for (const std::string& w : model.warnings) ROS_WARN("robot model: %s", w.c_str());
+  if (model.floating_base && settings_.base_frame.empty())
+    settings_.base_frame = model.link_name[0];
+  estimator_ = std::make_unique<Estimator>(model, settings_.estimator);
+
+  for (int i = 0; i < model.nq; ++i) coordinate_of_[model.coordinate_names[i]] = i;
+  for (int s : model.moving_segments) segment_of_[model.joint_name[s]] = s;
+  if (settings_.joints.empty()) {
+    published_segments_ = model.moving_segments;
+  } else {
+    for (const std::string& j : settings_.joints) {
+      auto it = segment_of_.find(j);
+      if (it == segment_of_.end()) {
+        // A kept fixed joint is a valid output too.
+        try {
+          published_segments_.push_back(model.segmentOfJoint(j));
+          continue;
+        } catch (const std::invalid_argument&) {
+        }
+        throw SettingsError("parameter 'joints': '" + j + "' is not a joint of the model");
+      }
+      published_segments_.push_back(it->second);
+    }
+  }
+  q_.assign(static_cast<std::size_t>(model.nq), 0.0);
+  q_received_.assign(static_cast<std::size_t>(model.nq), false);
+  effort_.assign(published_segments_.size(), std::numeric_limits<double>::quiet_NaN());
+
+  const std::size_t n = published_segments_.size();
+  loads_msg_.name.resize(n);
+  loads_msg_.wrench.resize(n);
+  loads_msg_.effort.resize(n);
+  loads_msg_.measured_effort.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    loads_msg_.name[i] = model.joint_name[static_cast<std::size_t>(published_segments_[i])];
+
+  loads_pub_ = private_nh_.advertise<joint_load_estimator::JointLoads>("joint_loads", 100);
+  if (settings_.publish_wrench_topics)
+    for (std::size_t i = 0; i < n; ++i)
+      wrench_pubs_.push_back(
+          private_nh_.advertise<geometry_msgs::WrenchStamped>("wrench/" + loads_msg_.name[i], 10));
+  if (model.floating_base)
+    residual_pub_ = private_nh_.advertise<geometry_msgs::WrenchStamped>("base_residual", 10);
+
+  for (std::size_t k = 0; k < settings_.wrenches.size(); ++k) {
+    auto topic = std::make_unique<WrenchTopic>();
+    topic->settings = settings_.wrenches[k];
+    topic->subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
+        topic->settings.topic, 100,
+        [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onWrench(k, msg); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    wrench_topics_.push_back(std::move(topic));
+  }
+  joint_sub_ = nh_.subscribe(settings_.joint_states_topic, 100, &EstimatorNode::onJointState,
+                             this, ros::TransportHints().tcpNoDelay());
+
+  updater_.setHardwareID(model.link_name[0]);
+  updater_.add("joint loads", this, &EstimatorNode::diagnose);
+  ROS_INFO("joint_load_estimator: %d segments, %d coordinates, %zu joints published, %zu wrench "
+           "inputs%s",
+           model.nsegments(), model.nq, n, settings_.wrenches.size(),
+           model.floating_base ? ", floating base" : "");
+}
+
+bool EstimatorNode::checkTimeJump(const ros::Time& stamp) {
+  // A looping bag (rosbag play -l) or a restarted simulation sends time backwards:
+  // the filters' memory belongs to another timeline.
+  const ros::Time now = ros::Time::now();
+  const bool clock_back = !last_now_.isZero() && now < last_now_;
+  const bool stamp_back =
+      !last_stamp_.isZero() && (last_stamp_ - stamp).toSec() > settings_.time_jump_threshold;
+  last_now_ = now;
+  if (!clock_back && !stamp_back) return false;
+  ROS_WARN("time jumped back (from %.6f to %.6f): resetting the filters", last_stamp_.toSec(),
+           stamp.toSec());
+  estimator_->reset();
+  effort_history_.clear();
+  last_stamp_ = ros::Time();
+  ++counters_.resets;
+  return true;
+}
+
+void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
+  const ros::Time received = ros::Time::now();
+  ++counters_.joint_states;
+  try {
+    const std::size_t n = msg->name.size();
+    if (msg->position.size() != n) {
+      ROS_ERROR_THROTTLE(kThrottle, "joint_states: %zu names but %zu positions: message dropped",
+                         n, msg->position.size());
+      ++counters_.dropped_invalid;
+      return;
+    }
+    if (!msg->velocity.empty() && msg->velocity.size() != n) {
+      ROS_ERROR_THROTTLE(kThrottle, "joint_states: %zu names but %zu velocities: message dropped",
+                         n, msg->velocity.size());
+      ++counters_.dropped_invalid;
+      return;
+    }
+    if (!msg->effort.empty() && msg->effort.size() != n) {
+      ROS_ERROR_THROTTLE(kThrottle, "joint_states: %zu names but %zu efforts: message dropped", n,
+                         msg->effort.size());
+      ++counters_.dropped_invalid;
+      return;
+    }
+    std::size_t bad = 0;
+    for (const auto* field : {&msg->position, &msg->velocity, &msg->effort}) {
+      if (!allFinite(*field, bad)) {
+        const char* name = field == &msg->position   ? "position"
+                           : field == &msg->velocity ? "velocity"
+                                                     : "effort";
+        ROS_ERROR_THROTTLE(kThrottle, "joint_states: %s of joint '%s' is %f: message dropped",
+                           name, msg->name[bad].c_str(), (*field)[bad]);
+        ++counters_.dropped_invalid;
+        return;
+      }
+    }
+    ros::Time stamp = msg->header.stamp;
+    if (stamp.isZero()) stamp = received;
+    checkTimeJump(stamp);
+
+    bool unknown = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      auto it = coordinate_of_.find(msg->name[i]);
+      if (it == coordinate_of_.end()) {
+        if (!segment_of_.count(msg->name[i])) {  // a mimic joint's value is not needed
+          ROS_WARN_THROTTLE(kThrottle, "joint_states: joint '%s' is not in the model: ignored",
+                            msg->name[i].c_str());
+          unknown = true;
+        }
+        continue;
+      }
+      q_[static_cast<std::size_t>(it->second)] = msg->position[i];
+      q_received_[static_cast<std::size_t>(it->second)] = true;
+    }
+    if (unknown) ++counters_.unknown_joints;
+    if (!msg->effort.empty()) {
+      for (std::size_t j = 0; j < published_segments_.size(); ++j)
+        for (std::size_t i = 0; i < n; ++i)
+          if (msg->name[i] == loads_msg_.name[j]) effort_[j] = msg->effort[i];
+      effort_history_.emplace_back(stamp.toSec(), effort_);
+      if (effort_history_.size() > kEffortHistory) effort_history_.pop_front();
+    }
+    for (std::size_t i = 0; i < q_.size(); ++i) {
+      if (!q_received_[i]) {
+        ROS_ERROR_THROTTLE(kThrottle,
+                           "joint_states: no position received yet for joint '%s': not "
+                           "publishing",
+                           estimator_->model().coordinate_names[i].c_str());
+        return;
+      }
+    }
+
+    BasePose base;
+    if (estimator_->model().floating_base) {
+      geometry_msgs::TransformStamped tf;
+      try {
+        tf = tf_buffer_.lookupTransform(settings_.world_frame, settings_.base_frame, stamp);
+      } catch (const tf2::TransformException& e) {
+        ROS_WARN_THROTTLE(kThrottle, "floating base: no pose of '%s' in '%s' at %.6f: %s",
+                          settings_.base_frame.c_str(), settings_.world_frame.c_str(),
+                          stamp.toSec(), e.what());
+        ++counters_.dropped_frame;
+        return;
+      }
+      base.position = tf2::transformToEigen(tf).translation();
+      tf2::fromMsg(tf.transform.rotation, base.orientation);
+    }
+
+    const SampleStatus status = estimator_->addJointSample(stamp.toSec(), q_.data(), &base);
+    switch (status) {
+      case SampleStatus::kPublished: publish(received); break;
+      case SampleStatus::kDuplicate:
+      case SampleStatus::kOutOfOrder:
+        ++counters_.dropped_order;
+        ROS_WARN_THROTTLE(kThrottle, "joint_states: %s %.9f (previous %.9f): message dropped",
+                          toString(status), stamp.toSec(), last_stamp_.toSec());
+        return;
+      case SampleStatus::kNonFinite:
+        ++counters_.dropped_invalid;
+        ROS_ERROR_THROTTLE(kThrottle, "joint_states: non-finite stamp or base pose: dropped");
+        return;
+      case SampleStatus::kStale:
+        ++counters_.stale;
+        for (std::size_t k = 0; k < wrench_topics_.size(); ++k)
+          if (estimator_->stale(static_cast<int>(k)))
+            ROS_WARN_THROTTLE(kThrottle, "wrench input '%s' is stale: not publishing",
+                              wrench_topics_[k]->settings.topic.c_str());
+        break;
+      default: break;
+    }
+    last_stamp_ = stamp;
+  } catch (const std::exception& e) {
+    // Nothing may leave a callback; the next message is processed as usual.
+    ++counters_.dropped_invalid;
+    ROS_ERROR_THROTTLE(kThrottle, "joint_states: %s", e.what());
+  }
+}
+
+bool EstimatorNode::resolveFrame(WrenchTopic& topic, const std::string& frame,
+                                 const ros::Time& stamp, Eigen::Matrix3d& R, Eigen::Vector3d& p) {
+  const Model<double>& model = estimator_->model();
+  const std::string& link = topic.settings.input.link;
+  if (frame == topic.last_frame && topic.rigid) {
+    R = topic.R_link_frame;
+    p = topic.p_link_frame;
+    return true;
+  }
+  // A URDF frame on the same segment as the link: a constant transform from the model.
+  for (const Frame<double>& f : model.frames) {
+    if (f.name != frame) continue;
+    const Frame<double>& l = model.frames[static_cast<std::size_t>(model.frameIndex(link))];
+    if (f.segment != l.segment) break;  // moves relative to the link: ask tf2
+    topic.R_link_frame = l.R_segment_frame.transpose() * f.R_segment_frame;
+    topic.p_link_frame = l.R_segment_frame.transpose() * (f.p_segment_frame - l.p_segment_frame);
+    topic.rigid = true;
+    topic.last_frame = frame;
+    R = topic.R_link_frame;
+    p = topic.p_link_frame;
+    return true;
+  }
+  topic.rigid = false;
+  topic.last_frame = frame;
+  try {
+    const geometry_msgs::TransformStamped tf =
+        tf_buffer_.lookupTransform(link, frame, stamp, ros::Duration(0.0));
+    const Eigen::Isometry3d X = tf2::transformToEigen(tf);
+    R = X.rotation();
+    p = X.translation();
+    return true;
+  } catch (const tf2::TransformException& e) {
+    ROS_ERROR_THROTTLE(kThrottle, "wrench '%s': frame '%s' is neither a URDF link nor known to "
+                       "tf2 relative to '%s': %s",
+                       topic.settings.topic.c_str(), frame.c_str(), link.c_str(), e.what());
+    return false;
+  }
+}
+
+void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+  ++counters_.wrenches;
+  try {
+    WrenchTopic& topic = *wrench_topics_[k];
+    Eigen::Vector3d f, m;
+    tf2::fromMsg(msg->wrench.force, f);
+    tf2::fromMsg(msg->wrench.torque, m);
+    if (!f.allFinite() || !m.allFinite()) {
+      ROS_ERROR_THROTTLE(kThrottle, "wrench '%s': non-finite force or torque: dropped",
+                         topic.settings.topic.c_str());
+      ++counters_.dropped_invalid;
+      return;
+    }
+    const std::string& frame =
+        topic.settings.frame.empty() ? msg->header.frame_id : topic.settings.frame;
+    if (frame.empty()) {
+      ROS_ERROR_THROTTLE(kThrottle, "wrench '%s': empty header.frame_id and no 'frame' "
+                         "configured: dropped", topic.settings.topic.c_str());
+      ++counters_.dropped_frame;
+      return;
+    }
+    const ros::Time stamp = msg->header.stamp.isZero() ? ros::Time::now() : msg->header.stamp;
+    Eigen::Matrix3d R;
+    Eigen::Vector3d p;
+    if (!resolveFrame(topic, frame, stamp, R, p)) {
+      ++counters_.dropped_frame;
+      return;
+    }
+    // Expressed in the link frame, moment about the link origin.
+    const Eigen::Vector3d f_link = R * f;
+    const Eigen::Vector3d m_link = R * m + p.cross(f_link);
+    if (!estimator_->addWrench(static_cast<int>(k), stamp.toSec(), f_link, m_link)) {
+      ++counters_.dropped_order;
+      ROS_WARN_THROTTLE(kThrottle, "wrench '%s': stamp %.9f not newer than the last: dropped",
+                        topic.settings.topic.c_str(), stamp.toSec());
+    }
+  } catch (const std::exception& e) {
+    ++counters_.dropped_invalid;
+    ROS_ERROR_THROTTLE(kThrottle, "wrench input %zu: %s", k, e.what());
+  }
+}
+
+void EstimatorNode::publish(const ros::Time& received) {
+  const Data<double>& data = estimator_->data();
+  const ros::Time stamp(estimator_->stamp());
+  // The measured efforts that belong to the stamp the estimate describes.
+  const std::vector<double>* measured = nullptr;
+  for (auto it = effort_history_.rbegin(); it != effort_history_.rend(); ++it)
+    if (it->first == estimator_->stamp()) {
+      measured = &it->second;
+      break;
+    }
+  loads_msg_.header.stamp = stamp;
+  for (std::size_t i = 0; i < published_segments_.size(); ++i) {
+    const std::size_t s = static_cast<std::size_t>(published_segments_[i]);
+    geometry_msgs::Wrench& w = loads_msg_.wrench[i];
+    w.force.x = data.force[s].x();
+    w.force.y = data.force[s].y();
+    w.force.z = data.force[s].z();
+    w.torque.x = data.moment[s].x();
+    w.torque.y = data.moment[s].y();
+    w.torque.z = data.moment[s].z();
+    loads_msg_.effort[i] = data.effort[s];
+    loads_msg_.measured_effort[i] =
+        measured ? (*measured)[i] : std::numeric_limits<double>::quiet_NaN();
+    if (!wrench_pubs_.empty() && wrench_pubs_[i].getNumSubscribers() > 0) {
+      wrench_msg_.header.stamp = stamp;
+      wrench_msg_.header.frame_id = estimator_->model().link_name[s];
+      wrench_msg_.wrench = w;
+      wrench_pubs_[i].publish(wrench_msg_);
+    }
+  }
+  loads_pub_.publish(loads_msg_);
+  if (residual_pub_ && residual_pub_.getNumSubscribers() > 0) {
+    wrench_msg_.header.stamp = stamp;
+    wrench_msg_.header.frame_id = estimator_->model().link_name[0];
+    wrench_msg_.wrench.force = tf2::toMsg(data.force[0], wrench_msg_.wrench.force);
+    wrench_msg_.wrench.torque = tf2::toMsg(data.moment[0], wrench_msg_.wrench.torque);
+    residual_pub_.publish(wrench_msg_);
+  }
+  ++counters_.published;
+  const double latency = (ros::Time::now() - received).toSec();
+  latency_sum_ += latency;
+  latency_max_ = std::max(latency_max_, latency);
+  ++latency_count_;
+  updater_.update();
+}
+
+void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const ros::WallTime now = ros::WallTime::now();
+  const double dt = (now - last_diag_).toSec();
+  const double in_rate = dt > 0 ? (counters_.joint_states - received_at_last_diag_) / dt : 0.0;
+  const double out_rate = dt > 0 ? (counters_.published - published_at_last_diag_) / dt : 0.0;
+  last_diag_ = now;
+  received_at_last_diag_ = counters_.joint_states;
+  published_at_last_diag_ = counters_.published;
+  std::string stale;
+  for (std::size_t k = 0; k < wrench_topics_.size(); ++k)
+    if (estimator_->stale(static_cast<int>(k)))
+      stale += (stale.empty() ? "" : ", ") + wrench_topics_[k]->settings.topic;
+  if (counters_.published == 0)
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no loads published yet");
+  else if (!stale.empty())
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale wrench inputs: " + stale);
+  else
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "publishing");
+  status.add("input rate [Hz]", in_rate);
+  status.add("output rate [Hz]", out_rate);
+  status.add("mean latency [s]", latency_count_ ? latency_sum_ / latency_count_ : 0.0);
+  status.add("max latency [s]", latency_max_);
+  status.add("joint states received", counters_.joint_states);
+  status.add("wrenches received", counters_.wrenches);
+  status.add("loads published", counters_.published);
+  status.add("dropped: invalid", counters_.dropped_invalid);
+  status.add("dropped: stamp order", counters_.dropped_order);
+  status.add("dropped: unresolved frame", counters_.dropped_frame);
+  status.add("messages with unknown joints", counters_.unknown_joints);
+  status.add("not published: stale input", counters_.stale);
+  status.add("time jumps back", counters_.resets);
+  status.add("stale inputs", stale);
+  latency_sum_ = 0.0;
+  latency_max_ = 0.0;
+  latency_count_ = 0;
+}
+
+}  // namespace jle

@@ -1,0 +1,258 @@
+#include <joint_load_estimator/ros/settings.hpp>
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <set>
+
+namespace jle {
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+std::string typeName(const XmlRpcValue& v) {
+  switch (v.getType()) {
+    case XmlRpcValue::TypeBoolean: return "a boolean";
+    case XmlRpcValue::TypeInt: return "an integer";
+    case XmlRpcValue::TypeDouble: return "a number";
+    case XmlRpcValue::TypeString: return "a string";
+    case XmlRpcValue::TypeArray: return "a list";
+    case XmlRpcValue::TypeStruct: return "a map";
+    default: return "of another type";
+  }
+}
+
+[[noreturn]] void wrongType(const std::string& key, const XmlRpcValue& v, const char* expected) {
+  throw SettingsError("parameter '" + key + "' must be " + expected + ", it is " + typeName(v));
+}
+
+// Reads the keys of one struct, remembering which were used so that the rest can be
+// reported as unknown.
+class Section {
+ public:
+  Section(const XmlRpcValue& value, std::string prefix) : prefix_(std::move(prefix)) {
+    if (value.getType() == XmlRpcValue::TypeInvalid) return;  // absent: all defaults
+    if (value.getType() != XmlRpcValue::TypeStruct) wrongType(prefix_, value, "a map");
+    value_ = value;
+  }
+  bool has(const std::string& key) const {
+    return value_.getType() == XmlRpcValue::TypeStruct && value_.hasMember(key);
+  }
+  const XmlRpcValue& get(const std::string& key) {
+    used_.insert(key);
+    return value_[key];
+  }
+  std::string name(const std::string& key) const {
+    return prefix_.empty() ? key : prefix_ + "/" + key;
+  }
+  void read(const std::string& key, double& out) {
+    if (!has(key)) return;
+    const XmlRpcValue& v = get(key);
+    if (v.getType() == XmlRpcValue::TypeDouble)
+      out = static_cast<double>(const_cast<XmlRpcValue&>(v));
+    else if (v.getType() == XmlRpcValue::TypeInt)
+      out = static_cast<int>(const_cast<XmlRpcValue&>(v));
+    else
+      wrongType(name(key), v, "a number");
+    if (!std::isfinite(out)) throw SettingsError("parameter '" + name(key) + "' is not finite");
+  }
+  void read(const std::string& key, int& out) {
+    if (!has(key)) return;
+    const XmlRpcValue& v = get(key);
+    if (v.getType() != XmlRpcValue::TypeInt) wrongType(name(key), v, "an integer");
+    out = static_cast<int>(const_cast<XmlRpcValue&>(v));
+  }
+  void read(const std::string& key, bool& out) {
+    if (!has(key)) return;
+    const XmlRpcValue& v = get(key);
+    if (v.getType() != XmlRpcValue::TypeBoolean) wrongType(name(key), v, "true or false");
+    out = static_cast<bool>(const_cast<XmlRpcValue&>(v));
+  }
+  void read(const std::string& key, std::string& out) {
+    if (!has(key)) return;
+    const XmlRpcValue& v = get(key);
+    if (v.getType() != XmlRpcValue::TypeString) wrongType(name(key), v, "a string");
+    out = static_cast<std::string>(const_cast<XmlRpcValue&>(v));
+  }
+  void read(const std::string& key, std::vector<std::string>& out) {
+    if (!has(key)) return;
+    const XmlRpcValue& v = get(key);
+    if (v.getType() != XmlRpcValue::TypeArray) wrongType(name(key), v, "a list of strings");
+    out.clear();
+    for (int i = 0; i < v.size(); ++i) {
+      const XmlRpcValue& e = v[i];
+      if (e.getType() != XmlRpcValue::TypeString)
+        wrongType(name(key) + "[" + std::to_string(i) + "]", e, "a string");
+      out.push_back(static_cast<std::string>(const_cast<XmlRpcValue&>(e)));
+    }
+  }
+  void finish() const {
+    if (value_.getType() != XmlRpcValue::TypeStruct) return;
+    for (auto it = value_.begin(); it != value_.end(); ++it)
+      if (!used_.count(it->first))
+        throw SettingsError("unknown parameter '" + name(it->first) + "'");
+  }
+
+ private:
+  XmlRpcValue value_;
+  std::string prefix_;
+  std::set<std::string> used_;
+};
+
+template <typename Enum>
+Enum choose(const std::string& key, const std::string& value,
+            std::initializer_list<std::pair<const char*, Enum>> options) {
+  std::string names;
+  for (const auto& o : options) {
+    if (value == o.first) return o.second;
+    names += std::string(names.empty() ? "" : ", ") + o.first;
+  }
+  throw SettingsError("parameter '" + key + "' is '" + value + "'; expected one of " + names);
+}
+
+DifferentiatorConfig parseDifferentiator(const XmlRpcValue& value, const std::string& prefix) {
+  DifferentiatorConfig c;
+  Section s(value, prefix);
+  std::string type = "savitzky_golay", model = "constant_acceleration";
+  s.read("type", type);
+  c.type = choose<DifferentiatorType>(s.name("type"), type,
+                                      {{"finite_difference", DifferentiatorType::kFiniteDifference},
+                                       {"savitzky_golay", DifferentiatorType::kSavitzkyGolay},
+                                       {"kalman", DifferentiatorType::kKalman}});
+  s.read("window", c.window);
+  s.read("order", c.order);
+  if (s.has("delay")) {
+    // "centred" or a number of samples.
+    const XmlRpcValue& d = s.get("delay");
+    if (d.getType() == XmlRpcValue::TypeString &&
+        static_cast<std::string>(const_cast<XmlRpcValue&>(d)) == "centred")
+      c.delay = (c.window - 1) / 2;
+    else if (d.getType() == XmlRpcValue::TypeInt)
+      c.delay = static_cast<int>(const_cast<XmlRpcValue&>(d));
+    else
+      wrongType(s.name("delay"), d, "an integer or \"centred\"");
+  }
+  s.read("kalman_model", model);
+  c.kalman_model = choose<KalmanModel>(s.name("kalman_model"), model,
+                                       {{"constant_acceleration", KalmanModel::kConstantAcceleration},
+                                        {"constant_jerk", KalmanModel::kConstantJerk}});
+  s.read("process_noise", c.process_noise);
+  s.read("measurement_noise", c.measurement_noise);
+  s.read("max_gap", c.max_gap);
+  s.finish();
+  try {
+    validate(c);
+  } catch (const std::invalid_argument& e) {
+    throw SettingsError(std::string("parameter ") + e.what());
+  }
+  return c;
+}
+
+WrenchTopicSettings parseWrench(const XmlRpcValue& value, const std::string& prefix) {
+  WrenchTopicSettings w;
+  Section s(value, prefix);
+  if (value.getType() != XmlRpcValue::TypeStruct) wrongType(prefix, value, "a map");
+  if (!s.has("topic")) throw SettingsError("parameter '" + s.name("topic") + "' is required");
+  if (!s.has("link")) throw SettingsError("parameter '" + s.name("link") + "' is required");
+  s.read("topic", w.topic);
+  s.read("link", w.input.link);
+  s.read("frame", w.frame);
+  s.read("sign", w.input.sign);
+  if (!(w.input.sign == 1.0 || w.input.sign == -1.0))
+    throw SettingsError("parameter '" + s.name("sign") + "' must be 1 or -1");
+  s.read("timeout", w.input.timeout);
+  if (!(w.input.timeout > 0.0))
+    throw SettingsError("parameter '" + s.name("timeout") + "' must be positive");
+  std::string policy = "hold";
+  s.read("stale_policy", policy);
+  w.input.stale_policy = choose<StalePolicy>(
+      s.name("stale_policy"), policy,
+      {{"hold", StalePolicy::kHold}, {"zero", StalePolicy::kZero}, {"stop", StalePolicy::kStop}});
+  s.finish();
+  w.input.name = w.topic;
+  return w;
+}
+
+XmlRpcValue fromYaml(const YAML::Node& node) {
+  XmlRpcValue out;
+  switch (node.Type()) {
+    case YAML::NodeType::Map:
+      out = XmlRpcValue();
+      for (const auto& kv : node) out[kv.first.as<std::string>()] = fromYaml(kv.second);
+      if (node.size() == 0) out.begin();  // an empty map stays a map
+      return out;
+    case YAML::NodeType::Sequence:
+      out.setSize(static_cast<int>(node.size()));
+      for (std::size_t i = 0; i < node.size(); ++i) out[static_cast<int>(i)] = fromYaml(node[i]);
+      return out;
+    case YAML::NodeType::Scalar: {
+      const std::string text = node.Scalar();
+      if (node.Tag() == "!") return XmlRpcValue(text);  // quoted: a string
+      if (text == "true" || text == "True") return XmlRpcValue(true);
+      if (text == "false" || text == "False") return XmlRpcValue(false);
+      char* end = nullptr;
+      const long i = std::strtol(text.c_str(), &end, 10);
+      if (!text.empty() && *end == '\0') return XmlRpcValue(static_cast<int>(i));
+      const double d = std::strtod(text.c_str(), &end);
+      if (!text.empty() && *end == '\0') return XmlRpcValue(d);
+      return XmlRpcValue(text);
+    }
+    default: return out;
+  }
+}
+
+}  // namespace
+
+NodeSettings parseSettings(const XmlRpcValue& params) {
+  NodeSettings n;
+  Section s(params, "");
+  s.read("robot_description", n.robot_description);
+  s.read("joint_states_topic", n.joint_states_topic);
+  s.read("joints", n.joints);
+  s.read("publish_wrench_topics", n.publish_wrench_topics);
+  s.read("floating_base", n.floating_base);
+  s.read("world_frame", n.world_frame);
+  s.read("base_frame", n.base_frame);
+  s.read("time_jump_threshold", n.time_jump_threshold);
+  s.read("keep_fixed_joints", n.keep_fixed_joints);
+  s.read("decimation", n.estimator.decimation);
+  if (n.estimator.decimation < 1) throw SettingsError("parameter 'decimation' must be >= 1");
+  if (s.has("gravity")) {
+    const XmlRpcValue& g = s.get("gravity");
+    if (g.getType() != XmlRpcValue::TypeArray || g.size() != 3)
+      throw SettingsError("parameter 'gravity' must be a list of 3 numbers");
+    for (int i = 0; i < 3; ++i) {
+      const XmlRpcValue& e = g[i];
+      if (e.getType() == XmlRpcValue::TypeDouble)
+        n.estimator.gravity_world[i] = static_cast<double>(const_cast<XmlRpcValue&>(e));
+      else if (e.getType() == XmlRpcValue::TypeInt)
+        n.estimator.gravity_world[i] = static_cast<int>(const_cast<XmlRpcValue&>(e));
+      else
+        wrongType("gravity[" + std::to_string(i) + "]", e, "a number");
+    }
+  }
+  if (s.has("differentiator"))
+    n.estimator.differentiator = parseDifferentiator(s.get("differentiator"), "differentiator");
+  if (s.has("wrenches")) {
+    const XmlRpcValue& list = s.get("wrenches");
+    if (list.getType() != XmlRpcValue::TypeArray) wrongType("wrenches", list, "a list of maps");
+    for (int i = 0; i < list.size(); ++i) {
+      n.wrenches.push_back(parseWrench(list[i], "wrenches[" + std::to_string(i) + "]"));
+      n.estimator.wrenches.push_back(n.wrenches.back().input);
+    }
+  }
+  if (n.time_jump_threshold <= 0.0)
+    throw SettingsError("parameter 'time_jump_threshold' must be positive");
+  s.finish();
+  return n;
+}
+
+XmlRpcValue loadYaml(const std::string& path) {
+  try {
+    return fromYaml(YAML::LoadFile(path));
+  } catch (const YAML::Exception& e) {
+    throw SettingsError(path + ": " + e.what());
+  }
+}
+
+}  // namespace jle
