@@ -75,7 +75,7 @@ class CsvReader {
   char* buffer_ = nullptr;  // POSIX getline buffer, reused
   std::size_t capacity_ = 0;
   std::size_t length_ = 0;
-  long line_ = 0;          // line of the current record
+  long line_ = 0;           // line of the current record
   long physical_line_ = 0;  // lines read so far
   std::vector<std::string> header_;
   std::vector<std::size_t> begin_, end_;  // current record's cells, size columns()
@@ -85,7 +85,9 @@ class CsvReader {
 /// reads back to the same double). To a file: the rows go to a temporary file in the
 /// same directory, renamed onto the path by commit(); if commit() is never reached
 /// (an error, an exception) the temporary file is removed and an existing file at the
-/// path is untouched. To standard output when the path is empty.
+/// path is untouched (through a symbolic link, the file it names is replaced). A path
+/// that names a device or a pipe is written in place. To standard output when the path
+/// is empty.
 class CsvWriter {
  public:
   /// Throws CsvError if the temporary file cannot be created.
@@ -106,8 +108,9 @@ class CsvWriter {
  private:
   void put();  // line_ to the stream; throws on a write error
 
-  std::string path_;  // empty: standard output
-  std::string temporary_path_;
+  std::string path_;            // empty: standard output
+  std::string target_;          // the file renamed onto (path_, or what its link names)
+  std::string temporary_path_;  // empty when writing in place
   std::FILE* file_ = nullptr;
   std::string line_;
 };

@@ -5,7 +5,7 @@
 // of one set of coefficients.
 #pragma once
 
-#include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <Eigen/Core>
 
 #include <cmath>
@@ -145,35 +145,39 @@ class DifferentiatorBank {
     const int w = config_.window;
     const int eval = ring(config_.delay);
     stamp_ = times_[eval];
-    // Times relative to the evaluation point, scaled by the window's span so that the
-    // normal equations stay well conditioned at any rate.
-    const double span = times_[ring(0)] - times_[ring(w - 1)];
-    bool same = true;
+    // Times centred on the window and scaled to [-1, 1], so that the Vandermonde matrix
+    // stays well conditioned at any rate and any offset of the clock.
+    const double newest = times_[ring(0)], oldest = times_[ring(w - 1)];
+    const double mid = 0.5 * (newest + oldest), half = 0.5 * (newest - oldest);
+    bool same = half == half_prev_;
     for (int k = 0; k < w; ++k) {
-      const double tau = (times_[ring(k)] - stamp_) / span;
+      const double tau = (times_[ring(k)] - mid) / half;
       same = same && std::abs(tau - tau_prev_[k]) <= 1e-12;
       tau_[k] = tau;
     }
-    if (!same || span != span_prev_) {
-      // Coefficients of the least-squares polynomial at tau = 0: value = row 0 . x,
-      // first derivative = row 1 . x / span, second = 2 row 2 . x / span^2.
+    if (!same) {
+      // Least squares through Householder QR of the Vandermonde matrix (not the normal
+      // equations, which square its condition number). The estimate is a fixed linear
+      // combination of the window: coeff row d . x is the d-th derivative at the stamp.
       V_.resize(w, n_);
       for (int k = 0; k < w; ++k) {
         double p = 1.0;
         for (int j = 0; j < n_; ++j, p *= tau_[k]) V_(k, j) = p;
       }
-      SmallMatrix normal = V_.transpose() * V_;
-      Eigen::LDLT<SmallMatrix> ldlt(normal);
-      SmallMatrix inv = ldlt.solve(SmallMatrix::Identity(n_, n_));
-      for (int k = 0; k < w; ++k) {
-        const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> row =
-            inv * V_.row(k).transpose();
-        coeff_(0, k) = row[0];
-        coeff_(1, k) = row[1] / span;
-        coeff_(2, k) = 2.0 * row[2] / (span * span);
+      qr_.compute(V_);
+      pinv_ = qr_.solve(Identity::Identity(w, w));  // n x w
+      const double te = (stamp_ - mid) / half;
+      Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxOrder + 1> e(3, n_);
+      for (int j = 0; j < n_; ++j) {
+        e(0, j) = std::pow(te, j);
+        e(1, j) = j >= 1 ? j * std::pow(te, j - 1) : 0.0;
+        e(2, j) = j >= 2 ? j * (j - 1) * std::pow(te, j - 2) : 0.0;
       }
+      coeff_.noalias() = e * pinv_;
+      coeff_.row(1) /= half;
+      coeff_.row(2) /= half * half;
       tau_prev_.head(w) = tau_.head(w);
-      span_prev_ = span;
+      half_prev_ = half;
     }
     out_.setZero();
     for (int k = 0; k < w; ++k) out_.noalias() += coeff_.col(k) * values_.row(ring(k));
@@ -238,14 +242,18 @@ class DifferentiatorBank {
   double last_time_ = 0.0;
   double stamp_ = 0.0;
   double prev_t_ = 0.0;
-  double span_prev_ = 0.0;
+  double half_prev_ = 0.0;
   Eigen::VectorXd times_;
   Eigen::MatrixXd values_;  // window x channels
   Eigen::MatrixXd coeff_;   // 3 x window
   Eigen::MatrixXd out_;     // 3 x channels
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_{101};
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_prev_;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 101, kMaxOrder + 1> V_;
+  using Vandermonde = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 101, kMaxOrder + 1>;
+  using Identity = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 101, 101>;
+  Vandermonde V_;
+  Eigen::HouseholderQR<Vandermonde> qr_;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, 101> pinv_;
   Eigen::MatrixXd state_;  // Kalman: n x channels
   SmallMatrix P_;
 };

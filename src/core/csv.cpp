@@ -92,8 +92,7 @@ std::string errnoText() { return std::strerror(errno); }
 
 constexpr std::array<const char*, 6> kWrenchComponents = {"fx", "fy", "fz", "mx", "my", "mz"};
 constexpr std::array<const char*, 3> kStateSuffixes = {"q", "qd", "qdd"};
-constexpr std::array<const char*, 7> kLoadSuffixes = {"fx", "fy", "fz", "mx",
-                                                      "my", "mz", "effort"};
+constexpr std::array<const char*, 7> kLoadSuffixes = {"fx", "fy", "fz", "mx", "my", "mz", "effort"};
 const std::string kWrenchPrefix = "wrench@";
 
 template <std::size_t N>
@@ -128,17 +127,16 @@ void CsvReader::readHeader() {
     length_ -= 3;
   }
   line_ = physical_line_;
-  forEachCell(buffer_, length_, [&](int, std::size_t b, std::size_t e) {
-    header_.emplace_back(buffer_ + b, e - b);
-  });
+  forEachCell(buffer_, length_,
+              [&](int, std::size_t b, std::size_t e) { header_.emplace_back(buffer_ + b, e - b); });
   if (header_.size() == 1 && header_[0].empty())
     failHeader("blank header row, expected the column names");
   for (int c = 0; c < columns(); ++c) {
     if (header_[c].empty()) failHeader("column " + std::to_string(c + 1) + " has no name");
     for (int d = 0; d < c; ++d)
       if (header_[d] == header_[c])
-        failHeader("column '" + header_[c] + "' appears twice (columns " +
-                   std::to_string(d + 1) + " and " + std::to_string(c + 1) + ")");
+        failHeader("column '" + header_[c] + "' appears twice (columns " + std::to_string(d + 1) +
+                   " and " + std::to_string(c + 1) + ")");
   }
   begin_.assign(header_.size(), 0);
   end_.assign(header_.size(), 0);
@@ -231,9 +229,7 @@ void CsvReader::failAt(int c, const std::string& what) const {
   throw CsvError(path_ + ":" + std::to_string(line_) + ": column '" + header_[c] + "': " + what);
 }
 
-void CsvReader::failHeader(const std::string& what) const {
-  throw CsvError(path_ + ":1: " + what);
-}
+void CsvReader::failHeader(const std::string& what) const { throw CsvError(path_ + ":1: " + what); }
 
 // ---------------------------------------------------------------------------- writer
 
@@ -242,23 +238,40 @@ CsvWriter::CsvWriter(const std::string& path) : path_(path) {
     file_ = stdout;
     return;
   }
+  // Through a symbolic link, the file it names is replaced, not the link.
+  std::string target = path_;
   struct stat existing;
-  if (::stat(path_.c_str(), &existing) == 0 && S_ISDIR(existing.st_mode))
-    throw CsvError(path_ + ": is a directory");
-  const std::size_t slash = path_.rfind('/');
-  const std::string directory = slash == std::string::npos ? "." : path_.substr(0, slash + 1);
-  const std::string base = slash == std::string::npos ? path_ : path_.substr(slash + 1);
-  std::string name = (slash == std::string::npos ? std::string() : directory) + "." + base +
-                     ".tmp.XXXXXX";
+  if (::lstat(path_.c_str(), &existing) == 0 && S_ISLNK(existing.st_mode))
+    if (char* resolved = ::realpath(path_.c_str(), nullptr)) {
+      target = resolved;
+      std::free(resolved);
+    }
+  const bool exists = ::stat(target.c_str(), &existing) == 0;
+  if (exists && S_ISDIR(existing.st_mode)) throw CsvError(path_ + ": is a directory");
+  if (exists && !S_ISREG(existing.st_mode)) {
+    // A device or a pipe (/dev/stdout, a FIFO) is written in place: renaming a file
+    // onto it would replace the device itself.
+    file_ = std::fopen(target.c_str(), "wb");
+    if (!file_) throw CsvError(path_ + ": cannot open: " + errnoText());
+    return;
+  }
+  const std::size_t slash = target.rfind('/');
+  const std::string directory = slash == std::string::npos ? "." : target.substr(0, slash + 1);
+  const std::string base = slash == std::string::npos ? target : target.substr(slash + 1);
+  std::string name =
+      (slash == std::string::npos ? std::string() : directory) + "." + base + ".tmp.XXXXXX";
   const int fd = ::mkstemp(name.data());
   if (fd < 0)
     throw CsvError(path_ + ": cannot create a temporary file in '" + directory +
                    "': " + errnoText());
   temporary_path_ = name;
-  // mkstemp creates the file 0600; give it the mode a plain fopen would.
+  target_ = target;
+  // mkstemp creates the file 0600; give it the mode of the file it replaces, or the one
+  // a plain fopen would.
   const mode_t mask = ::umask(0);
   ::umask(mask);
-  if (::fchmod(fd, 0666 & ~mask) != 0 || !(file_ = ::fdopen(fd, "wb"))) {
+  const mode_t mode = exists ? (existing.st_mode & 07777) : (0666 & ~mask);
+  if (::fchmod(fd, mode) != 0 || !(file_ = ::fdopen(fd, "wb"))) {
     const std::string reason = errnoText();
     ::close(fd);
     ::unlink(temporary_path_.c_str());
@@ -299,8 +312,8 @@ void CsvWriter::writeRow(const double* values, std::size_t count) {
     if (i > 0) line_ += ',';
 #if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
     // Specified as printf's %.17g in the C locale, and several times faster.
-    const std::to_chars_result r = std::to_chars(buffer, buffer + sizeof buffer, values[i],
-                                                 std::chars_format::general, 17);
+    const std::to_chars_result r =
+        std::to_chars(buffer, buffer + sizeof buffer, values[i], std::chars_format::general, 17);
     line_.append(buffer, r.ptr);
 #else
     const int n = std::snprintf(buffer, sizeof buffer, "%.17g", values[i]);
@@ -316,11 +329,14 @@ void CsvWriter::commit() {
   if (std::fflush(file_) != 0 || std::ferror(file_))
     throw CsvError(where + ": cannot write: " + errnoText());
   if (path_.empty()) return;
-  if (::fsync(::fileno(file_)) != 0) throw CsvError(where + ": cannot sync: " + errnoText());
+  // Written in place (a device, a pipe): nothing to sync or rename.
+  if (!temporary_path_.empty() && ::fsync(::fileno(file_)) != 0)
+    throw CsvError(where + ": cannot sync: " + errnoText());
   std::FILE* file = file_;
   file_ = nullptr;
   if (std::fclose(file) != 0) throw CsvError(where + ": cannot write: " + errnoText());
-  if (std::rename(temporary_path_.c_str(), path_.c_str()) != 0)
+  if (temporary_path_.empty()) return;
+  if (std::rename(temporary_path_.c_str(), target_.c_str()) != 0)
     throw CsvError(where + ": cannot rename '" + temporary_path_ + "' onto it: " + errnoText());
   temporary_path_.clear();
 }
@@ -371,8 +387,9 @@ StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reade
     }
     const int kind = indexOf(kStateSuffixes, suffix);
     if (dot == std::string::npos || kind < 0) {
-      problems.add(name, "unknown column (expected t, JOINT.q, JOINT.qd, JOINT.qdd or "
-                         "wrench@LINK.fx ... .mz)");
+      problems.add(name,
+                   "unknown column (expected t, JOINT.q, JOINT.qd, JOINT.qdd or "
+                   "wrench@LINK.fx ... .mz)");
       continue;
     }
     const std::string joint = name.substr(0, dot);
@@ -380,8 +397,9 @@ StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reade
     for (int s : model.moving_segments)
       if (model.joint_name[s] == joint) segment = s;
     if (segment < 0) {
-      problems.add(name, "unknown joint (no revolute, continuous or prismatic joint of that "
-                         "name in the model)");
+      problems.add(name,
+                   "unknown joint (no revolute, continuous or prismatic joint of that "
+                   "name in the model)");
       continue;
     }
     const int k = model.coordinate[segment];

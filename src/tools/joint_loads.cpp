@@ -18,7 +18,8 @@
 
 namespace {
 
-const char* const kUsage = R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS.csv]
+const char* const kUsage =
+    R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS.csv]
                    [--gravity GX,GY,GZ] [--frame child|parent|world]
 
 Joint loads by per-segment inverse dynamics: for every sample of STATES.csv, the
@@ -157,10 +158,9 @@ void run(const Options& options) {
     jle::forwardKinematics(model, data, q, qd, qdd, options.gravity_world);
     for (const jle::StateColumns::WrenchColumns& w : columns.wrenches) {
       const auto& c = w.column;
-      jle::addExternalWrench(model, data, w.frame,
-                             Eigen::Vector3d(cells[c[0]], cells[c[1]], cells[c[2]]),
-                             Eigen::Vector3d(cells[c[3]], cells[c[4]], cells[c[5]]),
-                             jle::WrenchFrame::kLocal);
+      jle::addExternalWrench(
+          model, data, w.frame, Eigen::Vector3d(cells[c[0]], cells[c[1]], cells[c[2]]),
+          Eigen::Vector3d(cells[c[3]], cells[c[4]], cells[c[5]]), jle::WrenchFrame::kLocal);
     }
     jle::inverseDynamics(model, data);
 

@@ -17,7 +17,8 @@
 
 namespace {
 
-const char* const kUsage = R"(usage: make_trajectory --urdf ROBOT.urdf [--duration 2.0] [--rate 1000] [--seed 1]
+const char* const kUsage =
+    R"(usage: make_trajectory --urdf ROBOT.urdf [--duration 2.0] [--rate 1000] [--seed 1]
                        [--wrench LINK] [--output FILE]
 
 Writes a joint-state CSV for joint_loads (docs/joint_loads.md): columns t, then

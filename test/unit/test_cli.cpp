@@ -1,3 +1,726 @@
+// The command-line tools joint_loads and make_trajectory, run as processes: their CSV
+// plumbing (column mapping, order, frames, number formatting), their refusal of bad
+// input with one located message and no output file, and make_trajectory's formula.
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
 #include <gtest/gtest.h>
-TEST(Placeholder, ReplacedByRealTests) { FAIL() << "placeholder"; }
-int main(int argc, char** argv) { testing::InitGoogleTest(&argc, argv); return RUN_ALL_TESTS(); }
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kData = JLE_TEST_DATA;
+const std::string kPandaChain = kData + "/urdf/chains/panda_chain.urdf";
+const std::string kPanda = kData + "/urdf/panda.urdf";
+
+// ------------------------------------------------------------------ processes, files
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+struct Result {
+  int status = -1;  // exit status, -1 if the process did not exit normally
+  std::string out, err;
+};
+
+// A CSV as text cells; a parser of its own, so that the tools' reader is not its own judge.
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+
+  int column(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+  }
+  double number(std::size_t row, const std::string& name) const {
+    const int c = column(name);
+    EXPECT_GE(c, 0) << name;
+    return c < 0 ? 0.0 : std::strtod(rows[row][c].c_str(), nullptr);
+  }
+};
+
+std::vector<std::string> splitCells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream s(line);
+  std::string cell;
+  while (std::getline(s, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.push_back("");
+  return cells;
+}
+
+Table parseTable(const std::string& text) {
+  Table table;
+  std::stringstream s(text);
+  std::string line;
+  bool first = true;
+  while (std::getline(s, line)) {
+    if (first) {
+      table.header = splitCells(line);
+      first = false;
+    } else {
+      table.rows.push_back(splitCells(line));
+    }
+  }
+  return table;
+}
+
+std::string formatTable(const Table& table, const std::string& end_of_line = "\n") {
+  const auto join = [&](const std::vector<std::string>& cells) {
+    std::string line;
+    for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+    return line + end_of_line;
+  };
+  std::string text = join(table.header);
+  for (const auto& row : table.rows) text += join(row);
+  return text;
+}
+
+// One temporary directory per test: inputs and captured streams at the top, the tools'
+// outputs in out/, which must stay empty whenever a tool fails.
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/jle_test_cli_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr) << pattern << ": " << std::strerror(errno);
+    dir_ = pattern;
+    fs::create_directory(outDir());
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  std::string outDir() const { return dir_ + "/out"; }
+  std::string outPath() const { return outDir() + "/loads.csv"; }
+
+  Result run(const std::string& program, const std::vector<std::string>& args) const {
+    std::string command = quote(program);
+    for (const std::string& a : args) command += " " + quote(a);
+    command += " >" + quote(path("stdout.txt")) + " 2>" + quote(path("stderr.txt"));
+    const int raw = std::system(command.c_str());
+    Result r;
+    r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = readFile(path("stdout.txt"));
+    r.err = readFile(path("stderr.txt"));
+    return r;
+  }
+  Result jointLoads(const std::vector<std::string>& args) const {
+    return run(JLE_JOINT_LOADS, args);
+  }
+  Result makeTrajectory(const std::vector<std::string>& args) const {
+    return run(JLE_MAKE_TRAJECTORY, args);
+  }
+
+  // make_trajectory into `name`; fails the test if it fails.
+  std::string trajectory(const std::string& name, const std::string& urdf,
+                         std::vector<std::string> args) const {
+    args.insert(args.begin(), {"--urdf", urdf, "--output", path(name)});
+    const Result r = makeTrajectory(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return path(name);
+  }
+
+  std::vector<std::string> outEntries() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(outDir())) names.push_back(e.path().string());
+    return names;
+  }
+
+  std::string dir_;
+};
+
+// ------------------------------------------------------------------ the library's answer
+
+std::vector<std::string> loadHeader(const std::vector<std::string>& joints) {
+  std::vector<std::string> names{"t"};
+  for (const std::string& j : joints)
+    for (const char* s : {"fx", "fy", "fz", "mx", "my", "mz", "effort"})
+      names.push_back(j + "." + s);
+  return names;
+}
+
+std::vector<std::string> pandaArm() {
+  std::vector<std::string> joints;
+  for (int i = 1; i <= 7; ++i) joints.push_back("panda_joint" + std::to_string(i));
+  return joints;
+}
+
+// Checks every output row of joint_loads against the library run on the same input
+// row: joint wrench (named by the output column) in `frame`, effort.
+void expectMatchesLibrary(const std::string& urdf, const Table& in, const Table& out,
+                          const std::vector<std::string>& joints, const std::string& wrench_link,
+                          jle::WrenchFrame frame, const Eigen::Vector3d& gravity) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(urdf);
+  jle::Data<double> data(model);
+  ASSERT_EQ(out.header, loadHeader(joints));
+  ASSERT_EQ(out.rows.size(), in.rows.size());
+  jle::VectorX<double> q(model.nq), qd(model.nq), qdd(model.nq);
+  for (std::size_t r = 0; r < in.rows.size(); ++r) {
+    for (int k = 0; k < model.nq; ++k) {
+      const std::string& name = model.coordinate_names[k];
+      q[k] = in.number(r, name + ".q");
+      qd[k] = in.number(r, name + ".qd");
+      qdd[k] = in.number(r, name + ".qdd");
+    }
+    jle::forwardKinematics(model, data, q, qd, qdd, gravity);
+    if (!wrench_link.empty()) {
+      const std::string w = "wrench@" + wrench_link + ".";
+      jle::addExternalWrench(
+          model, data, model.frameIndex(wrench_link),
+          Eigen::Vector3d(in.number(r, w + "fx"), in.number(r, w + "fy"), in.number(r, w + "fz")),
+          Eigen::Vector3d(in.number(r, w + "mx"), in.number(r, w + "my"), in.number(r, w + "mz")),
+          jle::WrenchFrame::kLocal);
+    }
+    jle::inverseDynamics(model, data);
+
+    ASSERT_EQ(out.rows[r].size(), out.header.size()) << "row " << r;
+    // t passes through unchanged: the same 17 digits in and out.
+    EXPECT_EQ(out.rows[r][0], in.rows[r][in.column("t")]);
+    for (std::size_t c = 0; c < out.header.size(); ++c) {
+      const std::string& cell = out.rows[r][c];
+      const double printed = std::strtod(cell.c_str(), nullptr);
+      // The text is exactly %.17g of the number it reads back as: 17 significant digits.
+      char canonical[40];
+      std::snprintf(canonical, sizeof canonical, "%.17g", printed);
+      EXPECT_EQ(cell, canonical) << out.header[c] << " row " << r;
+      if (c == 0) continue;
+
+      const std::string& column = out.header[c];
+      const std::size_t dot = column.rfind('.');
+      const int s = model.segmentOfJoint(column.substr(0, dot));
+      const std::string component = column.substr(dot + 1);
+      const jle::Wrench<double> w = jle::jointWrench(model, data, s, frame);
+      double expected = data.effort[s];
+      if (component != "effort") {
+        const Eigen::Vector3d& v = component[0] == 'f' ? w.force : w.moment;
+        expected = v[component[1] - 'x'];
+      }
+      // The same algorithm on the same doubles (the inputs' 17 digits read back exactly):
+      // a column mix-up or a wrong frame is off by newtons. 1e-12 relative leaves room only
+      // for a compiler contracting a*b+c differently in the two builds.
+      EXPECT_NEAR(printed, expected, 1e-12 * std::max(1.0, std::abs(expected)))
+          << column << " row " << r;
+#ifndef __FP_FAST_FMA
+      // Without fused multiply-add both builds round identically: the printed 17 digits
+      // must give back the library's double bit for bit.
+      EXPECT_EQ(printed, expected) << column << " row " << r;
+#endif
+    }
+  }
+}
+
+// ------------------------------------------------------------------ round trips
+
+TEST_F(CliTest, PandaChainRoundTripMatchesTheLibrary) {
+  const std::string in =
+      trajectory("states.csv", kPandaChain,
+                 {"--duration", "0.05", "--rate", "1000", "--seed", "7", "--wrench", "panda_hand"});
+  const Result r = jointLoads({"--urdf", kPandaChain, "--input", in, "--output", outPath()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const Table input = parseTable(readFile(in));
+  ASSERT_EQ(input.rows.size(), 51u);  // t = 0, 0.001, ..., 0.05
+  expectMatchesLibrary(kPandaChain, input, parseTable(readFile(outPath())), pandaArm(),
+                       "panda_hand", jle::WrenchFrame::kChild, Eigen::Vector3d(0, 0, -9.80665));
+
+  // Without --output the same bytes go to standard output.
+  const Result piped = jointLoads({"--urdf", kPandaChain, "--input", in});
+  ASSERT_EQ(piped.status, 0) << piped.err;
+  EXPECT_EQ(piped.out, readFile(outPath()));
+}
+
+TEST_F(CliTest, PandaWithMimicFingerRoundTripMatchesTheLibrary) {
+  // The wrench acts on a finger: a prismatic segment, its link frame rotated in the hand.
+  const std::string in = trajectory(
+      "states.csv", kPanda, {"--duration", "0.02", "--seed", "3", "--wrench", "panda_leftfinger"});
+  const Table input = parseTable(readFile(in));
+  // The mimic finger has no columns of its own; its leader has.
+  EXPECT_EQ(input.column("panda_finger_joint2.q"), -1);
+  EXPECT_GE(input.column("panda_finger_joint1.qdd"), 0);
+  const Result r = jointLoads({"--urdf", kPanda, "--input", in, "--output", outPath()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> joints = pandaArm();
+  joints.push_back("panda_finger_joint1");
+  joints.push_back("panda_finger_joint2");  // reported: it moves
+  expectMatchesLibrary(kPanda, input, parseTable(readFile(outPath())), joints, "panda_leftfinger",
+                       jle::WrenchFrame::kChild, Eigen::Vector3d(0, 0, -9.80665));
+}
+
+TEST_F(CliTest, OutputReplacesTheFileALinkNamesAndWritesIntoAFifo) {
+  const std::string in = trajectory("states.csv", kPandaChain, {"--duration", "0.003"});
+  const Result reference = jointLoads({"--urdf", kPandaChain, "--input", in});
+  ASSERT_EQ(reference.status, 0) << reference.err;
+
+  writeFile(outDir() + "/real.csv", "previous\n");
+  fs::create_symlink("real.csv", outDir() + "/link.csv");
+  const Result r =
+      jointLoads({"--urdf", kPandaChain, "--input", in, "--output", outDir() + "/link.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(outDir() + "/link.csv"));
+  EXPECT_EQ(readFile(outDir() + "/real.csv"), reference.out);
+
+  // A pipe (like a device) is written in place, never replaced by a file. The reader
+  // gives up after a minute should joint_loads never open the pipe.
+  const std::string fifo = outDir() + "/pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  const std::string command = "timeout 60 cat " + quote(fifo) + " >" + quote(path("piped.csv")) +
+                              " & " + quote(JLE_JOINT_LOADS) + " --urdf " + quote(kPandaChain) +
+                              " --input " + quote(in) + " --output " + quote(fifo) +
+                              "; status=$?; wait; exit $status";
+  const int raw = std::system(command.c_str());
+  EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << raw;
+  EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
+  EXPECT_EQ(readFile(path("piped.csv")), reference.out);
+}
+
+TEST_F(CliTest, ParentAndWorldFramesAndGravityMatchTheLibrary) {
+  const std::string in = trajectory(
+      "states.csv", kPanda, {"--duration", "0.01", "--seed", "11", "--wrench", "panda_hand_tcp"});
+  const Table input = parseTable(readFile(in));
+  std::vector<std::string> joints = pandaArm();
+  joints.push_back("panda_finger_joint1");
+  joints.push_back("panda_finger_joint2");
+  const Eigen::Vector3d tilted(0.5, -1.25, -9.7);
+  for (const auto& [name, frame] :
+       std::vector<std::pair<std::string, jle::WrenchFrame>>{{"parent", jle::WrenchFrame::kParent},
+                                                             {"world", jle::WrenchFrame::kWorld},
+                                                             {"child", jle::WrenchFrame::kChild}}) {
+    SCOPED_TRACE(name);
+    const Result r = jointLoads({"--urdf", kPanda, "--input", in, "--output", outPath(), "--frame",
+                                 name, "--gravity=0.5, -1.25 ,-9.7"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    expectMatchesLibrary(kPanda, input, parseTable(readFile(outPath())), joints, "panda_hand_tcp",
+                         frame, tilted);
+  }
+}
+
+// ------------------------------------------------------------------ input layout
+
+class CliInputTest : public CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    in_ = trajectory("states.csv", kPanda,
+                     {"--duration", "0.01", "--seed", "5", "--wrench", "panda_hand"});
+    const Result r = jointLoads({"--urdf", kPanda, "--input", in_, "--output", outPath()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    reference_ = readFile(outPath());
+    table_ = parseTable(readFile(in_));
+  }
+  // joint_loads on `text` as input, to standard output.
+  Result loadsOf(const std::string& text) const {
+    writeFile(path("variant.csv"), text);
+    return jointLoads({"--urdf", kPanda, "--input", path("variant.csv")});
+  }
+
+  std::string in_, reference_;
+  Table table_;
+};
+
+TEST_F(CliInputTest, ShuffledColumnsGiveIdenticalOutput) {
+  const std::size_t n = table_.header.size();
+  ASSERT_EQ(n, 1u + 8 * 3 + 6);  // t, 8 coordinates, one wrench
+  // A fixed permutation that moves every column, t and the wrench included.
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = (7 * i + 3) % n;  // 7 is prime to 31
+  Table shuffled;
+  for (std::size_t i : order) shuffled.header.push_back(table_.header[i]);
+  for (const auto& row : table_.rows) {
+    std::vector<std::string> cells;
+    for (std::size_t i : order) cells.push_back(row[i]);
+    shuffled.rows.push_back(cells);
+  }
+  ASSERT_NE(shuffled.header[0], "t");
+  const Result r = loadsOf(formatTable(shuffled));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, reference_);
+}
+
+TEST_F(CliInputTest, BlanksCrlfAndTrailingBlankLineAreAccepted) {
+  Table padded = table_;
+  for (auto& cell : padded.header) cell = " " + cell + "\t";
+  for (auto& row : padded.rows)
+    for (auto& cell : row) cell = "\t " + cell + "  ";
+  const Result r = loadsOf(formatTable(padded, "\r\n") + "\r\n");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, reference_);
+}
+
+TEST_F(CliInputTest, MimicColumnsAreAcceptedAndIgnored) {
+  Table extra = table_;
+  for (const char* s : {".q", ".qd", ".qdd"})
+    extra.header.push_back(std::string("panda_finger_joint2") + s);
+  for (auto& row : extra.rows)
+    for (const char* v : {"0.5", "-3", "100"}) row.push_back(v);  // not what the leader says
+  const Result r = loadsOf(formatTable(extra));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, reference_);
+}
+
+TEST_F(CliInputTest, HeaderOnlyGivesHeaderOnly) {
+  const Result r = loadsOf(formatTable(Table{table_.header, {}}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, reference_.substr(0, reference_.find('\n') + 1));
+}
+
+// ------------------------------------------------------------------ bad input
+
+struct BadCase {
+  std::string name;
+  int status;
+  std::vector<std::string> message_parts;  // each must appear in the message
+};
+
+class CliBadInputTest : public CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    good_ = parseTable(
+        readFile(trajectory("good.csv", kPandaChain,
+                            {"--duration", "0.005", "--seed", "2", "--wrench", "panda_hand"})));
+    ASSERT_EQ(good_.rows.size(), 6u);  // lines 2 to 7
+  }
+  // Writes `table` as bad.csv, runs joint_loads on it (plus `extra` options) and checks
+  // the status, that stderr holds one line with every part, and that out/ stays empty.
+  void expectRefused(const Table& table, const BadCase& c,
+                     const std::vector<std::string>& extra = {}) {
+    SCOPED_TRACE(c.name);
+    writeFile(path("bad.csv"), formatTable(table));
+    std::vector<std::string> args{"--urdf",        kPandaChain, "--input",
+                                  path("bad.csv"), "--output",  outPath()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    expectRefusedArgs(args, c);
+  }
+  void expectRefusedArgs(const std::vector<std::string>& args, const BadCase& c) {
+    const Result r = jointLoads(args);
+    EXPECT_EQ(r.status, c.status) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    for (const std::string& part : c.message_parts)
+      EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
+    EXPECT_EQ(outEntries(), std::vector<std::string>{});
+  }
+  // good_ with cell `column` of data row `row` (line row + 2) replaced.
+  Table withCell(std::size_t row, const std::string& column, const std::string& text) const {
+    Table t = good_;
+    t.rows[row][t.column(column)] = text;
+    return t;
+  }
+
+  Table good_;
+};
+
+TEST_F(CliBadInputTest, BadCellsNameFileLineAndColumn) {
+  const std::string file = path("bad.csv");
+  // Row 4 is line 6: rows 0 to 3 have been written by then, and must vanish.
+  expectRefused(withCell(4, "panda_joint3.qd", ""),
+                {"missing cell", 1, {file + ":6: column 'panda_joint3.qd': empty cell"}});
+  expectRefused(withCell(4, "panda_joint3.qd", "abc"),
+                {"non-numeric", 1, {file + ":6: column 'panda_joint3.qd': 'abc' is not a number"}});
+  expectRefused(
+      withCell(4, "panda_joint5.q", "1.5x"),
+      {"trailing junk", 1, {file + ":6: column 'panda_joint5.q': '1.5x' is not a number"}});
+  expectRefused(
+      withCell(4, "wrench@panda_hand.my", "nan"),
+      {"NaN", 1, {file + ":6: column 'wrench@panda_hand.my': 'nan' is not a finite number"}});
+  expectRefused(withCell(5, "t", "-inf"),
+                {"inf", 1, {file + ":7: column 't': '-inf' is not a finite number"}});
+  expectRefused(withCell(5, "panda_joint1.qdd", "1e400"),
+                {"overflow", 1, {file + ":7: column 'panda_joint1.qdd': '1e400' is not a finite"}});
+}
+
+TEST_F(CliBadInputTest, RowsOfTheWrongLengthNameFileLineAndColumn) {
+  const std::string file = path("bad.csv");
+  ASSERT_EQ(good_.header.size(), 28u);  // t, 7 coordinates, one wrench
+  Table shorter = good_;
+  shorter.rows[3].pop_back();
+  expectRefused(shorter, {"short row",
+                          1,
+                          {file + ":5: row has 27 cells, the header has 28",
+                           "column '" + good_.header.back() + "'"}});
+  Table longer = good_;
+  longer.rows[3].push_back("1.0");
+  expectRefused(longer, {"long row",
+                         1,
+                         {file + ":5: row has 29 cells, the header has 28", "cell 29",
+                          "column '" + good_.header.back() + "'"}});
+  Table blank = good_;
+  blank.rows.insert(blank.rows.begin() + 2, std::vector<std::string>{""});
+  expectRefused(blank, {"blank line inside", 1, {file + ":4: blank line"}});
+}
+
+TEST_F(CliBadInputTest, BadHeadersNameTheColumns) {
+  const std::string at = path("bad.csv") + ":1: ";
+  Table unknown = good_;
+  unknown.header.push_back("bogus");
+  for (auto& row : unknown.rows) row.push_back("0");
+  expectRefused(unknown, {"unknown column", 1, {at + "column 'bogus': unknown column"}});
+
+  Table unknown_joint = good_;
+  unknown_joint.header[unknown_joint.column("panda_joint2.qd")] = "panda_jiont2.qd";
+  expectRefused(unknown_joint, {"unknown joint",
+                                1,
+                                {at + "column 'panda_jiont2.qd': unknown joint",
+                                 "missing column 'panda_joint2.qd'"}});
+
+  Table fixed_joint = good_;
+  fixed_joint.header.push_back("panda_hand_joint.q");  // fixed: no coordinate
+  for (auto& row : fixed_joint.rows) row.push_back("0");
+  expectRefused(fixed_joint,
+                {"fixed joint", 1, {at + "column 'panda_hand_joint.q': unknown joint"}});
+
+  Table missing = good_;
+  const int c = missing.column("panda_joint6.qdd");
+  missing.header.erase(missing.header.begin() + c);
+  for (auto& row : missing.rows) row.erase(row.begin() + c);
+  expectRefused(missing, {"missing column", 1, {at + "missing column 'panda_joint6.qdd'"}});
+
+  Table no_t = good_;
+  no_t.header[0] = "time";
+  expectRefused(no_t,
+                {"missing t", 1, {at + "column 'time': unknown column", "missing column 't'"}});
+
+  Table unknown_link = good_;
+  for (auto& name : unknown_link.header)
+    if (name.rfind("wrench@", 0) == 0) name.replace(0, 17, "wrench@no_such_link");
+  expectRefused(unknown_link,
+                {"unknown link",
+                 1,
+                 {at + "columns 'wrench@no_such_link.fx'", "unknown link 'no_such_link'"}});
+
+  Table incomplete = good_;
+  const int mz = incomplete.column("wrench@panda_hand.mz");
+  incomplete.header.erase(incomplete.header.begin() + mz);
+  for (auto& row : incomplete.rows) row.erase(row.begin() + mz);
+  expectRefused(incomplete, {"incomplete wrench",
+                             1,
+                             {at + "wrench@panda_hand: missing column "
+                                   "'wrench@panda_hand.mz'"}});
+
+  Table twice = good_;
+  twice.header[twice.column("panda_joint4.q")] = "panda_joint3.q";
+  expectRefused(twice, {"duplicate column", 1, {at + "column 'panda_joint3.q' appears twice"}});
+
+  writeFile(path("empty.csv"), "");
+  expectRefusedArgs({"--urdf", kPandaChain, "--input", path("empty.csv"), "--output", outPath()},
+                    {"empty file", 1, {path("empty.csv") + ":1: empty file"}});
+}
+
+TEST_F(CliBadInputTest, UnreadableFilesAreNamed) {
+  expectRefusedArgs({"--urdf", kPandaChain, "--input", path("absent.csv"), "--output", outPath()},
+                    {"missing file", 1, {path("absent.csv") + ": cannot open"}});
+  writeFile(path("bad.urdf"), "<robot name=\"r\"><link name=\"a\">\n");
+  writeFile(path("good.csv"), formatTable(good_));
+  expectRefusedArgs(
+      {"--urdf", path("bad.urdf"), "--input", path("good.csv"), "--output", outPath()},
+      {"malformed URDF", 1, {path("bad.urdf") + ": malformed XML"}});
+  expectRefusedArgs(
+      {"--urdf", path("absent.urdf"), "--input", path("good.csv"), "--output", outPath()},
+      {"missing URDF", 1, {path("absent.urdf")}});
+}
+
+TEST_F(CliBadInputTest, BadOptionsAreUsageErrors) {
+  writeFile(path("good.csv"), formatTable(good_));
+  const std::vector<std::string> base{"--urdf",         kPandaChain, "--input",
+                                      path("good.csv"), "--output",  outPath()};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  expectRefusedArgs(with({"--frame", "sideways"}), {"bad frame", 2, {"--frame", "'sideways'"}});
+  expectRefusedArgs(with({"--gravity", "0,-9.81"}), {"two numbers", 2, {"--gravity", "'0,-9.81'"}});
+  expectRefusedArgs(with({"--gravity", "0,0,nan"}), {"nan gravity", 2, {"--gravity", "'0,0,nan'"}});
+  expectRefusedArgs(with({"--gravity", "0,0,-9.8,1"}), {"four numbers", 2, {"--gravity"}});
+  expectRefusedArgs(with({"--gravity", "0,zero,-9.8"}), {"word", 2, {"--gravity"}});
+  expectRefusedArgs(with({"--bogus", "1"}), {"unknown option", 2, {"'--bogus'"}});
+  expectRefusedArgs(with({"stray"}), {"positional", 2, {"'stray'"}});
+  expectRefusedArgs(with({"--frame"}), {"no value", 2, {"--frame"}});
+  expectRefusedArgs(with({"--input", path("good.csv")}), {"twice", 2, {"--input"}});
+  expectRefusedArgs({"--input", path("good.csv"), "--output", outPath()},
+                    {"no urdf", 2, {"--urdf"}});
+}
+
+TEST_F(CliBadInputTest, FailureLeavesAnExistingOutputUntouched) {
+  writeFile(outPath(), "previous\n");
+  writeFile(path("bad.csv"), formatTable(withCell(5, "panda_joint1.q", "x")));
+  const Result r =
+      jointLoads({"--urdf", kPandaChain, "--input", path("bad.csv"), "--output", outPath()});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(readFile(outPath()), "previous\n");
+  EXPECT_EQ(outEntries(), std::vector<std::string>{outPath()});  // no temporary left
+}
+
+TEST_F(CliTest, HelpDocumentsTheContract) {
+  const Result r = jointLoads({"--help"});
+  EXPECT_EQ(r.status, 0);
+  for (const char* part : {"--urdf", "--input", "--output", "--gravity", "--frame", "JOINT.qdd",
+                           "wrench@LINK", "JOINT.effort", "%.17g", "Exit status"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part;
+}
+
+// ------------------------------------------------------------------ make_trajectory
+
+TEST_F(CliTest, TrajectoryIsDeterministicAndSeeded) {
+  const std::string a =
+      readFile(trajectory("a.csv", kPanda, {"--duration", "0.01", "--seed", "9"}));
+  const std::string b =
+      readFile(trajectory("b.csv", kPanda, {"--duration", "0.01", "--seed", "9"}));
+  const std::string c =
+      readFile(trajectory("c.csv", kPanda, {"--duration", "0.01", "--seed", "10"}));
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a.substr(a.find('\n')), c.substr(c.find('\n')));
+  EXPECT_EQ(a.substr(0, a.find('\n')), c.substr(0, c.find('\n')));
+}
+
+// The documented formula, worked again here from std::mt19937 and the documented draw
+// order: what make_trajectory writes is what its --help promises.
+TEST_F(CliTest, TrajectoryFollowsTheDocumentedFormula) {
+  const Table table = parseTable(readFile(trajectory(
+      "s.csv", kPanda,
+      {"--duration", "0.5", "--rate", "100", "--seed", "42", "--wrench", "panda_hand"})));
+  std::mt19937 gen(42);
+  const auto u = [&gen](double lo, double hi) {
+    const double a = static_cast<double>(gen() >> 5);
+    const double b = static_cast<double>(gen() >> 6);
+    return lo + (hi - lo) * ((a * 67108864.0 + b) / 9007199254740992.0);
+  };
+  const double two_pi = 2.0 * M_PI;
+  struct Sine {
+    double a, w, p;
+  };
+  std::vector<std::string> names = pandaArm();
+  names.push_back("panda_finger_joint1");  // the mimic finger has no coordinate
+  std::vector<std::vector<Sine>> coordinate(names.size());
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const int n = u(0, 1) < 0.5 ? 2 : 3;
+    const bool prismatic = names[k] == "panda_finger_joint1";
+    for (int j = 0; j < n; ++j) {
+      Sine s;
+      s.a = prismatic ? u(0.002, 0.01) : u(0.05, 0.4);
+      s.w = two_pi * u(0.1, 0.8);
+      s.p = u(0, two_pi);
+      coordinate[k].push_back(s);
+    }
+  }
+  std::vector<double> offset(6);
+  std::vector<Sine> component(6);
+  for (int i = 0; i < 6; ++i) {
+    const double scale = i < 3 ? 10.0 : 1.0;
+    offset[i] = u(-scale, scale);
+    component[i].a = u(0, scale);
+    component[i].w = two_pi * u(0.1, 1.0);
+    component[i].p = u(0, two_pi);
+  }
+
+  std::vector<std::string> header{"t"};
+  for (const auto& n : names)
+    for (const char* s : {".q", ".qd", ".qdd"}) header.push_back(n + s);
+  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"})
+    header.push_back(std::string("wrench@panda_hand.") + c);
+  ASSERT_EQ(table.header, header);
+  ASSERT_EQ(table.rows.size(), 51u);
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const double t = static_cast<double>(r) / 100.0;
+    EXPECT_EQ(table.number(r, "t"), t);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      double q = 0, qd = 0, qdd = 0;
+      for (const Sine& s : coordinate[k]) {
+        q += s.a * std::sin(s.w * t + s.p);
+        qd += s.a * s.w * std::cos(s.w * t + s.p);
+        qdd -= s.a * s.w * s.w * std::sin(s.w * t + s.p);
+      }
+      // Same formula and operations; the margin covers a compiler contracting a*b+c
+      // differently in the two builds: a few ulps of values up to 30 (|qdd| < 3 A w^2).
+      EXPECT_NEAR(table.number(r, names[k] + ".q"), q, 1e-13);
+      EXPECT_NEAR(table.number(r, names[k] + ".qd"), qd, 1e-13);
+      EXPECT_NEAR(table.number(r, names[k] + ".qdd"), qdd, 1e-12);
+    }
+    for (int i = 0; i < 6; ++i) {
+      const double expected =
+          offset[i] + component[i].a * std::sin(component[i].w * t + component[i].p);
+      EXPECT_NEAR(table.number(r, header[header.size() - 6 + i]), expected, 1e-13);
+    }
+  }
+}
+
+// qd and qdd are the derivatives of q: central differences agree to O(h^2).
+TEST_F(CliTest, TrajectoryDerivativesAreConsistent) {
+  const Table table = parseTable(readFile(
+      trajectory("s.csv", kPandaChain, {"--duration", "0.2", "--rate", "1000", "--seed", "8"})));
+  const double h = 1e-3;
+  for (int j = 1; j <= 7; ++j) {
+    const std::string n = "panda_joint" + std::to_string(j);
+    for (std::size_t r = 1; r + 1 < table.rows.size(); ++r) {
+      const double dq = (table.number(r + 1, n + ".q") - table.number(r - 1, n + ".q")) / (2 * h);
+      const double dqd =
+          (table.number(r + 1, n + ".qd") - table.number(r - 1, n + ".qd")) / (2 * h);
+      // Central-difference error h^2/6 |q'''|, |q'''| <= sum A w^3 < 3 * 0.4 * 5.03^3 = 153:
+      // 2.6e-5 (and |q''''| < 770 gives 1.3e-4 for qdd); rounding adds 1e-13 / h.
+      EXPECT_NEAR(dq, table.number(r, n + ".qd"), 3e-5) << n << " row " << r;
+      EXPECT_NEAR(dqd, table.number(r, n + ".qdd"), 1.5e-4) << n << " row " << r;
+    }
+  }
+}
+
+TEST_F(CliTest, TrajectoryRefusesBadOptions) {
+  for (const auto& args :
+       std::vector<std::vector<std::string>>{{"--urdf", kPanda, "--wrench", "no_such_link"},
+                                             {"--urdf", kPanda, "--rate", "0"},
+                                             {"--urdf", kPanda, "--duration", "-1"},
+                                             {"--urdf", kPanda, "--seed", "-3"},
+                                             {"--urdf", kPanda, "--seed", "4294967296"},
+                                             {"--urdf", kPanda, "--bogus"},
+                                             {"--duration", "1"}}) {
+    std::vector<std::string> full = args;
+    full.insert(full.end(), {"--output", outPath()});
+    const Result r = makeTrajectory(full);
+    EXPECT_EQ(r.status, 2) << args.back();
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(outEntries(), std::vector<std::string>{}) << args.back();
+  }
+  const Result r = makeTrajectory({"--urdf", path("absent.urdf"), "--output", outPath()});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(path("absent.urdf")), std::string::npos) << r.err;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

@@ -73,8 +73,8 @@ Mat3 rotation(const Vec3& axis, double angle) {
 
 struct Inertial {
   double mass = 0.0;
-  Vec3 xyz = Vec3::Zero();  ///< centre of mass in the link frame [m]
-  Vec3 rpy = Vec3::Zero();  ///< orientation of the inertia axes in the link frame
+  Vec3 xyz = Vec3::Zero();      ///< centre of mass in the link frame [m]
+  Vec3 rpy = Vec3::Zero();      ///< orientation of the inertia axes in the link frame
   Mat3 inertia = Mat3::Zero();  ///< about the centre of mass, inertia axes [kg m^2]
 };
 
@@ -83,10 +83,9 @@ std::string link(const std::string& name) { return "<link name=\"" + name + "\"/
 std::string link(const std::string& name, const Inertial& in) {
   const Mat3& I = in.inertia;
   return "<link name=\"" + name + "\"><inertial><origin xyz=\"" + vec(in.xyz) + "\" rpy=\"" +
-         vec(in.rpy) + "\"/><mass value=\"" + num(in.mass) + "\"/><inertia ixx=\"" +
-         num(I(0, 0)) + "\" ixy=\"" + num(I(0, 1)) + "\" ixz=\"" + num(I(0, 2)) + "\" iyy=\"" +
-         num(I(1, 1)) + "\" iyz=\"" + num(I(1, 2)) + "\" izz=\"" + num(I(2, 2)) +
-         "\"/></inertial></link>\n";
+         vec(in.rpy) + "\"/><mass value=\"" + num(in.mass) + "\"/><inertia ixx=\"" + num(I(0, 0)) +
+         "\" ixy=\"" + num(I(0, 1)) + "\" ixz=\"" + num(I(0, 2)) + "\" iyy=\"" + num(I(1, 1)) +
+         "\" iyz=\"" + num(I(1, 2)) + "\" izz=\"" + num(I(2, 2)) + "\"/></inertial></link>\n";
 }
 
 std::string joint(const std::string& name, const std::string& type, const std::string& parent,
@@ -223,10 +222,10 @@ TEST(DoublePendulum, MatchesTextbookEquationsOfMotion) {
   const double m2 = 1.1, lc2 = 0.22, I2 = 0.034;
   Inertial link1{m1, Vec3(lc1, 0, 0), Vec3::Zero(), inertiaMatrix(0.004, 0.060, I1)};
   Inertial link2{m2, Vec3(lc2, 0, 0), Vec3::Zero(), inertiaMatrix(0.002, 0.033, I2)};
-  const jle::Model<double> model = jle::modelFromUrdfString(
-      robot(link("world") + link("link1", link1) + link("link2", link2) +
-            joint("shoulder", "revolute", "world", "link1") +
-            joint("elbow", "revolute", "link1", "link2", Vec3(l1, 0, 0))));
+  const jle::Model<double> model =
+      jle::modelFromUrdfString(robot(link("world") + link("link1", link1) + link("link2", link2) +
+                                     joint("shoulder", "revolute", "world", "link1") +
+                                     joint("elbow", "revolute", "link1", "link2", Vec3(l1, 0, 0))));
   ASSERT_EQ(model.nq, 2);
   ASSERT_EQ(model.coordinate_names, (std::vector<std::string>{"shoulder", "elbow"}));
   const int s1 = model.segmentOfJoint("shoulder"), s2 = model.segmentOfJoint("elbow");
@@ -254,8 +253,8 @@ TEST(DoublePendulum, MatchesTextbookEquationsOfMotion) {
 
     const double scale1 = std::abs(M11 * qdd1) + std::abs(M12 * qdd2) + std::abs(h * qd2 * qd2) +
                           std::abs(2 * h * qd1 * qd2) + std::abs(G1);
-    const double scale2 = std::abs(M12 * qdd1) + std::abs(M22 * qdd2) + std::abs(h * qd1 * qd1) +
-                          std::abs(G2);
+    const double scale2 =
+        std::abs(M12 * qdd1) + std::abs(M22 * qdd2) + std::abs(h * qd1 * qd1) + std::abs(G2);
     EXPECT_NEAR(data.effort[s1], tau1, kRel * scale1) << "trial " << trial;
     EXPECT_NEAR(data.effort[s2], tau2, kRel * scale2) << "trial " << trial;
   }
@@ -286,8 +285,8 @@ TEST(HangingChain, JointForceIsTheWeightBelowAndMomentsVanish) {
                   name, Vec3(0, 0, -length[k]), Vec3(0, 0, yaw[k]), axes[k]);
   }
   // A lumped weight on l3, also on its vertical.
-  body += link("l3_weight", Inertial{0.35, Vec3(0, 0, -0.07), Vec3::Zero(),
-                                     inertiaMatrix(0.001, 0.001, 0.001)});
+  body += link("l3_weight",
+               Inertial{0.35, Vec3(0, 0, -0.07), Vec3::Zero(), inertiaMatrix(0.001, 0.001, 0.001)});
   body += joint("j3_weight", "fixed", "l3", "l3_weight", Vec3(0, 0, -0.05), Vec3(0, 0, 0.9));
   const jle::Model<double> model = jle::modelFromUrdfString(robot(body));
   ASSERT_EQ(model.nq, 5);
@@ -300,9 +299,9 @@ TEST(HangingChain, JointForceIsTheWeightBelowAndMomentsVanish) {
   jle::inverseDynamics(model, data);
 
   const double total_weight = (1.5 + 1.2 + 0.9 + 0.35 + 0.6 + 0.4) * kG;
-  const std::vector<double> weight_below = {
-      total_weight, (1.2 + 0.9 + 0.35 + 0.6 + 0.4) * kG, (0.9 + 0.35 + 0.6 + 0.4) * kG,
-      (0.6 + 0.4) * kG, 0.4 * kG};
+  const std::vector<double> weight_below = {total_weight, (1.2 + 0.9 + 0.35 + 0.6 + 0.4) * kG,
+                                            (0.9 + 0.35 + 0.6 + 0.4) * kG, (0.6 + 0.4) * kG,
+                                            0.4 * kG};
   // Moments: the weights times lever arms of up to 2 m would be ~ total_weight * 2.
   const double moment_scale = total_weight * 2.0;
   for (int k = 0; k < 5; ++k) {
@@ -391,8 +390,8 @@ TEST(FreeBody, ResidualIsNewtonEulerMinusAppliedWrenchAndWeight) {
       const Mat3 J = R_inertia * b.J_inertial * R_inertia.transpose();
       const Vec3 r_handle = R * b.handle_xyz;  // O -> handle
       const Vec3 F_res = b.m * a_G - F - b.m * gravity;
-      const Vec3 M_res = J * al + w.cross(J * w) + c.cross(b.m * a_G) -
-                         (r_handle.cross(F) + M) - c.cross(b.m * gravity);
+      const Vec3 M_res = J * al + w.cross(J * w) + c.cross(b.m * a_G) - (r_handle.cross(F) + M) -
+                         c.cross(b.m * gravity);
 
       const double force_scale = b.m * (a_G.norm() + kG) + F.norm();
       const double moment_scale = J.norm() * (al.norm() + w.squaredNorm()) +
@@ -436,8 +435,7 @@ TEST(FreeBody, MotionCausedByTheAppliedWrenchLeavesNoResidual) {
 
       jle::forwardKinematics(model, data, VecX(), VecX(), VecX(), gravity, base);
       jle::addExternalWrench(model, data, handle, Vec3(R_world_handle.transpose() * F_world),
-                             Vec3(R_world_handle.transpose() * M_world),
-                             jle::WrenchFrame::kLocal);
+                             Vec3(R_world_handle.transpose() * M_world), jle::WrenchFrame::kLocal);
       jle::inverseDynamics(model, data);
 
       const double force_scale = F_world.norm() + b.m * kG;
@@ -465,9 +463,9 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 }
 
 TEST(PlanarFoot, AnkleWrenchMatchesThePapersPlanarEquations) {
-  const double m = 1.2, J_G = 0.0065;          // [kg], [kg m^2]
-  const double l = 0.09, beta = 0.6;           // ankle from G [m], [rad]
-  const double b = 0.11, d = 0.04;             // centre of pressure from G [m]
+  const double m = 1.2, J_G = 0.0065;             // [kg], [kg m^2]
+  const double l = 0.09, beta = 0.6;              // ankle from G [m], [rad]
+  const double b = 0.11, d = 0.04;                // centre of pressure from G [m]
   const Eigen::Vector2d ankle_world(0.05, 0.08);  // the fixed ankle [m]
   const Eigen::Vector2d g(0, -kG);
 
@@ -482,10 +480,10 @@ TEST(PlanarFoot, AnkleWrenchMatchesThePapersPlanarEquations) {
   // child frame of the foot.
   Inertial foot{m, Vec3(G_foot.x(), G_foot.y(), 0), Vec3(0, 0, 0.3),
                 inertiaMatrix(0.0012, 0.0058, J_G)};
-  const jle::Model<double> model = jle::modelFromUrdfString(robot(
-      link("world") + link("foot", foot) + link("cop") +
-      joint("ankle", "revolute", "world", "foot", Vec3(ankle_world.x(), ankle_world.y(), 0)) +
-      joint("cop_joint", "fixed", "foot", "cop", Vec3(P_foot.x(), P_foot.y(), 0))));
+  const jle::Model<double> model = jle::modelFromUrdfString(
+      robot(link("world") + link("foot", foot) + link("cop") +
+            joint("ankle", "revolute", "world", "foot", Vec3(ankle_world.x(), ankle_world.y(), 0)) +
+            joint("cop_joint", "fixed", "foot", "cop", Vec3(P_foot.x(), P_foot.y(), 0))));
   const int s = model.segmentOfJoint("ankle");
   const int cop = model.frameIndex("cop");
   jle::Data<double> data(model);
@@ -544,9 +542,9 @@ TEST(Prismatic, SliderCarriesItsWeightAndItsInertia) {
   // Vertical slider: effort = m (qdd + g); then a slider inclined at cos(a) = 0.8 from the
   // vertical: effort = m (qdd + g cos a), the textbook inclined plane.
   for (const Vec3& u : {Vec3(0, 0, 1), Vec3(0, 0.6, 0.8)}) {
-    const jle::Model<double> model = jle::modelFromUrdfString(
-        robot(link("world") + link("slider", slider) +
-              joint("lift", "prismatic", "world", "slider", Vec3(0.1, -0.2, 0.3), Vec3::Zero(), u)));
+    const jle::Model<double> model = jle::modelFromUrdfString(robot(
+        link("world") + link("slider", slider) +
+        joint("lift", "prismatic", "world", "slider", Vec3(0.1, -0.2, 0.3), Vec3::Zero(), u)));
     const int s = model.segmentOfJoint("lift");
     jle::Data<double> data(model);
     for (int trial = 0; trial < 20; ++trial) {
@@ -574,10 +572,10 @@ TEST(Mimic, LeaderAndFollowerAreTwoPendulumsOnOneCoordinate) {
   Inertial b{mB, Vec3(lB, 0, 0), Vec3::Zero(), inertiaMatrix(0.001, 0.0065, IB)};
   const std::string mimic =
       "<mimic joint=\"lead\" multiplier=\"" + num(k) + "\" offset=\"" + num(o) + "\"/>";
-  const jle::Model<double> model = jle::modelFromUrdfString(robot(
-      link("world") + link("a", a) + link("b", b) + joint("lead", "revolute", "world", "a") +
-      joint("follow", "revolute", "world", "b", Vec3(0, 0.5, 0), Vec3::Zero(), Vec3::UnitZ(),
-            mimic)));
+  const jle::Model<double> model = jle::modelFromUrdfString(
+      robot(link("world") + link("a", a) + link("b", b) + joint("lead", "revolute", "world", "a") +
+            joint("follow", "revolute", "world", "b", Vec3(0, 0.5, 0), Vec3::Zero(), Vec3::UnitZ(),
+                  mimic)));
   ASSERT_EQ(model.nq, 1);
   ASSERT_EQ(model.coordinate_names, std::vector<std::string>{"lead"});
   const int sA = model.segmentOfJoint("lead"), sB = model.segmentOfJoint("follow");
@@ -626,9 +624,9 @@ TEST(LumpedFixedJoint, EqualsOneLinkWithTheCombinedInertia) {
   const Mat3 J = JA + parallel(A.mass, cA - c) + JB + parallel(B.mass, cB - c);
 
   const std::string hinge = joint("hinge", "revolute", "world", "a", j_xyz, j_rpy, u);
-  const jle::Model<double> lumped = jle::modelFromUrdfString(
-      robot(link("world") + link("a", A) + link("b", B) + hinge +
-            joint("bolt", "fixed", "a", "b", bolt_xyz, bolt_rpy)));
+  const jle::Model<double> lumped =
+      jle::modelFromUrdfString(robot(link("world") + link("a", A) + link("b", B) + hinge +
+                                     joint("bolt", "fixed", "a", "b", bolt_xyz, bolt_rpy)));
   const jle::Model<double> single = jle::modelFromUrdfString(
       robot(link("world") + link("a", Inertial{m, c, Vec3::Zero(), J}) + hinge));
   ASSERT_EQ(lumped.nsegments(), 2);
@@ -714,8 +712,8 @@ TEST(KeptFixedJoint, SensorWrenchIsTheDistalNewtonEuler) {
     const Eigen::Vector2d F_b = rot(-phiB) * F_world;  // in the sensor (b) frame
 
     const double force_scale = FB.norm() + FC.norm();
-    const double moment_scale = IB * std::abs(alB) + IC * std::abs(alC) +
-                                r_SB.norm() * FB.norm() + (r_SJ + r_JC).norm() * FC.norm();
+    const double moment_scale = IB * std::abs(alB) + IC * std::abs(alC) + r_SB.norm() * FB.norm() +
+                                (r_SJ + r_JC).norm() * FC.norm();
     expectNear(data.force[s], Vec3(F_b.x(), F_b.y(), 0), force_scale, "sensor force");
     expectNear(data.moment[s], Vec3(0, 0, M_z), moment_scale, "sensor moment");
     EXPECT_EQ(data.effort[s], 0.0);

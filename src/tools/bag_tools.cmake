@@ -1,0 +1,1 @@
+# bag tools (filled in)

@@ -1,0 +1,338 @@
+// make_example_bag: a deterministic example bag of an arm with a wrist force/torque
+// sensor, for the demo and for process_bag's tests and benchmarks. The formulas are in
+// kUsage and docs/demo.md.
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <geometry_msgs/WrenchStamped.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/JointState.h>
+
+#include <Eigen/Core>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <map>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char* const kUsage = R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]
+                        [--samples N] [--seed 1] [--effort] [--sensor-frame panda_link8]
+                        [--tcp-frame panda_hand_tcp]
+
+Writes a bag of an arm moving along an analytic trajectory while a wrist
+force/torque sensor measures a payload and a push:
+  /joint_states     sensor_msgs/JointState, every moving joint of the URDF (mimic
+                    joints included), positions only; with --effort also the exact
+                    joint efforts (inverse dynamics with the exact derivatives and the
+                    exact wrench), for comparison with the estimate
+  /ft_sensor/wrench geometry_msgs/WrenchStamped, header.frame_id = SENSOR (a URDF
+                    link), the wrench applied TO the robot, moment about SENSOR's
+                    origin, in SENSOR's frame
+both at RATE, stamped t0 + i / RATE (t0 = 1000 s, i = 0 .. N-1, N = round(DURATION *
+RATE) or --samples); bag time = stamp. At each stamp the wrench is written first, so
+that whoever reads the bag in time order has the wrench of that instant.
+
+Trajectory: each coordinate k (model.coordinate_names order)
+  q_k(t) = c_k + A_k sin(w_k t + p_k),  w_k = 2 pi f_k,  t = stamp - t0
+with c_k the Panda's "ready" pose for panda_joint1..7 (0, -pi/4, 0, -3 pi/4, 0, pi/2,
+pi/4), 0.02 m for panda_finger_joint1 and 0 for any other joint; A_k in [0.15, 0.45)
+rad (revolute) or [0.005, 0.015) m (prismatic); f_k in [0.1, 0.4) Hz; p_k in [0, 2 pi).
+Wrench: a point payload of mass m in [0.5, 2) kg held at the origin of TCP, and a
+horizontal push at the same point,
+  F_world(t) = P sin(w_p t + p_p) (cos b, sin b, 0),  P in [5, 15) N,
+  w_p = 2 pi f_p, f_p in [0.2, 0.6) Hz, p_p in [0, 2 pi), b in [0, 2 pi);
+the payload applies -m (a - g) to the robot, a its acceleration (exact, from the
+trajectory), g = (0, 0, -9.80665) m/s^2. The wrench is their sum at TCP, moved to
+SENSOR's origin and frame.
+
+Random numbers: std::mt19937 seeded with SEED; u = (a * 2^26 + b) / 2^53 with
+a = (first draw) >> 5, b = (second draw) >> 6, in [0, 1); a number in [lo, hi) is
+lo + (hi - lo) u. Draw order: A_k, f_k, p_k for each coordinate, then m, P, f_p, p_p, b.
+So the bag is the same with every standard library (and bit for bit wherever sin and
+cos are, e.g. glibc).
+
+  --urdf PATH          the robot (a fixed base), e.g. test/data/urdf/panda_demo.urdf
+  --output PATH        the bag; written beside PATH and renamed onto it on success only
+  --duration S         seconds covered, > 0 (default 10)
+  --rate HZ            samples per second, > 0 (default 1000)
+  --samples N          number of samples instead of DURATION * RATE (benchmarks)
+  --seed N             0 .. 4294967295 (default 1)
+  --effort             add the exact efforts to the joint states
+  --sensor-frame LINK  the sensor's frame (default panda_link8)
+  --tcp-frame LINK     where the payload and the push act (default panda_hand_tcp)
+  --help               this text
+
+Exit status: 0 success; 1 a data error (unreadable URDF, unwritable bag); 2 a usage
+error (unknown, missing or repeated option, bad value, unknown LINK).
+)";
+
+constexpr double kTwoPi = 6.283185307179586;
+constexpr double kPi = 3.141592653589793;
+constexpr std::int64_t kEpochNs = 1000000000000LL;  // t0 = 1000 s
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string urdf, output;
+  std::string sensor_frame = "panda_link8", tcp_frame = "panda_hand_tcp";
+  double duration = 10.0;
+  double rate = 1000.0;
+  long long samples = -1;
+  std::uint32_t seed = 1;
+  bool effort = false;
+};
+
+// --key value or --key=value, each known key at most once; flags take no value.
+std::map<std::string, std::string> optionValues(int argc, char** argv,
+                                                const std::vector<std::string>& keys,
+                                                const std::vector<std::string>& flags) {
+  std::map<std::string, std::string> values;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const std::size_t eq = arg.find('=');
+    const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
+    bool known = false, flag = false;
+    for (const std::string& k : keys) known = known || k == key;
+    for (const std::string& k : flags) flag = flag || k == arg;
+    if (!known && !flag)
+      throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
+                                                   : "unexpected argument '" + arg + "'");
+    std::string value = "1";
+    if (!flag) {
+      if (eq != std::string::npos) {
+        value = arg.substr(eq + 1);
+      } else {
+        if (i + 1 >= argc) throw UsageError(key + " needs a value");
+        value = argv[++i];
+      }
+      if (value.empty()) throw UsageError(key + ": empty value");
+    }
+    if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
+  }
+  return values;
+}
+
+double parseNumber(const std::string& key, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
+    throw UsageError(key + ": '" + text + "' is not a finite number");
+  return v;
+}
+
+unsigned long long parseInteger(const std::string& key, const std::string& text,
+                                unsigned long long max) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || v > max)
+    throw UsageError(key + ": '" + text + "' is not an integer in 0 .. " + std::to_string(max));
+  return v;
+}
+
+Options parseOptions(int argc, char** argv) {
+  std::map<std::string, std::string> v =
+      optionValues(argc, argv,
+                   {"--urdf", "--output", "--duration", "--rate", "--samples", "--seed",
+                    "--sensor-frame", "--tcp-frame"},
+                   {"--effort"});
+  Options options;
+  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
+  if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
+  options.urdf = v["--urdf"];
+  options.output = v["--output"];
+  options.effort = v.count("--effort") > 0;
+  if (v.count("--sensor-frame")) options.sensor_frame = v["--sensor-frame"];
+  if (v.count("--tcp-frame")) options.tcp_frame = v["--tcp-frame"];
+  if (v.count("--duration")) options.duration = parseNumber("--duration", v["--duration"]);
+  if (v.count("--rate")) options.rate = parseNumber("--rate", v["--rate"]);
+  if (!(options.duration > 0.0)) throw UsageError("--duration: must be > 0");
+  if (!(options.rate > 0.0)) throw UsageError("--rate: must be > 0");
+  if (v.count("--samples")) {
+    if (v.count("--duration")) throw UsageError("--samples and --duration exclude each other");
+    options.samples = static_cast<long long>(parseInteger("--samples", v["--samples"], 1000000000));
+    if (options.samples < 1) throw UsageError("--samples: must be >= 1");
+  } else {
+    if (options.duration * options.rate > 1e9) throw UsageError("--duration * --rate: over 1e9");
+    options.samples = std::max(1LL, std::llround(options.duration * options.rate));
+  }
+  if (v.count("--seed"))
+    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 4294967295ULL));
+  return options;
+}
+
+/// Uniform numbers in [0, 1) with 53 random bits, the same from every standard library.
+class Uniform {
+ public:
+  explicit Uniform(std::uint32_t seed) : generator_(seed) {}
+  double operator()() {
+    const std::uint32_t a = static_cast<std::uint32_t>(generator_()) >> 5;  // 27 bits
+    const std::uint32_t b = static_cast<std::uint32_t>(generator_()) >> 6;  // 26 bits
+    return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+  }
+  double operator()(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
+
+ private:
+  std::mt19937 generator_;
+};
+
+double homePosition(const std::string& joint) {
+  static const std::map<std::string, double> kReady = {
+      {"panda_joint1", 0.0},          {"panda_joint2", -kPi / 4},
+      {"panda_joint3", 0.0},          {"panda_joint4", -3 * kPi / 4},
+      {"panda_joint5", 0.0},          {"panda_joint6", kPi / 2},
+      {"panda_joint7", kPi / 4},      {"panda_finger_joint1", 0.02}};
+  const auto it = kReady.find(joint);
+  return it == kReady.end() ? 0.0 : it->second;
+}
+
+int frameOf(const jle::Model<double>& model, const std::string& option, const std::string& link,
+            const std::string& urdf) {
+  for (std::size_t i = 0; i < model.frames.size(); ++i)
+    if (model.frames[i].name == link) return static_cast<int>(i);
+  throw UsageError(option + ": no link '" + link + "' in " + urdf);
+}
+
+void run(const Options& options) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf);
+  if (model.floating_base)
+    throw std::runtime_error(options.urdf + ": a floating-base model; make_example_bag moves "
+                             "fixed-base arms only");
+  const int sensor = frameOf(model, "--sensor-frame", options.sensor_frame, options.urdf);
+  const int tcp = frameOf(model, "--tcp-frame", options.tcp_frame, options.urdf);
+  const jle::Frame<double>& sensor_frame = model.frames[static_cast<std::size_t>(sensor)];
+  const jle::Frame<double>& tcp_frame = model.frames[static_cast<std::size_t>(tcp)];
+  if (sensor_frame.segment != tcp_frame.segment)
+    throw UsageError("--tcp-frame: '" + options.tcp_frame + "' moves relative to '" +
+                     options.sensor_frame + "'; the payload must be rigid to the sensor");
+
+  Uniform uniform(options.seed);
+  const std::size_t nq = static_cast<std::size_t>(model.nq);
+  std::vector<double> home(nq), amplitude(nq), omega(nq), phase(nq);
+  for (std::size_t k = 0; k < nq; ++k) {
+    const std::string& name = model.coordinate_names[k];
+    const int s = model.segmentOfJoint(name);
+    const bool prismatic = model.joint_type[static_cast<std::size_t>(s)] == jle::JointType::kPrismatic;
+    home[k] = homePosition(name);
+    amplitude[k] = prismatic ? uniform(0.005, 0.015) : uniform(0.15, 0.45);
+    omega[k] = kTwoPi * uniform(0.1, 0.4);
+    phase[k] = uniform(0.0, kTwoPi);
+  }
+  const double payload_mass = uniform(0.5, 2.0);
+  const double push = uniform(5.0, 15.0);
+  const double push_omega = kTwoPi * uniform(0.2, 0.6);
+  const double push_phase = uniform(0.0, kTwoPi);
+  const double push_bearing = uniform(0.0, kTwoPi);
+  const Eigen::Vector3d push_direction(std::cos(push_bearing), std::sin(push_bearing), 0.0);
+  const Eigen::Vector3d gravity_world(0.0, 0.0, -9.80665);
+
+  // Everything the loop touches is allocated here, once.
+  jle::Data<double> data(model);
+  jle::VectorX<double> q(model.nq), qd(model.nq), qdd(model.nq);
+  sensor_msgs::JointState joints;
+  for (int s : model.moving_segments)
+    joints.name.push_back(model.joint_name[static_cast<std::size_t>(s)]);
+  joints.position.resize(joints.name.size());
+  if (options.effort) joints.effort.resize(joints.name.size());
+  geometry_msgs::WrenchStamped wrench;
+  wrench.header.frame_id = options.sensor_frame;
+
+  const std::string temporary = options.output + ".partial";
+  try {
+    rosbag::Bag bag(temporary, rosbag::bagmode::Write);
+    const std::size_t s = static_cast<std::size_t>(sensor_frame.segment);
+    // TCP in the segment frame; the sensor's pose in the segment frame.
+    const Eigen::Vector3d r_tcp = tcp_frame.p_segment_frame;
+    const Eigen::Matrix3d& R_segment_sensor = sensor_frame.R_segment_frame;
+    const Eigen::Vector3d& p_segment_sensor = sensor_frame.p_segment_frame;
+    for (long long i = 0; i < options.samples; ++i) {
+      const std::int64_t ns =
+          kEpochNs + std::llround(static_cast<double>(i) * 1e9 / options.rate);
+      const ros::Time stamp(static_cast<std::uint32_t>(ns / 1000000000),
+                            static_cast<std::uint32_t>(ns % 1000000000));
+      const double t = static_cast<double>(ns - kEpochNs) * 1e-9;
+      for (std::size_t k = 0; k < nq; ++k) {
+        const double angle = omega[k] * t + phase[k];
+        const double sin = std::sin(angle), cos = std::cos(angle);
+        q[static_cast<int>(k)] = home[k] + amplitude[k] * sin;
+        qd[static_cast<int>(k)] = amplitude[k] * omega[k] * cos;
+        qdd[static_cast<int>(k)] = -amplitude[k] * omega[k] * omega[k] * sin;
+      }
+      jle::forwardKinematics(model, data, q, qd, qdd, gravity_world);
+
+      // The payload's acceleration minus gravity at the TCP, segment frame (data.acc
+      // is the origin's, gravity included as an upward acceleration of the base).
+      const Eigen::Vector3d& w = data.omega[s];
+      const Eigen::Vector3d a_minus_g = data.acc[s] + data.alpha[s].cross(r_tcp) +
+                                        w.cross(w.cross(r_tcp));
+      const Eigen::Vector3d f_segment =
+          -payload_mass * a_minus_g +
+          data.R_world[s].transpose() * (push * std::sin(push_omega * t + push_phase) *
+                                         push_direction);
+      const Eigen::Vector3d f_sensor = R_segment_sensor.transpose() * f_segment;
+      const Eigen::Vector3d m_sensor =
+          R_segment_sensor.transpose() * (r_tcp - p_segment_sensor).cross(f_segment);
+
+      wrench.header.stamp = stamp;
+      wrench.wrench.force.x = f_sensor.x();
+      wrench.wrench.force.y = f_sensor.y();
+      wrench.wrench.force.z = f_sensor.z();
+      wrench.wrench.torque.x = m_sensor.x();
+      wrench.wrench.torque.y = m_sensor.y();
+      wrench.wrench.torque.z = m_sensor.z();
+      bag.write("/ft_sensor/wrench", stamp, wrench);
+
+      if (options.effort) {
+        jle::addExternalWrench(model, data, sensor, f_sensor, m_sensor, jle::WrenchFrame::kLocal);
+        jle::inverseDynamics(model, data);
+      }
+      joints.header.stamp = stamp;
+      joints.header.seq = static_cast<std::uint32_t>(i);
+      for (std::size_t j = 0; j < model.moving_segments.size(); ++j) {
+        const std::size_t seg = static_cast<std::size_t>(model.moving_segments[j]);
+        joints.position[j] = data.q[seg];
+        if (options.effort) joints.effort[j] = data.effort[seg];
+      }
+      bag.write("/joint_states", stamp, joints);
+    }
+    bag.close();
+    if (std::rename(temporary.c_str(), options.output.c_str()) != 0)
+      throw std::runtime_error(options.output + ": cannot rename " + temporary + " onto it");
+  } catch (...) {
+    std::remove(temporary.c_str());
+    throw;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+  try {
+    run(parseOptions(argc, argv));
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "make_example_bag: %s (see make_example_bag --help)\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "make_example_bag: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

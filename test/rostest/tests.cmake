@@ -1,0 +1,1 @@
+# rostest node tests (filled in)

@@ -1,0 +1,215 @@
+// The differentiators against polynomials they must reproduce exactly (at any
+// spacing), and the Kalman filter against a known steady state.
+#include <joint_load_estimator/differentiation.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace {
+
+using jle::DifferentiatorBank;
+using jle::DifferentiatorConfig;
+using jle::DifferentiatorType;
+
+// Times with +-40% jitter around 1 ms, from a fixed seed.
+std::vector<double> jitteredTimes(int n, double t0 = 3.0) {
+  std::mt19937 gen(7);
+  std::vector<double> t;
+  double now = t0;
+  for (int i = 0; i < n; ++i) {
+    t.push_back(now);
+    now += 1e-3 * (0.6 + 0.8 * (gen() / 4294967296.0));
+  }
+  return t;
+}
+
+// A polynomial of degree `degree` with known derivatives: sum_k c_k (t - t0)^k.
+struct Poly {
+  std::vector<double> c;
+  double t0;
+  double value(double t) const {
+    double s = 0, p = 1;
+    for (double ck : c) s += ck * p, p *= (t - t0);
+    return s;
+  }
+  double rate(double t) const {
+    double s = 0, p = 1;
+    for (std::size_t k = 1; k < c.size(); ++k) s += k * c[k] * p, p *= (t - t0);
+    return s;
+  }
+  double accel(double t) const {
+    double s = 0, p = 1;
+    for (std::size_t k = 2; k < c.size(); ++k) s += k * (k - 1) * c[k] * p, p *= (t - t0);
+    return s;
+  }
+};
+
+void expectExactOnPolynomial(const DifferentiatorConfig& config, int degree) {
+  const Poly a{{0.3, -1.2, 2.5, 0.7, -0.4, 0.2}, 3.0}, b{{-2.0, 0.5, -3.0, 1.1, 0.3, -0.1}, 3.0};
+  Poly pa = a, pb = b;
+  pa.c.resize(degree + 1);
+  pb.c.resize(degree + 1);
+  DifferentiatorBank bank(config, 2);
+  const std::vector<double> t = jitteredTimes(60);
+  int outputs = 0;
+  for (double ti : t) {
+    const double x[2] = {pa.value(ti), pb.value(ti)};
+    if (!bank.update(ti, x)) continue;
+    ++outputs;
+    const double s = bank.stamp();
+    // Exact up to rounding: values O(1); the rate is divided by the window's half-span
+    // (1e-3 to 7e-3 s) and the acceleration by its square, which scales the rounding of
+    // the O(1) sums by up to 1e3 and 1e6 (times the Vandermonde conditioning).
+    EXPECT_NEAR(bank.value(0), pa.value(s), 1e-12);
+    EXPECT_NEAR(bank.rate(0), pa.rate(s), 1e-8);
+    EXPECT_NEAR(bank.accel(0), pa.accel(s), 2e-5);
+    EXPECT_NEAR(bank.value(1), pb.value(s), 1e-12);
+    EXPECT_NEAR(bank.rate(1), pb.rate(s), 1e-8);
+    EXPECT_NEAR(bank.accel(1), pb.accel(s), 2e-5);
+  }
+  EXPECT_EQ(outputs, 60 - bank.warmup() + 1);
+}
+
+TEST(Differentiator, FiniteDifferenceIsExactForQuadraticsAtAnySpacing) {
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kFiniteDifference;
+  expectExactOnPolynomial(c, 2);
+}
+
+TEST(Differentiator, SavitzkyGolayIsExactForItsOrder) {
+  for (int order = 2; order <= 4; ++order)
+    for (int window : {order + 1, 9, 15}) {
+      DifferentiatorConfig c;
+      c.order = order;
+      c.window = window;
+      SCOPED_TRACE("order " + std::to_string(order) + " window " + std::to_string(window));
+      expectExactOnPolynomial(c, order);
+    }
+}
+
+TEST(Differentiator, CentredSavitzkyGolayDescribesTheMiddleSample) {
+  DifferentiatorConfig c;
+  c.window = 11;
+  c.order = 3;
+  c.delay = 5;
+  DifferentiatorBank bank(c, 1);
+  const std::vector<double> t = jitteredTimes(30);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const double x = std::sin(t[i]);
+    if (bank.update(t[i], &x)) {
+      EXPECT_EQ(bank.stamp(), t[i - 5]);
+    }
+  }
+}
+
+TEST(Differentiator, CentredFitErrorIsTheTextbookTruncationTerm) {
+  // A quadratic least-squares fit over x = k h, k = -m..m, of f picks up its quartic
+  // term: the fitted second derivative is f'' + f'''' h^2 S(m), with
+  // S = (sum k^6 - mu sum k^4) / (12 (sum k^4 - (2m+1) mu^2)), mu = mean k^2 (the odd
+  // terms cancel by symmetry). For m = 4: S = 5060 / (12 * 308) = 1.36904. On
+  // sin(w t) at h = 1 ms the worst error must be that term (to 1%: the next term is
+  // O(h^4 w^6)); the causal fit keeps an O(h f''') term and is far worse.
+  const double h = 1e-3, w = 2 * M_PI * 2.0;
+  const double S = 5060.0 / (12.0 * 308.0);
+  double worst[2] = {0, 0};
+  for (int delay : {0, 4}) {
+    DifferentiatorConfig c;
+    c.window = 9;
+    c.order = 2;
+    c.delay = delay;
+    DifferentiatorBank bank(c, 1);
+    for (int i = 0; i < 2000; ++i) {
+      const double t = i * h;
+      const double x = std::sin(w * t);
+      if (!bank.update(t, &x)) continue;
+      const double s = bank.stamp();
+      double& e = worst[delay ? 1 : 0];
+      e = std::max(e, std::abs(bank.accel(0) + w * w * std::sin(w * s)));
+    }
+  }
+  const double predicted = S * std::pow(w, 4) * h * h;
+  EXPECT_NEAR(worst[1], predicted, 0.01 * predicted);
+  EXPECT_GT(worst[0], 20 * worst[1]);
+}
+
+TEST(Differentiator, KalmanTracksConstantAccelerationWithoutBias) {
+  // A constant-acceleration model fed an exact parabola converges to it: the steady
+  // state of the filter has no bias for this signal (the signal is in the model).
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kKalman;
+  c.process_noise = 1.0;
+  c.measurement_noise = 1e-3;
+  DifferentiatorBank bank(c, 1);
+  const Poly p{{0.1, 0.4, 1.5}, 0.0};
+  for (int i = 0; i < 20000; ++i) {
+    const double t = i * 1e-3;
+    const double x = p.value(t);
+    bank.update(t, &x);
+  }
+  EXPECT_NEAR(bank.value(0), p.value(19.999), 1e-9);
+  EXPECT_NEAR(bank.rate(0), p.rate(19.999), 1e-7);
+  EXPECT_NEAR(bank.accel(0), p.accel(19.999), 1e-5);
+}
+
+TEST(Differentiator, KalmanHandlesIrregularSpacing) {
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kKalman;
+  c.kalman_model = jle::KalmanModel::kConstantJerk;
+  c.process_noise = 10.0;
+  c.measurement_noise = 1e-4;
+  DifferentiatorBank bank(c, 1);
+  const Poly p{{0.1, 0.4, 1.5, -0.3}, 0.0};
+  const std::vector<double> t = jitteredTimes(20000, 0.0);
+  for (double ti : t) {
+    const double x = p.value(ti);
+    bank.update(ti, &x);
+  }
+  const double s = t.back();
+  // A cubic is in the constant-jerk model: no steady-state bias (bounds: 1e-6 of scale).
+  EXPECT_NEAR(bank.rate(0), p.rate(s), 1e-6 * std::abs(p.rate(s)));
+  EXPECT_NEAR(bank.accel(0), p.accel(s), 1e-5 * std::abs(p.accel(s)));
+}
+
+TEST(Differentiator, RefusesTimeThatDoesNotIncrease) {
+  DifferentiatorBank bank(DifferentiatorConfig(), 1);
+  const double x = 0.0;
+  bank.update(1.0, &x);
+  EXPECT_THROW(bank.update(1.0, &x), std::invalid_argument);
+  EXPECT_THROW(bank.update(0.5, &x), std::invalid_argument);
+}
+
+TEST(Differentiator, GapRestartsTheWindow) {
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kFiniteDifference;
+  c.max_gap = 0.1;
+  DifferentiatorBank bank(c, 1);
+  const double x = 1.0;
+  EXPECT_FALSE(bank.update(0.000, &x));
+  EXPECT_FALSE(bank.update(0.001, &x));
+  EXPECT_TRUE(bank.update(0.002, &x));
+  EXPECT_FALSE(bank.update(1.000, &x));  // 1 s gap: the window restarts
+  EXPECT_FALSE(bank.update(1.001, &x));
+  EXPECT_TRUE(bank.update(1.002, &x));
+}
+
+TEST(Differentiator, InvalidConfigurationsNameTheField) {
+  DifferentiatorConfig c;
+  c.order = 1;
+  try {
+    DifferentiatorBank bank(c, 1);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("order"), std::string::npos);
+  }
+  c = DifferentiatorConfig();
+  c.delay = 20;
+  EXPECT_THROW(DifferentiatorBank(c, 1), std::invalid_argument);
+  c = DifferentiatorConfig();
+  c.type = DifferentiatorType::kKalman;
+  c.process_noise = -1;
+  EXPECT_THROW(DifferentiatorBank(c, 1), std::invalid_argument);
+}
+
+}  // namespace
