@@ -193,14 +193,15 @@ bool CsvReader::next() {
       end_[c] = e;
     }
   });
-  const std::string where = path_ + ":" + std::to_string(line_) + ": ";
-  if (count < columns())
-    throw CsvError(where + "row has " + std::to_string(count) + " cells, the header has " +
-                   std::to_string(columns()) + " (no cell for column '" + header_[count] + "')");
-  if (count > columns())
+  if (count != columns()) {
+    const std::string where = path_ + ":" + std::to_string(line_) + ": ";
+    if (count < columns())
+      throw CsvError(where + "row has " + std::to_string(count) + " cells, the header has " +
+                     std::to_string(columns()) + " (no cell for column '" + header_[count] + "')");
     throw CsvError(where + "row has " + std::to_string(count) + " cells, the header has " +
                    std::to_string(columns()) + " (cell " + std::to_string(columns() + 1) +
                    " is beyond the last column '" + header_.back() + "')");
+  }
   // Terminate every cell in place so that strtod stops at its end at the latest.
   for (std::size_t c = 0; c < n; ++c) buffer_[end_[c]] = '\0';
   return true;

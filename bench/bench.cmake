@@ -1,0 +1,13 @@
+# Benchmarks (Google Benchmark). Built with the tests, since they need the same peers
+# (KDL); CI runs each once on a tiny input so that they cannot rot.
+if(CATKIN_ENABLE_TESTING)
+  find_package(benchmark REQUIRED)
+  add_executable(bench_speed_core bench/speed_core.cpp)
+  target_link_libraries(bench_speed_core joint_load_estimator_core benchmark::benchmark
+    ${orocos_kdl_LIBRARIES} ${kdl_parser_LIBRARIES})
+  target_include_directories(bench_speed_core PRIVATE ${orocos_kdl_INCLUDE_DIRS}
+    ${kdl_parser_INCLUDE_DIRS})
+  target_compile_definitions(bench_speed_core PRIVATE
+    JLE_BENCH_DATA="${CMAKE_CURRENT_SOURCE_DIR}/test/data")
+  add_dependencies(tests bench_speed_core)
+endif()

@@ -1,0 +1,214 @@
+// Per-timestep cost of the core against Orocos KDL on the same states, same run.
+// Each benchmark cycles through the same 256 random states (fixed seed), so both
+// libraries see identical inputs. The ratios are printed by bench/speed (run_speed.sh).
+#include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <benchmark/benchmark.h>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include <map>
+#include <random>
+#include <string>
+
+namespace {
+
+const std::string kData = JLE_BENCH_DATA;
+constexpr int kStates = 256;
+
+struct States {
+  std::vector<Eigen::VectorXd> q, qd, qdd;
+};
+
+double uniform(std::mt19937& gen, double lo, double hi) {
+  return lo + (hi - lo) * (gen() >> 5) * (1.0 / 134217728.0);
+}
+
+States randomStates(int nq) {
+  std::mt19937 gen(42);
+  States s;
+  for (int k = 0; k < kStates; ++k) {
+    Eigen::VectorXd q(nq), qd(nq), qdd(nq);
+    for (int i = 0; i < nq; ++i) {
+      q[i] = uniform(gen, -3.0, 3.0);
+      qd[i] = uniform(gen, -2.0, 2.0);
+      qdd[i] = uniform(gen, -5.0, 5.0);
+    }
+    s.q.push_back(q);
+    s.qd.push_back(qd);
+    s.qdd.push_back(qdd);
+  }
+  return s;
+}
+
+template <typename Scalar>
+void coreLoads(benchmark::State& state, const std::string& file) {
+  const jle::Model<Scalar> model = jle::modelFromUrdfFile(kData + file).cast<Scalar>();
+  jle::Data<Scalar> data(model);
+  const States s = randomStates(model.nq);
+  std::vector<jle::VectorX<Scalar>> q, qd, qdd;
+  for (int k = 0; k < kStates; ++k) {
+    q.push_back(s.q[k].cast<Scalar>());
+    qd.push_back(s.qd[k].cast<Scalar>());
+    qdd.push_back(s.qdd[k].cast<Scalar>());
+  }
+  const Eigen::Matrix<Scalar, 3, 1> g(0, 0, Scalar(-9.80665));
+  int k = 0;
+  for (auto _ : state) {
+    jle::forwardKinematics(model, data, q[k], qd[k], qdd[k], g);
+    jle::inverseDynamics(model, data);
+    benchmark::DoNotOptimize(data.moment.data());
+    k = (k + 1) % kStates;
+  }
+  state.counters["segments"] = model.nsegments();
+}
+
+void coreDouble(benchmark::State& state, const std::string& file) { coreLoads<double>(state, file); }
+void coreFloat(benchmark::State& state, const std::string& file) { coreLoads<float>(state, file); }
+void coreLongDouble(benchmark::State& state, const std::string& file) {
+  coreLoads<long double>(state, file);
+}
+
+void coreKinematicsOnly(benchmark::State& state, const std::string& file) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + file);
+  jle::Data<double> data(model);
+  const States s = randomStates(model.nq);
+  const Eigen::Vector3d g(0, 0, -9.80665);
+  int k = 0;
+  for (auto _ : state) {
+    jle::forwardKinematics(model, data, s.q[k], s.qd[k], s.qdd[k], g);
+    benchmark::DoNotOptimize(data.acc.data());
+    k = (k + 1) % kStates;
+  }
+}
+
+void coreDynamicsOnly(benchmark::State& state, const std::string& file) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + file);
+  jle::Data<double> data(model);
+  const States s = randomStates(model.nq);
+  jle::forwardKinematics(model, data, s.q[0], s.qd[0], s.qdd[0], Eigen::Vector3d(0, 0, -9.80665));
+  for (auto _ : state) {
+    jle::inverseDynamics(model, data);
+    benchmark::DoNotOptimize(data.moment.data());
+  }
+}
+
+// KDL's q index of each of our coordinates, by joint name.
+std::vector<unsigned> kdlIndex(const jle::Model<double>& model, const KDL::Tree& tree) {
+  std::map<std::string, unsigned> by_name;
+  for (const auto& kv : tree.getSegments()) {
+    const KDL::Segment& seg = kv.second.segment;
+    if (seg.getJoint().getType() != KDL::Joint::None)
+      by_name[seg.getJoint().getName()] = kv.second.q_nr;
+  }
+  std::vector<unsigned> out;
+  for (int s : model.moving_segments) out.push_back(by_name.at(model.joint_name[s]));
+  return out;
+}
+
+void kdlTree(benchmark::State& state, const std::string& file) {
+  KDL::Tree tree;
+  if (!kdl_parser::treeFromFile(kData + file, tree)) {
+    state.SkipWithError("kdl_parser failed");
+    return;
+  }
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + file);
+  const std::vector<unsigned> index = kdlIndex(model, tree);
+  const States s = randomStates(model.nq);
+  const unsigned n = tree.getNrOfJoints();
+  std::vector<KDL::JntArray> q(kStates, KDL::JntArray(n)), qd(kStates, KDL::JntArray(n)),
+      qdd(kStates, KDL::JntArray(n));
+  for (int k = 0; k < kStates; ++k)
+    for (std::size_t j = 0; j < model.moving_segments.size(); ++j) {
+      const int seg = model.moving_segments[j];
+      const int c = model.coordinate[seg];
+      q[k](index[j]) = model.multiplier[seg] * s.q[k][c] + model.offset[seg];
+      qd[k](index[j]) = model.multiplier[seg] * s.qd[k][c];
+      qdd[k](index[j]) = model.multiplier[seg] * s.qdd[k][c];
+    }
+  KDL::TreeIdSolver_RNE solver(tree, KDL::Vector(0, 0, -9.80665));
+  KDL::WrenchMap f_ext;
+  for (const auto& kv : tree.getSegments()) f_ext[kv.first] = KDL::Wrench::Zero();
+  KDL::JntArray tau(n);
+  int k = 0;
+  for (auto _ : state) {
+    solver.CartToJnt(q[k], qd[k], qdd[k], f_ext, tau);
+    benchmark::DoNotOptimize(tau.data.data());
+    k = (k + 1) % kStates;
+  }
+}
+
+void kdlChain(benchmark::State& state, const std::string& file, const std::string& root,
+              const std::string& tip) {
+  KDL::Tree tree;
+  KDL::Chain chain;
+  if (!kdl_parser::treeFromFile(kData + file, tree) || !tree.getChain(root, tip, chain)) {
+    state.SkipWithError("kdl chain failed");
+    return;
+  }
+  const unsigned n = chain.getNrOfJoints();
+  const States s = randomStates(static_cast<int>(n));
+  std::vector<KDL::JntArray> q(kStates, KDL::JntArray(n)), qd(kStates, KDL::JntArray(n)),
+      qdd(kStates, KDL::JntArray(n));
+  // Chain order is the tree order here (a serial chain): same states as the core.
+  for (int k = 0; k < kStates; ++k) {
+    q[k].data = s.q[k];
+    qd[k].data = s.qd[k];
+    qdd[k].data = s.qdd[k];
+  }
+  KDL::ChainIdSolver_RNE solver(chain, KDL::Vector(0, 0, -9.80665));
+  KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  KDL::JntArray tau(n);
+  int k = 0;
+  for (auto _ : state) {
+    solver.CartToJnt(q[k], qd[k], qdd[k], f_ext, tau);
+    benchmark::DoNotOptimize(tau.data.data());
+    k = (k + 1) % kStates;
+  }
+}
+
+void differentiation(benchmark::State& state, jle::DifferentiatorType type, int window) {
+  jle::DifferentiatorConfig c;
+  c.type = type;
+  c.window = window;
+  const int channels = 7 + 12;  // a 7-joint arm with two wrench inputs
+  jle::DifferentiatorBank bank(c, channels);
+  std::vector<double> x(channels, 0.0);
+  double t = 0.0;
+  for (auto _ : state) {
+    t += 1e-3;
+    for (int i = 0; i < channels; ++i) x[i] = std::sin(t + i);
+    benchmark::DoNotOptimize(bank.update(t, x.data()));
+  }
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(coreDouble, panda_chain, "/urdf/chains/panda_chain.urdf");
+BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",
+                  "panda_hand_tcp");
+BENCHMARK_CAPTURE(kdlTree, panda_chain, "/urdf/chains/panda_chain.urdf");
+BENCHMARK_CAPTURE(coreDouble, ur5_chain, "/urdf/chains/ur5_chain.urdf");
+BENCHMARK_CAPTURE(kdlChain, ur5_chain, "/urdf/chains/ur5_chain.urdf", "base_link", "tool0");
+BENCHMARK_CAPTURE(coreDouble, kinova_chain, "/urdf/chains/kinova_chain.urdf");
+BENCHMARK_CAPTURE(kdlChain, kinova_chain, "/urdf/chains/kinova_chain.urdf", "base",
+                  "j2s6s200_end_effector");
+BENCHMARK_CAPTURE(coreDouble, panda, "/urdf/panda.urdf");
+BENCHMARK_CAPTURE(kdlTree, panda, "/urdf/panda.urdf");
+BENCHMARK_CAPTURE(coreDouble, talos, "/urdf/talos_reduced.urdf");
+BENCHMARK_CAPTURE(coreFloat, talos, "/urdf/talos_reduced.urdf");
+BENCHMARK_CAPTURE(coreLongDouble, talos, "/urdf/talos_reduced.urdf");
+BENCHMARK_CAPTURE(kdlTree, talos, "/urdf/talos_reduced.urdf");
+BENCHMARK_CAPTURE(coreKinematicsOnly, talos, "/urdf/talos_reduced.urdf");
+BENCHMARK_CAPTURE(coreDynamicsOnly, talos, "/urdf/talos_reduced.urdf");
+BENCHMARK_CAPTURE(coreKinematicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
+BENCHMARK_CAPTURE(coreDynamicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
+BENCHMARK_CAPTURE(differentiation, finite_difference, jle::DifferentiatorType::kFiniteDifference, 3);
+BENCHMARK_CAPTURE(differentiation, savitzky_golay_9, jle::DifferentiatorType::kSavitzkyGolay, 9);
+BENCHMARK_CAPTURE(differentiation, kalman, jle::DifferentiatorType::kKalman, 1);
+
+BENCHMARK_MAIN();

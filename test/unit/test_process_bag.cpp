@@ -1,0 +1,486 @@
+// process_bag and make_example_bag, run as processes on bags written here: process_bag
+// must give what the estimator gives when driven directly with the same messages (its
+// plumbing: topics, partial-name mapping, wrench frames, settings file, CSV and bag
+// output), it must agree with the exact efforts make_example_bag computes from the
+// analytic trajectory (the whole chain, derivatives estimated from positions), and it
+// must refuse bad input with a message naming the culprit.
+#include <joint_load_estimator/JointLoads.h>
+#include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <geometry_msgs/WrenchStamped.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/JointState.h>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kData = JLE_TEST_DATA;
+const std::string kPanda = kData + "/urdf/panda_demo.urdf";
+constexpr double kPi = 3.141592653589793;
+
+// ------------------------------------------------------------------ processes, files
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+struct Result {
+  int status = -1;    // exit status, -1 if the process did not exit normally
+  std::string output;  // standard output and error
+};
+
+Result run(const std::string& command) {
+  Result r;
+  std::FILE* p = popen((command + " 2>&1").c_str(), "r");
+  if (p == nullptr) return r;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, p)) > 0) r.output.append(buffer, n);
+  const int status = pclose(p);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+void writeFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A CSV of numbers, parsed here (the tools' reader is not its own judge).
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+};
+
+Table readCsv(const std::string& path) {
+  Table t;
+  std::ifstream in(path);
+  std::string line;
+  bool first = true;
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::string cell;
+    std::vector<double> row;
+    while (std::getline(s, cell, ',')) {
+      if (first)
+        t.header.push_back(cell);
+      else
+        row.push_back(std::strtod(cell.c_str(), nullptr));
+    }
+    if (!first) t.rows.push_back(row);
+    first = false;
+  }
+  return t;
+}
+
+class ProcessBagTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("jle_test_process_bag_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  fs::path dir_;
+};
+
+// ------------------------------------------------------------ a bag written by the test
+
+// The arm's "ready" pose and a smooth motion about it; the fingers still.
+const std::vector<std::string> kJoints = {"panda_joint1", "panda_joint2", "panda_joint3",
+                                          "panda_joint4", "panda_joint5", "panda_joint6",
+                                          "panda_joint7", "panda_finger_joint1"};
+double position(std::size_t k, double t) {
+  const double ready[] = {0.0, -kPi / 4, 0.0, -3 * kPi / 4, 0.0, kPi / 2, kPi / 4, 0.02};
+  if (k == 7) return ready[k];
+  return ready[k] + 0.3 * std::sin(2 * kPi * (0.3 + 0.1 * static_cast<double>(k)) * t + k);
+}
+
+struct Messages {
+  // In time order, wrench samples between the joint samples.
+  std::vector<std::pair<ros::Time, sensor_msgs::JointState>> joints;
+  std::vector<std::pair<ros::Time, geometry_msgs::WrenchStamped>> wrenches;
+};
+
+// 300 joint states at 1 kHz (names reversed and an extra joint the model lacks: the
+// mapping by name is exercised), efforts = 100 + sample index (to pair with the
+// estimate), and a wrench at 400 Hz stamped between the joint samples, expressed in
+// panda_hand_tcp (rotated and offset from panda_link8, where it is configured to act).
+Messages makeMessages() {
+  Messages m;
+  for (int i = 0; i < 300; ++i) {
+    const double t = 0.001 * i;
+    sensor_msgs::JointState js;
+    js.header.stamp = ros::Time(2000.0) + ros::Duration(t);
+    js.name.push_back("not_in_the_model");
+    js.position.push_back(0.5);
+    js.effort.push_back(0.0);
+    for (std::size_t k = kJoints.size(); k-- > 0;) {
+      js.name.push_back(kJoints[k]);
+      js.position.push_back(position(k, t));
+      js.effort.push_back(100.0 + i + 0.1 * static_cast<double>(k));
+    }
+    m.joints.emplace_back(js.header.stamp, js);
+  }
+  for (int i = 0; i < 120; ++i) {
+    const double t = 0.0025 * i + 0.0003;
+    geometry_msgs::WrenchStamped w;
+    w.header.stamp = ros::Time(2000.0) + ros::Duration(t);
+    w.header.frame_id = "panda_hand_tcp";
+    w.wrench.force.x = 5.0 * std::sin(3 * t);
+    w.wrench.force.y = -3.0;
+    w.wrench.force.z = -15.0 + 2.0 * std::cos(5 * t);
+    w.wrench.torque.x = 0.2;
+    w.wrench.torque.y = -0.1 * std::sin(7 * t);
+    w.wrench.torque.z = 0.05;
+    m.wrenches.emplace_back(w.header.stamp, w);
+  }
+  return m;
+}
+
+void writeBag(const std::string& path, const Messages& m) {
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  for (const auto& j : m.joints) bag.write("/arm/joint_states", j.first, j.second);
+  for (const auto& w : m.wrenches) bag.write("/ft", w.first, w.second);
+}
+
+const char* const kConfig = R"(# the test's settings
+joint_states_topic: arm/joint_states
+joints: [panda_joint2, panda_joint4, panda_joint7]
+decimation: 2
+gravity: [0.0, 0.0, -9.81]
+differentiator:
+  type: savitzky_golay
+  window: 11
+  order: 3
+  delay: 5
+wrenches:
+  - topic: /ft
+    link: panda_link8
+    sign: -1
+    timeout: 0.5
+)";
+
+// The estimator of kConfig, configured here by hand (not by the settings parser).
+jle::Estimator referenceEstimator(const jle::Model<double>& model) {
+  jle::EstimatorConfig config;
+  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
+  config.differentiator.window = 11;
+  config.differentiator.order = 3;
+  config.differentiator.delay = 5;
+  config.gravity_world = Eigen::Vector3d(0.0, 0.0, -9.81);
+  config.decimation = 2;
+  jle::WrenchInputConfig input;
+  input.name = "/ft";
+  input.link = "panda_link8";
+  input.sign = -1.0;
+  input.timeout = 0.5;
+  config.wrenches.push_back(input);
+  return jle::Estimator(model, config);
+}
+
+// panda_hand_tcp in panda_link8, from the URDF's numbers: panda_hand_joint turns by
+// -pi/4 about z at the flange, panda_hand_tcp_joint is 0.1034 m along the hand's z.
+const Eigen::Matrix3d kR_link8_tcp =
+    Eigen::AngleAxisd(-kPi / 4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+const Eigen::Vector3d kP_link8_tcp(0.0, 0.0, 0.1034);
+
+struct Expected {
+  std::vector<double> t;
+  std::vector<std::vector<double>> values;  // per row: fx..effort per published joint
+  std::vector<std::vector<double>> measured;
+};
+
+// Drives the estimator directly with the messages, in time order.
+Expected expectedLoads(const Messages& m) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kPanda);
+  jle::Estimator estimator = referenceEstimator(model);
+  const std::vector<int> published = {model.segmentOfJoint("panda_joint2"),
+                                      model.segmentOfJoint("panda_joint4"),
+                                      model.segmentOfJoint("panda_joint7")};
+  std::map<double, std::vector<double>> efforts;  // by stamp, of the published joints
+  Expected e;
+  std::size_t w = 0;
+  for (const auto& j : m.joints) {
+    for (; w < m.wrenches.size() && m.wrenches[w].first <= j.first; ++w) {
+      const geometry_msgs::Wrench& msg = m.wrenches[w].second.wrench;
+      const Eigen::Vector3d f(msg.force.x, msg.force.y, msg.force.z);
+      const Eigen::Vector3d mo(msg.torque.x, msg.torque.y, msg.torque.z);
+      const Eigen::Vector3d f_link = kR_link8_tcp * f;
+      const Eigen::Vector3d m_link = kR_link8_tcp * mo + kP_link8_tcp.cross(f_link);
+      estimator.addWrench(0, m.wrenches[w].first.toSec(), f_link, m_link);
+    }
+    std::vector<double> q(static_cast<std::size_t>(model.nq));
+    for (std::size_t i = 0; i < j.second.name.size(); ++i)
+      for (int k = 0; k < model.nq; ++k)
+        if (model.coordinate_names[static_cast<std::size_t>(k)] == j.second.name[i])
+          q[static_cast<std::size_t>(k)] = j.second.position[i];
+    std::vector<double>& effort = efforts[j.first.toSec()];
+    for (const char* name : {"panda_joint2", "panda_joint4", "panda_joint7"})
+      for (std::size_t i = 0; i < j.second.name.size(); ++i)
+        if (j.second.name[i] == name) effort.push_back(j.second.effort[i]);
+    if (estimator.addJointSample(j.first.toSec(), q.data()) != jle::SampleStatus::kPublished)
+      continue;
+    e.t.push_back(estimator.stamp());
+    std::vector<double> row;
+    for (int s : published) {
+      const jle::Data<double>& d = estimator.data();
+      for (int c = 0; c < 3; ++c) row.push_back(d.force[static_cast<std::size_t>(s)][c]);
+      for (int c = 0; c < 3; ++c) row.push_back(d.moment[static_cast<std::size_t>(s)][c]);
+      row.push_back(d.effort[static_cast<std::size_t>(s)]);
+    }
+    e.values.push_back(row);
+    e.measured.push_back(efforts.at(estimator.stamp()));
+  }
+  return e;
+}
+
+// 1e-9 relative (absolute below 1): the CSV holds 17 significant digits and both sides
+// run the same arithmetic on the same inputs, so any difference is a plumbing defect
+// (a wrong frame, sign, pairing or order moves the loads by far more).
+void expectClose(double actual, double expected, const std::string& what) {
+  EXPECT_NEAR(actual, expected, 1e-9 * std::max(1.0, std::abs(expected))) << what;
+}
+
+TEST_F(ProcessBagTest, CsvEqualsTheEstimatorDrivenWithTheSameMessages) {
+  const Messages m = makeMessages();
+  writeBag(path("in.bag"), m);
+  writeFile(path("config.yaml"), kConfig);
+  const Result r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("in.bag")) +
+                       " --urdf " + quote(kPanda) + " --config " + quote(path("config.yaml")) +
+                       " --csv " + quote(path("out.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
+  // The extra joint is reported once, by name.
+  EXPECT_NE(r.output.find("'not_in_the_model'"), std::string::npos) << r.output;
+
+  const Expected e = expectedLoads(m);
+  const Table csv = readCsv(path("out.csv"));
+  const std::vector<std::string> header = {
+      "t",               "panda_joint2.fx", "panda_joint2.fy",     "panda_joint2.fz",
+      "panda_joint2.mx", "panda_joint2.my", "panda_joint2.mz",     "panda_joint2.effort",
+      "panda_joint4.fx", "panda_joint4.fy", "panda_joint4.fz",     "panda_joint4.mx",
+      "panda_joint4.my", "panda_joint4.mz", "panda_joint4.effort", "panda_joint7.fx",
+      "panda_joint7.fy", "panda_joint7.fz", "panda_joint7.mx",     "panda_joint7.my",
+      "panda_joint7.mz", "panda_joint7.effort"};
+  EXPECT_EQ(csv.header, header);
+  // 300 samples, the first 10 fill the window, every second one is published.
+  ASSERT_EQ(e.t.size(), 145u);
+  ASSERT_EQ(csv.rows.size(), e.t.size());
+  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
+    ASSERT_EQ(csv.rows[i].size(), header.size());
+    expectClose(csv.rows[i][0], e.t[i], "t, row " + std::to_string(i));
+    for (std::size_t c = 1; c < header.size(); ++c)
+      expectClose(csv.rows[i][c], e.values[i][c - 1], header[c] + ", row " + std::to_string(i));
+  }
+}
+
+TEST_F(ProcessBagTest, BagOutputHoldsTheLoadsAndTheMeasuredEfforts) {
+  const Messages m = makeMessages();
+  writeBag(path("in.bag"), m);
+  writeFile(path("config.yaml"), kConfig);
+  const Result r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("in.bag")) +
+                       " --urdf " + quote(kPanda) + " --config " + quote(path("config.yaml")) +
+                       " --output " + quote(path("out.bag")) + " --topic-prefix estimate/");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Expected e = expectedLoads(m);
+
+  rosbag::Bag bag(path("out.bag"), rosbag::bagmode::Read);
+  rosbag::View view(bag);
+  std::size_t i = 0;
+  for (const rosbag::MessageInstance& instance : view) {
+    EXPECT_EQ(instance.getTopic(), "/estimate/joint_loads");
+    const auto msg = instance.instantiate<joint_load_estimator::JointLoads>();
+    ASSERT_TRUE(msg != nullptr);
+    ASSERT_LT(i, e.t.size());
+    // Bag time = the estimate's stamp, which lags the newest sample by the delay.
+    EXPECT_EQ(instance.getTime(), msg->header.stamp);
+    expectClose(msg->header.stamp.toSec(), e.t[i], "stamp");
+    ASSERT_EQ(msg->name, (std::vector<std::string>{"panda_joint2", "panda_joint4", "panda_joint7"}));
+    for (std::size_t j = 0; j < 3; ++j) {
+      const geometry_msgs::Wrench& w = msg->wrench[j];
+      const double got[] = {w.force.x,  w.force.y,  w.force.z,     w.torque.x,
+                            w.torque.y, w.torque.z, msg->effort[j]};
+      for (int c = 0; c < 7; ++c) expectClose(got[c], e.values[i][7 * j + c], "message " + std::to_string(i));
+      // The measured effort of the sample the estimate describes, exactly.
+      EXPECT_EQ(msg->measured_effort[j], e.measured[i][j]);
+    }
+    ++i;
+  }
+  EXPECT_EQ(i, e.t.size());
+}
+
+// ------------------------------------------------- the analytic bag of make_example_bag
+
+// The settings of the demo, but a Savitzky-Golay fit centred on the estimate, whose
+// error on these slow sines is tiny.
+const char* const kCentredConfig = R"(differentiator:
+  type: savitzky_golay
+  window: 21
+  order: 4
+  delay: centred
+wrenches:
+  - topic: /ft_sensor/wrench
+    link: panda_hand
+)";
+
+struct Comparison {
+  std::size_t rows = 0;
+  double max_error = 0.0;   // max |estimated - exact effort| over joints and rows [N m]
+  double max_effort = 0.0;  // max |exact effort|
+};
+
+// The estimated efforts against the exact ones make_example_bag stored in the joint states.
+Comparison compareWithExact(const std::string& csv_path, const std::string& bag_path) {
+  std::map<long long, std::map<std::string, double>> exact;  // by stamp [ns]
+  rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/joint_states"))) {
+    const auto js = m.instantiate<sensor_msgs::JointState>();
+    for (std::size_t i = 0; i < js->name.size(); ++i)
+      exact[static_cast<long long>(js->header.stamp.toNSec())][js->name[i]] = js->effort[i];
+  }
+  const Table csv = readCsv(csv_path);
+  Comparison c;
+  for (const std::vector<double>& row : csv.rows) {
+    const long long ns = std::llround(row[0] * 1e6) * 1000;  // stamps are whole microseconds
+    const auto it = exact.find(ns);
+    EXPECT_NE(it, exact.end()) << "no joint state at " << row[0];
+    if (it == exact.end()) continue;
+    for (std::size_t col = 1; col < csv.header.size(); ++col) {
+      const std::string& name = csv.header[col];
+      const std::size_t dot = name.rfind('.');
+      if (name.substr(dot) != ".effort") continue;
+      const double truth = it->second.at(name.substr(0, dot));
+      c.max_error = std::max(c.max_error, std::abs(row[col] - truth));
+      c.max_effort = std::max(c.max_effort, std::abs(truth));
+    }
+    ++c.rows;
+  }
+  return c;
+}
+
+TEST_F(ProcessBagTest, AgreesWithTheExactEffortsOfTheExampleBag) {
+  Result r = run(std::string(JLE_MAKE_EXAMPLE_BAG) + " --urdf " + quote(kPanda) +
+                 " --output " + quote(path("example.bag")) + " --duration 1 --effort --seed 7");
+  ASSERT_EQ(r.status, 0) << r.output;
+  writeFile(path("centred.yaml"), kCentredConfig);
+  r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("example.bag")) + " --urdf " +
+          quote(kPanda) + " --config " + quote(path("centred.yaml")) + " --csv " +
+          quote(path("loads.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Comparison with = compareWithExact(path("loads.csv"), path("example.bag"));
+  // 1000 samples, the first 20 fill the window.
+  EXPECT_EQ(with.rows, 980u);
+  EXPECT_GT(with.max_effort, 10.0);
+  // A 4th-order fit over 21 ms of sines below 0.6 Hz: the acceleration error is about
+  // w^2 (w h)^4 A ~ 1e-8 rad/s^2 and the wrench is smoothed as little; 1e-4 N m is
+  // well above that and far below what a wrong sign or frame of the wrench gives.
+  EXPECT_LT(with.max_error, 1e-4);
+
+  // The same without the sensor: the payload and the push are missing, so the check
+  // above is not blind to the wrench.
+  writeFile(path("none.yaml"), "differentiator: {type: savitzky_golay, window: 21, order: 4, "
+                               "delay: centred}\n");
+  r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("example.bag")) + " --urdf " +
+          quote(kPanda) + " --config " + quote(path("none.yaml")) + " --csv " +
+          quote(path("bare.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_GT(compareWithExact(path("bare.csv"), path("example.bag")).max_error, 1.0);
+}
+
+TEST_F(ProcessBagTest, ExampleBagIsDeterministic) {
+  const std::string base = std::string(JLE_MAKE_EXAMPLE_BAG) + " --urdf " + quote(kPanda) +
+                           " --samples 200 --output ";
+  ASSERT_EQ(run(base + quote(path("a.bag"))).status, 0);
+  ASSERT_EQ(run(base + quote(path("b.bag"))).status, 0);
+  ASSERT_EQ(run(base + quote(path("c.bag")) + " --seed 2").status, 0);
+  EXPECT_EQ(readFile(path("a.bag")), readFile(path("b.bag")));
+  EXPECT_NE(readFile(path("a.bag")), readFile(path("c.bag")));
+  EXPECT_FALSE(fs::exists(path("a.bag.partial")));
+}
+
+// ---------------------------------------------------------------------------- bad input
+
+TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
+  const Messages m = makeMessages();
+  writeBag(path("in.bag"), m);
+  writeFile(path("config.yaml"), kConfig);
+  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda);
+
+  // A missing bag.
+  Result r = run(tool + " --bag " + quote(path("missing.bag")) + " --csv " + quote(path("o.csv")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find(path("missing.bag")), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.csv")));
+
+  // A misspelt key in the settings.
+  writeFile(path("bad.yaml"), std::string(kConfig) + "decimaton: 3\n");
+  r = run(tool + " --bag " + quote(path("in.bag")) + " --config " + quote(path("bad.yaml")) +
+          " --csv " + quote(path("o.csv")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("'decimaton'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(path("bad.yaml")), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.csv")));
+
+  // The joint states on another topic than the bag has (the default joint_states).
+  r = run(tool + " --bag " + quote(path("in.bag")) + " --csv " + quote(path("o.csv")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("'/joint_states'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("/arm/joint_states"), std::string::npos) << r.output;  // what there is
+  EXPECT_FALSE(fs::exists(path("o.csv")));
+
+  // A wrench in a frame that moves relative to its link (tf2 would be needed).
+  std::string moving = kConfig;
+  moving.replace(moving.find("link: panda_link8"), 17, "link: panda_link3");
+  writeFile(path("moving.yaml"), moving);
+  r = run(tool + " --bag " + quote(path("in.bag")) + " --config " + quote(path("moving.yaml")) +
+          " --output " + quote(path("o.bag")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("'panda_hand_tcp'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("'panda_link3'"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.bag")));
+  EXPECT_FALSE(fs::exists(path("o.bag.partial")));
+
+  // Usage errors.
+  r = run(tool + " --bag " + quote(path("in.bag")) + " --csv a.csv --output b.bag");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("exclude"), std::string::npos) << r.output;
+  r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("in.bag")));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--urdf"), std::string::npos) << r.output;
+}
+
+}  // namespace
