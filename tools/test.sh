@@ -1,16 +1,31 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test; exits non-zero on a failure.
+# Installs what is missing, builds, and runs every test (gtest units, the CLI tests,
+# rostest node tests, each benchmark once on a tiny input); exits non-zero on a failure.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
+export JLE_WS=$ws
 bash "$repo/tools/install_deps.sh"
 bash "$repo/tools/build.sh" -j2
 bash "$repo/tools/build.sh" -j2 tests
 export PATH=/usr/bin:$PATH
 cd "$ws"
+rm -rf build/test_results
 # run_tests does not fail on a failed test; catkin_test_results does.
-catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests -j1 >"$ws/run_tests.log" 2>&1 ||
-  { tail -50 "$ws/run_tests.log"; exit 1; }
-grep -E "^\[ *(OK|FAILED|PASSED) |^\[==========\]|FAILURE|Error" "$ws/run_tests.log" | tail -60 || true
-catkin_test_results --verbose build/test_results | tail -40
-catkin_test_results build/test_results
+if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests -j1 >"$ws/run_tests.log" 2>&1; then
+  tail -80 "$ws/run_tests.log"
+  echo "run_tests failed (log: $ws/run_tests.log)"
+  exit 1
+fi
+grep -E "^\[  (FAILED|PASSED) |^\[ *FAILED *\]|^\[ROSTEST\]|FAILURE" "$ws/run_tests.log" | sort | uniq -c | sort -rn | head -40 || true
+status=0
+catkin_test_results --verbose build/test_results >"$ws/test_results.txt" 2>&1 || status=$?
+grep -vE "^$" "$ws/test_results.txt" | grep -vE "^(Summary|  )" | tail -20 || true
+summary=$(grep -E "^Summary:" "$ws/test_results.txt" || echo "Summary: 0 tests, 1 errors, 0 failures, 0 skipped")
+echo "$summary"
+# The plain closing line: N passed, N failed.
+echo "$summary" | awk '{gsub(",", ""); t=$2; e=$4; f=$6; s=$8; printf "tests: %d passed, %d failed, %d skipped\n", t-e-f-s, e+f, s}'
+if [ "$(echo "$summary" | awk '{gsub(",", ""); print $2}')" = "0" ]; then
+  echo "no test ran"; exit 1
+fi
+exit $status

@@ -11,6 +11,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace jle {
 
@@ -57,6 +58,45 @@ void addExternalWrench(const Model<Scalar>& model, Data<Scalar>& data, int frame
   data.n_ext[s] += n + fr.p_segment_frame.cross(f);
 }
 
+namespace detail {
+
+// One segment of the backward pass: its own inertial terms added to what its children
+// and the applied wrenches left in force/moment, then handed to its parent.
+template <typename Scalar>
+inline void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  Vector3& f = data.force[i];
+  Vector3& m = data.moment[i];
+  if (model.has_inertia[i]) {
+    const Vector3& c = model.com[i];
+    const Vector3& w = data.omega[i];
+    const Vector3& al = data.alpha[i];
+    const Vector3 m_a_com = model.mass[i] * (data.acc[i] + al.cross(c) + w.cross(w.cross(c)));
+    f += m_a_com;
+    m.noalias() += model.inertia_com[i] * al;
+    m += c.cross(m_a_com);
+    if (model.gyroscopic[i]) {
+      const Vector3 Jw = model.inertia_com[i] * w;
+      m += w.cross(Jw);
+    }
+  }
+  switch (model.joint_type[i]) {
+    case JointType::kRevolute: data.effort[i] = model.axis[i].dot(m); break;
+    case JointType::kPrismatic: data.effort[i] = model.axis[i].dot(f); break;
+    default: data.effort[i] = Scalar(0); break;
+  }
+  const int p = model.parent[i];
+  if (p < 0) return;
+  // The child's joint wrench acts on the parent reversed; in the parent's sum it
+  // enters with a plus sign (F = m a - F_0 with F_0 holding -F_child).
+  const Vector3 f_p = data.R_parent_child[i] * f;
+  data.force[p] += f_p;
+  data.moment[p].noalias() += data.R_parent_child[i] * m;
+  data.moment[p] += data.p_parent_child[i].cross(f_p);
+}
+
+}  // namespace detail
+
 /// Backward pass over the kinematics in data (forwardKinematics) and the external
 /// wrenches added since. For each segment, in its own frame (the paper's equations are
 /// frame-independent; in the segment frame J'_G is constant and no world offset enters),
@@ -68,39 +108,26 @@ void addExternalWrench(const Model<Scalar>& model, Data<Scalar>& data, int frame
 /// Fills data.force, data.moment (child frame, about the joint origin) and data.effort.
 template <typename Scalar>
 void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data) {
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   const int n = model.nsegments();
   for (int i = 0; i < n; ++i) {
     data.force[i] = -data.f_ext[i];
     data.moment[i] = -data.n_ext[i];
   }
-  for (int i = n - 1; i >= 0; --i) {
-    const Vector3& c = model.com[i];
-    const Vector3& w = data.omega[i];
-    const Vector3& al = data.alpha[i];
-    const Vector3 m_a_com =
-        model.mass[i] * (data.acc[i] + al.cross(c) + w.cross(w.cross(c)));
-    const Vector3 Jw = model.inertia_com[i] * w;
-    Vector3& f = data.force[i];
-    Vector3& m = data.moment[i];
-    f += m_a_com;
-    m.noalias() += model.inertia_com[i] * al;
-    m += w.cross(Jw) + c.cross(m_a_com);
+  for (int i = n - 1; i >= 0; --i) detail::backwardSegment(model, data, i);
+}
 
-    switch (model.joint_type[i]) {
-      case JointType::kRevolute: data.effort[i] = model.axis[i].dot(m); break;
-      case JointType::kPrismatic: data.effort[i] = model.axis[i].dot(f); break;
-      default: data.effort[i] = Scalar(0); break;
-    }
-    const int p = model.parent[i];
-    if (p < 0) continue;
-    // The child's joint wrench acts on the parent reversed; in the parent's sum it
-    // enters with a plus sign (F = m a - F_0 with F_0 holding -F_child).
-    const Vector3 f_p = data.R_parent_child[i] * f;
-    data.force[p] += f_p;
-    data.moment[p].noalias() += data.R_parent_child[i] * m;
-    data.moment[p] += data.p_parent_child[i].cross(f_p);
+/// The backward pass over `segments` only: increasing indices, closed under children
+/// (every child of a listed segment is listed). The wrenches of the listed segments
+/// are exact; what they hand to unlisted parents is not meaningful.
+template <typename Scalar>
+void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data,
+                     const std::vector<int>& segments) {
+  for (int i : segments) {
+    data.force[i] = -data.f_ext[i];
+    data.moment[i] = -data.n_ext[i];
   }
+  for (auto it = segments.rbegin(); it != segments.rend(); ++it)
+    detail::backwardSegment(model, data, *it);
 }
 
 /// The joint wrench of segment i (exerted by its parent, moment about the joint

@@ -34,8 +34,35 @@ struct WrenchInputConfig {
   StalePolicy stale_policy = StalePolicy::kHold;
 };
 
+/// Arithmetic of the dynamics (the filters always run in double).
+enum class Precision : std::uint8_t { kDouble, kFloat };
+
+/// Work the estimator skips when a scene does not need it. Each switch exists for
+/// measurement; the exact ones are on by default.
+struct Savings {
+  /// Compute only the segments distal to the published joints, and the kinematics
+  /// they depend on.
+  bool prune = true;
+  /// A chain of massless, unloaded segments passes its distal wrench on unchanged.
+  bool massless_chains = true;
+  /// Skip the gyroscopic term where omega lies along a principal axis of inertia.
+  bool gyroscopic = true;
+  /// Joint velocities and accelerations whose magnitudes are all below these
+  /// thresholds are taken as zero (quasi-static scene). 0 = off (the default: not exact).
+  double static_velocity = 0.0;      ///< [rad/s or m/s]
+  double static_acceleration = 0.0;  ///< [rad/s^2 or m/s^2]
+  /// When the filtered inputs have not changed since the last computation, reuse its
+  /// result instead of recomputing (exact: same inputs, same outputs).
+  bool reuse_unchanged = true;
+};
+
 struct EstimatorConfig {
   DifferentiatorConfig differentiator;
+  Precision precision = Precision::kDouble;
+  Savings savings;
+  /// Joints whose loads are wanted (URDF names); empty: all. With savings.prune, only
+  /// what they depend on is computed.
+  std::vector<std::string> joints;
   Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};  ///< [m/s^2]
   std::vector<WrenchInputConfig> wrenches;
   /// Loads are computed for every n-th joint sample (the filters see every sample).
@@ -98,6 +125,15 @@ class Estimator {
   Wrench<double> appliedWrench(int k) const;
   /// Nominal delay of the estimate behind the newest sample, in samples.
   int delaySamples() const { return bank_.config().delay; }
+  /// Segments whose loads are computed (all, or what the wanted joints need).
+  const std::vector<int>& dynamicsSegments() const { return dynamics_segments_; }
+  /// Whether wrench input k acts on a segment whose loads are computed.
+  bool inputNeeded(int k) const { return inputs_[k].needed; }
+  /// Whether coordinate i enters the computed loads.
+  bool coordinateNeeded(int i) const { return coordinate_needed_[i] != 0; }
+  /// How the last published sample was obtained (for the benchmarks).
+  bool lastWasReused() const { return reused_; }
+  bool lastWasStatic() const { return static_; }
 
  private:
   struct Input {
@@ -109,13 +145,26 @@ class Estimator {
     int head = 0;
     int count = 0;
     bool stale = true;
+    bool needed = true;
   };
+  void compute(const BaseState<double>& base_state);
   // Value of input k at time t (linear between samples, held past the newest).
   Eigen::Matrix<double, 6, 1> sampleInput(Input& input, double t);
 
-  Model<double> model_;
+  Model<double> model_;  // flags of the disabled savings cleared
   EstimatorConfig config_;
   Data<double> data_;
+  Model<float> model_f_;  // Precision::kFloat
+  Data<float> data_f_;
+  VectorX<float> q_f_, qd_f_, qdd_f_;
+  std::vector<int> kinematics_segments_;  // closed under parents
+  std::vector<int> dynamics_segments_;    // closed under children
+  std::vector<char> coordinate_needed_;
+  bool prune_ = false;
+  std::vector<double> last_inputs_;  // the filtered inputs of the last computation
+  bool have_result_ = false;
+  bool reused_ = false;
+  bool static_ = false;
   DifferentiatorBank bank_;
   std::vector<Input> inputs_;
   std::vector<double> channels_;  // q (nq), base (7), wrenches (6 per input)

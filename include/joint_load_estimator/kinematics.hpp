@@ -11,6 +11,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace jle {
 
@@ -64,18 +65,12 @@ void checkCoordinates(const Model<Scalar>& model, const VectorX<Scalar>& q,
                                 std::to_string(model.nq) + " coordinates");
 }
 
-/// Forward pass. q, qd, qdd: size model.nq, in the order of model.coordinate_names
-/// [rad, rad/s, rad/s^2 or m, m/s, m/s^2]. gravity_world [m/s^2]. Fills the kinematic
-/// fields of data and clears its external wrenches.
-template <typename Scalar>
-void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
-                       const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
-                       const VectorX<Scalar>& qdd,
-                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                       const BaseState<Scalar>& base = BaseState<Scalar>()) {
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  checkCoordinates(model, q, qd, qdd);
+namespace detail {
 
+// Root of the forward pass: the base state, gravity as an upward acceleration.
+template <typename Scalar>
+void forwardRoot(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                 const BaseState<Scalar>& base) {
   const Eigen::Matrix<Scalar, 3, 3>& R0 = base.R_world_base;
   data.R_world[0] = R0;
   data.p_world[0] = base.p_world_base;
@@ -84,31 +79,45 @@ void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
   data.acc[0].noalias() = R0.transpose() * (base.a_world - gravity_world);
   data.f_ext[0].setZero();
   data.n_ext[0].setZero();
+}
 
-  const int n = model.nsegments();
-  for (int i = 1; i < n; ++i) {
-    const int p = model.parent[i];
-    const int k = model.coordinate[i];
-    Scalar qi(0), qdi(0), qddi(0);
-    if (k >= 0) {
-      qi = model.multiplier[i] * q[k] + model.offset[i];
+// One segment of the forward pass (its parent done). kStatic: the caller guarantees
+// zero joint velocities and accelerations and a base at rest (angular), so every
+// omega and alpha is zero and only the pose and the origin acceleration remain.
+template <typename Scalar, bool kStatic>
+inline void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i,
+                           const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                           const VectorX<Scalar>& qdd) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  const int p = model.parent[i];
+  const int k = model.coordinate[i];
+  Scalar qi(0), qdi(0), qddi(0);
+  if (k >= 0) {
+    qi = model.multiplier[i] * q[k] + model.offset[i];
+    if (!kStatic) {
       qdi = model.multiplier[i] * qd[k];
       qddi = model.multiplier[i] * qdd[k];
     }
-    data.q[i] = qi;
-    data.qd[i] = qdi;
-    data.qdd[i] = qddi;
+  }
+  data.q[i] = qi;
+  data.qd[i] = qdi;
+  data.qdd[i] = qddi;
 
-    const Vector3& u = model.axis[i];
-    Eigen::Matrix<Scalar, 3, 3>& R = data.R_parent_child[i];
-    Vector3& r = data.p_parent_child[i];
-    r = model.p_parent_joint[i];
-    if (model.joint_type[i] == JointType::kRevolute)
-      R.noalias() = model.R_parent_joint[i] * axisRotation(u, qi);
-    else
-      R = model.R_parent_joint[i];
-    if (model.joint_type[i] == JointType::kPrismatic) r.noalias() += R * (u * qi);
+  const Vector3& u = model.axis[i];
+  Eigen::Matrix<Scalar, 3, 3>& R = data.R_parent_child[i];
+  Vector3& r = data.p_parent_child[i];
+  r = model.p_parent_joint[i];
+  if (model.joint_type[i] == JointType::kRevolute)
+    R.noalias() = model.R_parent_joint[i] * axisRotation(u, qi);
+  else
+    R = model.R_parent_joint[i];
+  if (model.joint_type[i] == JointType::kPrismatic) r.noalias() += R * (u * qi);
 
+  if (kStatic) {
+    data.omega[i].setZero();
+    data.alpha[i].setZero();
+    data.acc[i].noalias() = R.transpose() * data.acc[p];
+  } else {
     // Acceleration of this origin as a point of the parent, parent frame.
     const Vector3& w_p = data.omega[p];
     const Vector3 a_point = data.acc[p] + data.alpha[p].cross(r) + w_p.cross(w_p.cross(r));
@@ -122,12 +131,53 @@ void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
     } else if (model.joint_type[i] == JointType::kPrismatic) {
       data.acc[i] += u * qddi + Scalar(2) * w.cross(u * qdi);
     }
+  }
 
-    data.R_world[i].noalias() = data.R_world[p] * R;
-    data.p_world[i] = data.p_world[p];
-    data.p_world[i].noalias() += data.R_world[p] * r;
-    data.f_ext[i].setZero();
-    data.n_ext[i].setZero();
+  data.R_world[i].noalias() = data.R_world[p] * R;
+  data.p_world[i] = data.p_world[p];
+  data.p_world[i].noalias() += data.R_world[p] * r;
+  data.f_ext[i].setZero();
+  data.n_ext[i].setZero();
+}
+
+}  // namespace detail
+
+/// Forward pass. q, qd, qdd: size model.nq, in the order of model.coordinate_names
+/// [rad, rad/s, rad/s^2 or m, m/s, m/s^2]. gravity_world [m/s^2]. Fills the kinematic
+/// fields of data and clears its external wrenches.
+template <typename Scalar>
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
+                       const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                       const VectorX<Scalar>& qdd,
+                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                       const BaseState<Scalar>& base = BaseState<Scalar>()) {
+  checkCoordinates(model, q, qd, qdd);
+  detail::forwardRoot(data, gravity_world, base);
+  const int n = model.nsegments();
+  for (int i = 1; i < n; ++i) detail::forwardSegment<Scalar, false>(model, data, i, q, qd, qdd);
+}
+
+/// The forward pass over `segments` only: indices in increasing order, closed under
+/// parents (every listed segment's parent is listed), starting with 0. With `statics`
+/// the caller asserts zero joint velocities and accelerations and a base that does
+/// not rotate, and the velocity terms are skipped.
+template <typename Scalar>
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
+                       const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                       const VectorX<Scalar>& qdd,
+                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                       const BaseState<Scalar>& base, const std::vector<int>& segments,
+                       bool statics) {
+  checkCoordinates(model, q, qd, qdd);
+  detail::forwardRoot(data, gravity_world, base);
+  if (statics) {
+    data.omega[0].setZero();
+    data.alpha[0].setZero();
+    for (std::size_t j = 1; j < segments.size(); ++j)
+      detail::forwardSegment<Scalar, true>(model, data, segments[j], q, qd, qdd);
+  } else {
+    for (std::size_t j = 1; j < segments.size(); ++j)
+      detail::forwardSegment<Scalar, false>(model, data, segments[j], q, qd, qdd);
   }
 }
 

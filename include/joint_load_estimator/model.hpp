@@ -68,6 +68,14 @@ struct Model {
   std::vector<Vector3> com;          ///< lumped centre of mass in the segment frame [m]
   std::vector<Matrix3> inertia_com;  ///< lumped inertia about the com, segment axes [kg m^2]
 
+  /// Derived by analyze() (which the URDF reader calls): what the backward pass may
+  /// skip for each segment without changing its result.
+  /// has_inertia[i] == 0: zero mass and inertia, no inertial term to compute.
+  std::vector<char> has_inertia;
+  /// gyroscopic[i] == 0: omega x J_G omega is identically zero for this segment, because
+  /// its angular velocity always lies along a principal axis of J_G (or is zero).
+  std::vector<char> gyroscopic;
+
   /// Names of the independent coordinates, index = position in q, size nq.
   std::vector<std::string> coordinate_names;
   /// Segments whose joint moves (revolute, continuous, prismatic, mimics included), in
@@ -101,6 +109,48 @@ struct Model {
     return total;
   }
 
+  /// Fills has_inertia and gyroscopic from the rest of the model. The direction of a
+  /// segment's angular velocity is constant in its frame when the base is fixed and
+  /// every joint above it turns about one and the same axis (a planar chain): then the
+  /// gyroscopic term vanishes wherever that axis is a principal axis of inertia.
+  void analyze() {
+    const int n = nsegments();
+    has_inertia.assign(static_cast<std::size_t>(n), 1);
+    gyroscopic.assign(static_cast<std::size_t>(n), 1);
+    // Direction of omega in each segment frame: 0 = always zero, 1 = along dir[i],
+    // 2 = varies.
+    std::vector<int> kind(static_cast<std::size_t>(n), 2);
+    std::vector<Vector3> dir(static_cast<std::size_t>(n), Vector3::Zero());
+    const Scalar eps = Scalar(64) * Eigen::NumTraits<Scalar>::epsilon();
+    for (int i = 0; i < n; ++i) {
+      has_inertia[i] = mass[i] != Scalar(0) || !inertia_com[i].isZero(Scalar(0));
+      if (i == 0) {
+        kind[0] = floating_base ? 2 : 0;
+      } else {
+        const int p = parent[i];
+        const bool revolute = joint_type[i] == JointType::kRevolute;
+        if (kind[p] == 0) {
+          kind[i] = revolute ? 1 : 0;
+          dir[i] = axis[i];
+        } else if (kind[p] == 1) {
+          const Vector3 v = R_parent_joint[i].transpose() * dir[p];  // joint frame
+          if (!revolute) {
+            kind[i] = 1;
+            dir[i] = v;
+          } else if (v.cross(axis[i]).norm() <= eps) {
+            kind[i] = 1;
+            dir[i] = axis[i];
+          }
+        }
+      }
+      if (kind[i] == 0) gyroscopic[i] = 0;
+      if (kind[i] == 1) {
+        const Vector3 Jd = inertia_com[i] * dir[i];
+        gyroscopic[i] = Jd.cross(dir[i]).norm() > eps * (Scalar(1) + Jd.norm());
+      }
+    }
+  }
+
   /// The same model in another scalar type.
   template <typename Other>
   Model<Other> cast() const {
@@ -115,6 +165,8 @@ struct Model {
     out.coordinate_names = coordinate_names;
     out.moving_segments = moving_segments;
     out.warnings = warnings;
+    out.has_inertia = has_inertia;
+    out.gyroscopic = gyroscopic;
     for (int i = 0; i < nsegments(); ++i) {
       out.R_parent_joint.push_back(R_parent_joint[i].template cast<Other>());
       out.p_parent_joint.push_back(p_parent_joint[i].template cast<Other>());

@@ -32,10 +32,27 @@ const char* toString(SampleStatus status) {
   return "?";
 }
 
+namespace {
+
+// The model with the flags of the disabled savings set to "compute everything".
+Model<double> withSavings(Model<double> model, const Savings& savings) {
+  if (model.has_inertia.empty()) model.analyze();
+  if (!savings.massless_chains) model.has_inertia.assign(model.has_inertia.size(), 1);
+  if (!savings.gyroscopic) model.gyroscopic.assign(model.gyroscopic.size(), 1);
+  return model;
+}
+
+}  // namespace
+
 Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
-    : model_(model),
+    : model_(withSavings(model, config.savings)),
       config_(config),
       data_(model_),
+      model_f_(model_.cast<float>()),
+      data_f_(model_f_),
+      q_f_(VectorX<float>::Zero(model.nq)),
+      qd_f_(VectorX<float>::Zero(model.nq)),
+      qdd_f_(VectorX<float>::Zero(model.nq)),
       bank_(config.differentiator,
             model.nq + (model.floating_base ? 7 : 0) + 6 * static_cast<int>(config.wrenches.size())),
       q_(VectorX<double>::Zero(model.nq)),
@@ -58,6 +75,32 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
     inputs_.push_back(input);
   }
   channels_.assign(static_cast<std::size_t>(bank_.channels()), 0.0);
+  last_inputs_.assign(channels_.size() * 3, 0.0);
+
+  // What the wanted joints need: the subtrees below them (dynamics) and the paths
+  // from the root to those (kinematics). A floating base's residual needs everything.
+  const int n = model_.nsegments();
+  std::vector<char> dyn(static_cast<std::size_t>(n), 0), kin(static_cast<std::size_t>(n), 0);
+  if (config_.joints.empty() || model_.floating_base || !config_.savings.prune) {
+    dyn.assign(dyn.size(), 1);
+  } else {
+    for (const std::string& j : config_.joints) dyn[model_.segmentOfJoint(j)] = 1;
+    for (int i = 1; i < n; ++i)
+      if (dyn[model_.parent[i]]) dyn[i] = 1;
+  }
+  for (const std::string& j : config_.joints) model_.segmentOfJoint(j);  // names checked
+  for (int i = n - 1; i >= 0; --i) {
+    if (dyn[i]) kin[i] = 1;
+    if (kin[i] && i > 0) kin[model_.parent[i]] = 1;
+  }
+  coordinate_needed_.assign(static_cast<std::size_t>(model_.nq), 0);
+  for (int i = 0; i < n; ++i) {
+    if (kin[i]) kinematics_segments_.push_back(i);
+    if (dyn[i]) dynamics_segments_.push_back(i);
+    if (kin[i] && model_.coordinate[i] >= 0) coordinate_needed_[model_.coordinate[i]] = 1;
+  }
+  prune_ = static_cast<int>(dynamics_segments_.size()) < n;
+  for (Input& input : inputs_) input.needed = dyn[model_.frames[input.frame].segment] != 0;
 }
 
 void Estimator::reset() {
@@ -68,6 +111,7 @@ void Estimator::reset() {
     input.stale = true;
   }
   have_last_ = false;
+  have_result_ = false;
   sample_count_ = 0;
 }
 
@@ -186,18 +230,87 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
     base_state.R_world_base =
         Eigen::Quaterniond(quat[0], quat[1], quat[2], quat[3]).toRotationMatrix();
   }
-  forwardKinematics(model_, data_, q_, qd_, qdd_, config_.gravity_world, base_state);
-  for (std::size_t k = 0; k < inputs_.size(); ++k) {
-    const std::size_t c = static_cast<std::size_t>(wrench_channel_) + 6 * k;
-    const Eigen::Vector3d f(bank_.value(static_cast<int>(c)), bank_.value(static_cast<int>(c + 1)),
-                            bank_.value(static_cast<int>(c + 2)));
-    const Eigen::Vector3d m(bank_.value(static_cast<int>(c + 3)),
-                            bank_.value(static_cast<int>(c + 4)),
-                            bank_.value(static_cast<int>(c + 5)));
-    addExternalWrench(model_, data_, inputs_[k].frame, f, m, WrenchFrame::kLocal);
+
+  // Same filtered inputs as the last computation: same loads (exact by construction).
+  reused_ = false;
+  if (config_.savings.reuse_unchanged) {
+    bool same = have_result_;
+    const std::size_t c = channels_.size();
+    for (std::size_t i = 0; i < c && same; ++i)
+      same = bank_.value(static_cast<int>(i)) == last_inputs_[i] &&
+             bank_.rate(static_cast<int>(i)) == last_inputs_[c + i] &&
+             bank_.accel(static_cast<int>(i)) == last_inputs_[2 * c + i];
+    if (same) {
+      reused_ = true;
+      return SampleStatus::kPublished;
+    }
+    for (std::size_t i = 0; i < c; ++i) {
+      last_inputs_[i] = bank_.value(static_cast<int>(i));
+      last_inputs_[c + i] = bank_.rate(static_cast<int>(i));
+      last_inputs_[2 * c + i] = bank_.accel(static_cast<int>(i));
+    }
   }
-  inverseDynamics(model_, data_);
+  compute(base_state);
+  have_result_ = true;
   return SampleStatus::kPublished;
+}
+
+void Estimator::compute(const BaseState<double>& base_state) {
+  // Quasi-static scene: below the user's thresholds the velocity terms are dropped.
+  static_ = false;
+  const Savings& sv = config_.savings;
+  if (sv.static_velocity > 0.0 && sv.static_acceleration > 0.0 && !model_.floating_base) {
+    static_ = true;
+    for (int i = 0; i < model_.nq && static_; ++i)
+      static_ = std::abs(qd_[i]) < sv.static_velocity && std::abs(qdd_[i]) < sv.static_acceleration;
+    if (static_) {
+      qd_.setZero();
+      qdd_.setZero();
+    }
+  }
+  if (config_.precision == Precision::kFloat) {
+    q_f_ = q_.cast<float>();
+    qd_f_ = qd_.cast<float>();
+    qdd_f_ = qdd_.cast<float>();
+    BaseState<float> base_f;
+    base_f.R_world_base = base_state.R_world_base.cast<float>();
+    base_f.p_world_base = base_state.p_world_base.cast<float>();
+    base_f.v_world = base_state.v_world.cast<float>();
+    base_f.omega_world = base_state.omega_world.cast<float>();
+    base_f.a_world = base_state.a_world.cast<float>();
+    base_f.alpha_world = base_state.alpha_world.cast<float>();
+    forwardKinematics(model_f_, data_f_, q_f_, qd_f_, qdd_f_,
+                      Eigen::Vector3f(config_.gravity_world.cast<float>()), base_f,
+                      kinematics_segments_, static_);
+  } else {
+    forwardKinematics(model_, data_, q_, qd_, qdd_, config_.gravity_world, base_state,
+                      kinematics_segments_, static_);
+  }
+  for (std::size_t k = 0; k < inputs_.size(); ++k) {
+    if (!inputs_[k].needed) continue;
+    const int c = wrench_channel_ + 6 * static_cast<int>(k);
+    const Eigen::Vector3d f(bank_.value(c), bank_.value(c + 1), bank_.value(c + 2));
+    const Eigen::Vector3d m(bank_.value(c + 3), bank_.value(c + 4), bank_.value(c + 5));
+    if (config_.precision == Precision::kFloat)
+      addExternalWrench(model_f_, data_f_, inputs_[k].frame, Eigen::Vector3f(f.cast<float>()),
+                        Eigen::Vector3f(m.cast<float>()), WrenchFrame::kLocal);
+    else
+      addExternalWrench(model_, data_, inputs_[k].frame, f, m, WrenchFrame::kLocal);
+  }
+  if (config_.precision == Precision::kFloat) {
+    inverseDynamics(model_f_, data_f_, dynamics_segments_);
+    for (int i : dynamics_segments_) {
+      data_.force[i] = data_f_.force[i].cast<double>();
+      data_.moment[i] = data_f_.moment[i].cast<double>();
+      data_.effort[i] = data_f_.effort[i];
+    }
+    for (int i : kinematics_segments_) {
+      data_.R_world[i] = data_f_.R_world[i].cast<double>();
+      data_.p_world[i] = data_f_.p_world[i].cast<double>();
+    }
+  } else {
+    inverseDynamics(model_, data_, dynamics_segments_);
+  }
 }
 
 Wrench<double> Estimator::appliedWrench(int k) const {

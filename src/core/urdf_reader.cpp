@@ -323,6 +323,7 @@ struct Builder {
     }
     if (!(model.totalMass() > 0.0))
       fail("robot: total mass is zero; no link has an <inertial> with a positive mass");
+    model.analyze();
   }
 };
 

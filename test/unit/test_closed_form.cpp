@@ -562,6 +562,53 @@ TEST(Prismatic, SliderCarriesItsWeightAndItsInertia) {
   }
 }
 
+// A slider running along a turning arm (the planar R-P arm, gravity along -y): theta
+// turns the arm about z, the slider's centre is at r along it. From the Lagrangian
+// T = (I1 + m1 lc1^2 + I2 + m2 r^2) theta_d^2 / 2 + m2 r_d^2 / 2,
+// V = (m1 lc1 + m2 r) g sin(theta):
+//   tau = (I1 + m1 lc1^2 + I2 + m2 r^2) theta_dd + 2 m2 r r_d theta_d
+//         + (m1 lc1 + m2 r) g cos(theta)
+//   f = m2 (r_dd - r theta_d^2 + g sin(theta))
+// with the Coriolis term 2 m2 r r_d theta_d in tau.
+TEST(Prismatic, SliderOnATurningArmFeelsCoriolis) {
+  const double m1 = 1.6, lc1 = 0.3, I1 = 0.05, m2 = 0.9, I2 = 0.004;
+  const Inertial arm{m1, Vec3(lc1, 0, 0), Vec3::Zero(), inertiaMatrix(0.002, 0.049, I1)};
+  const Inertial slider{m2, Vec3::Zero(), Vec3::Zero(), inertiaMatrix(0.003, 0.0025, I2)};
+  const jle::Model<double> model = jle::modelFromUrdfString(robot(
+      link("world") + link("arm", arm) + link("slider", slider) +
+      joint("turn", "revolute", "world", "arm") +
+      joint("slide", "prismatic", "arm", "slider", Vec3::Zero(), Vec3::Zero(), Vec3::UnitX())));
+  const int s1 = model.segmentOfJoint("turn"), s2 = model.segmentOfJoint("slide");
+  jle::Data<double> data(model);
+
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), radius(0.1, 0.8), rate(-4.0, 4.0),
+      acc(-30.0, 30.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double th = angle(rng), r = radius(rng);
+    const double thd = rate(rng), rd = rate(rng), thdd = acc(rng), rdd = acc(rng);
+    jle::forwardKinematics(model, data, vecx({th, r}), vecx({thd, rd}), vecx({thdd, rdd}),
+                           Vec3(0, -kG, 0));
+    jle::inverseDynamics(model, data);
+
+    const double inertia = I1 + m1 * lc1 * lc1 + I2 + m2 * r * r;
+    const double coriolis = 2 * m2 * r * rd * thd;
+    const double gravity = (m1 * lc1 + m2 * r) * kG * std::cos(th);
+    const double tau = inertia * thdd + coriolis + gravity;
+    const double f = m2 * (rdd - r * thd * thd + kG * std::sin(th));
+    const double tau_scale = inertia * std::abs(thdd) + std::abs(coriolis) + std::abs(gravity);
+    const double f_scale = m2 * (std::abs(rdd) + r * thd * thd + kG);
+    EXPECT_NEAR(data.effort[s1], tau, kRel * tau_scale) << "trial " << trial;
+    EXPECT_NEAR(data.effort[s2], f, kRel * f_scale) << "trial " << trial;
+    // Across the slide (the arm's y axis): tangential and Coriolis accelerations and the
+    // weight's component.
+    const double across = m2 * (r * thdd + 2 * rd * thd + kG * std::cos(th));
+    EXPECT_NEAR(data.force[s2].y(), across,
+                kRel * m2 * (r * std::abs(thdd) + std::abs(2 * rd * thd) + kG))
+        << "trial " << trial;
+  }
+}
+
 TEST(Mimic, LeaderAndFollowerAreTwoPendulumsOnOneCoordinate) {
   // Two independent pendulums about z hanging from the world, gravity along -y; the
   // follower turns by k q + o.
