@@ -3,6 +3,7 @@
 // libraries see identical inputs. The ratios are printed by bench/speed (run_speed.sh).
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -186,7 +187,70 @@ void differentiation(benchmark::State& state, jle::DifferentiatorType type, int 
   }
 }
 
+// One saving switched relative to the defaults (all exact savings on).
+jle::EstimatorConfig savingsVariant(const std::string& variant) {
+  jle::EstimatorConfig c;
+  if (variant == "none") {
+    c.savings.prune = c.savings.massless_chains = c.savings.gyroscopic = false;
+    c.savings.reuse_unchanged = false;
+  } else if (variant == "prune_off") {
+    c.savings.prune = false;
+  } else if (variant == "massless_off") {
+    c.savings.massless_chains = false;
+  } else if (variant == "gyroscopic_off") {
+    c.savings.gyroscopic = false;
+  } else if (variant == "reuse_off") {
+    c.savings.reuse_unchanged = false;
+  } else if (variant == "static_on") {
+    c.savings.static_velocity = 1e-3;
+    c.savings.static_acceleration = 1e-3;
+  } else if (variant == "float") {
+    c.precision = jle::Precision::kFloat;
+  }
+  return c;
+}
+
+// The estimator per joint sample (filter + kinematics + dynamics) as the node runs it,
+// over 4096 samples of a smooth trajectory (or of a still robot), cycled.
+void estimatorStep(benchmark::State& state, const std::string& file, const std::string& joints,
+                   bool still, const std::string& variant) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + file);
+  jle::EstimatorConfig config = savingsVariant(variant);
+  if (!joints.empty()) config.joints = {joints};
+  jle::Estimator estimator(model, config);
+  const int n = 4096;
+  std::vector<Eigen::VectorXd> q(n, Eigen::VectorXd(model.nq));
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i < model.nq; ++i) q[k][i] = still ? 0.1 * i : 0.5 * std::sin(2e-3 * k + i);
+  int k = 0;
+  double t = 0.0;
+  for (auto _ : state) {
+    t += 1e-3;
+    benchmark::DoNotOptimize(estimator.addJointSample(t, q[k].data()));
+    k = (k + 1) % n;
+  }
+  state.counters["computed_segments"] = static_cast<double>(estimator.dynamicsSegments().size());
+}
+
 }  // namespace
+
+// Savings: each switched off (or on) against the defaults, where it applies and where
+// it does not.
+#define JLE_SAVING(name, file, joints, still)                                              \
+  BENCHMARK_CAPTURE(estimatorStep, name##_defaults, file, joints, still, "defaults");     \
+  BENCHMARK_CAPTURE(estimatorStep, name##_none, file, joints, still, "none");             \
+  BENCHMARK_CAPTURE(estimatorStep, name##_prune_off, file, joints, still, "prune_off");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_massless_off, file, joints, still, "massless_off"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_gyroscopic_off, file, joints, still, "gyroscopic_off"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_reuse_off, file, joints, still, "reuse_off");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_static_on, file, joints, still, "static_on");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_float, file, joints, still, "float")
+JLE_SAVING(talos_all_moving, "/urdf/talos_reduced.urdf", "", false);
+JLE_SAVING(talos_one_knee_moving, "/urdf/talos_reduced.urdf", "leg_left_4_joint", false);
+JLE_SAVING(talos_all_still, "/urdf/talos_reduced.urdf", "", true);
+JLE_SAVING(planar_arm_moving, "/urdf/planar_arm.urdf", "", false);
+JLE_SAVING(panda_chain_moving, "/urdf/chains/panda_chain.urdf", "", false);
+JLE_SAVING(panda_chain_still, "/urdf/chains/panda_chain.urdf", "", true);
 
 BENCHMARK_CAPTURE(coreDouble, panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",

@@ -187,6 +187,10 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
     b[6] = o.z();
   }
   for (std::size_t k = 0; k < inputs_.size(); ++k) {
+    if (!inputs_[k].needed) {  // pruned away: never stale, never read
+      inputs_[k].stale = false;
+      continue;
+    }
     const Eigen::Matrix<double, 6, 1> w = sampleInput(inputs_[k], t);
     for (int j = 0; j < 6; ++j)
       channels_[static_cast<std::size_t>(wrench_channel_) + 6 * k + static_cast<std::size_t>(j)] = w[j];

@@ -91,6 +91,13 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (std::size_t k = 0; k < settings_.wrenches.size(); ++k) {
     auto topic = std::make_unique<WrenchTopic>();
     topic->settings = settings_.wrenches[k];
+    if (!estimator_->inputNeeded(static_cast<int>(k))) {
+      // Acts below none of the published joints: nothing to subscribe to.
+      ROS_INFO("wrench '%s' on link '%s' affects none of the published joints: not subscribed",
+               topic->settings.topic.c_str(), topic->settings.input.link.c_str());
+      wrench_topics_.push_back(std::move(topic));
+      continue;
+    }
     topic->subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
         topic->settings.topic, 100,
         [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onWrench(k, msg); },
@@ -188,7 +195,7 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
       if (effort_history_.size() > kEffortHistory) effort_history_.pop_front();
     }
     for (std::size_t i = 0; i < q_.size(); ++i) {
-      if (!q_received_[i]) {
+      if (!q_received_[i] && estimator_->coordinateNeeded(static_cast<int>(i))) {
         ROS_ERROR_THROTTLE(kThrottle,
                            "joint_states: no position received yet for joint '%s': not "
                            "publishing",
@@ -275,6 +282,7 @@ bool EstimatorNode::resolveFrame(WrenchTopic& topic, const std::string& frame,
     p = X.translation();
     return true;
   } catch (const tf2::TransformException& e) {
+    ROS_INFO("DEBUG frames: %s", tf_buffer_.allFramesAsString().c_str());
     ROS_ERROR_THROTTLE(kThrottle, "wrench '%s': frame '%s' is neither a URDF link nor known to "
                        "tf2 relative to '%s': %s",
                        topic.settings.topic.c_str(), frame.c_str(), link.c_str(), e.what());

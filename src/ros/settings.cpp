@@ -209,6 +209,7 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
   s.read("robot_description", n.robot_description);
   s.read("joint_states_topic", n.joint_states_topic);
   s.read("joints", n.joints);
+  n.estimator.joints = n.joints;
   s.read("publish_wrench_topics", n.publish_wrench_topics);
   s.read("floating_base", n.floating_base);
   s.read("world_frame", n.world_frame);
@@ -230,6 +231,24 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
       else
         wrongType("gravity[" + std::to_string(i) + "]", e, "a number");
     }
+  }
+  std::string precision = "double";
+  s.read("precision", precision);
+  n.estimator.precision = choose<Precision>("precision", precision,
+                                            {{"double", Precision::kDouble}, {"float", Precision::kFloat}});
+  if (s.has("savings")) {
+    Section sv(s.get("savings"), "savings");
+    Savings& v = n.estimator.savings;
+    sv.read("prune", v.prune);
+    sv.read("massless_chains", v.massless_chains);
+    sv.read("gyroscopic", v.gyroscopic);
+    sv.read("reuse_unchanged", v.reuse_unchanged);
+    sv.read("static_velocity", v.static_velocity);
+    sv.read("static_acceleration", v.static_acceleration);
+    if (v.static_velocity < 0.0 || v.static_acceleration < 0.0)
+      throw SettingsError("parameters 'savings/static_velocity' and 'savings/static_acceleration' "
+                          "must not be negative");
+    sv.finish();
   }
   if (s.has("differentiator"))
     n.estimator.differentiator = parseDifferentiator(s.get("differentiator"), "differentiator");

@@ -12,21 +12,9 @@ namespace {
 
 const std::string kData = JLE_TEST_DATA;
 
-// Three links turning about parallel z axes (a planar arm), with a massless link in
-// the middle of the chain and inertias whose z axis is principal (rotated about z).
-const char* kPlanarArm = R"(<robot name="planar">
-  <link name="base"/>
-  <link name="l1"><inertial><origin xyz="0.2 0 0" rpy="0 0 0.3"/><mass value="2"/>
-    <inertia ixx="0.01" ixy="0.002" ixz="0" iyy="0.05" iyz="0" izz="0.055"/></inertial></link>
-  <link name="l2"/>
-  <link name="l3"><inertial><origin xyz="0.15 0.01 0"/><mass value="1"/>
-    <inertia ixx="0.004" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.021"/></inertial></link>
-  <link name="tool"/>
-  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
-  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.4 0 0"/><axis xyz="0 0 1"/></joint>
-  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="0.05 0 0" rpy="0 0 0.5"/><axis xyz="0 0 1"/></joint>
-  <joint name="tool_joint" type="fixed"><parent link="l3"/><child link="tool"/><origin xyz="0.3 0 0"/></joint>
-</robot>)";
+// A planar arm (parallel z axes) with a massless link in the chain:
+// test/data/urdf/planar_arm.urdf.
+jle::Model<double> planarArm() { return jle::modelFromUrdfFile(kData + "/urdf/planar_arm.urdf"); }
 
 // Runs n samples of a smooth trajectory (or a still robot) through an estimator and
 // returns, per published sample, the concatenated loads of `joints`.
@@ -113,7 +101,7 @@ TEST(Savings, UnneededWrenchInputsAreSkipped) {
 }
 
 TEST(Savings, MasslessChainsAreBitExact) {
-  const jle::Model<double> arm = jle::modelFromUrdfString(kPlanarArm);
+  const jle::Model<double> arm = planarArm();
   EXPECT_FALSE(arm.has_inertia[arm.segmentOfJoint("j2")]);  // it applies here
   jle::EstimatorConfig on = noSavings(), off = noSavings();
   on.savings.massless_chains = true;
@@ -121,7 +109,7 @@ TEST(Savings, MasslessChainsAreBitExact) {
 }
 
 TEST(Savings, GyroscopicTermSkippedOnlyWhereItVanishes) {
-  const jle::Model<double> arm = jle::modelFromUrdfString(kPlanarArm);
+  const jle::Model<double> arm = planarArm();
   for (int s : arm.moving_segments) EXPECT_FALSE(arm.gyroscopic[s]);  // planar: all vanish
   const jle::Model<double> ur5 = jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf");
   int spatial = 0;
