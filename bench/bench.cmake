@@ -11,3 +11,9 @@ if(CATKIN_ENABLE_TESTING)
     JLE_BENCH_DATA="${CMAKE_CURRENT_SOURCE_DIR}/test/data")
   add_dependencies(tests bench_speed_core)
 endif()
+
+# The node end to end (bench/node_latency.sh runs it against the real node).
+add_executable(bench_node_latency bench/node_latency.cpp)
+target_link_libraries(bench_node_latency ${catkin_LIBRARIES})
+target_include_directories(bench_node_latency PRIVATE ${catkin_INCLUDE_DIRS})
+add_dependencies(bench_node_latency ${PROJECT_NAME}_generate_messages_cpp)

@@ -282,7 +282,6 @@ bool EstimatorNode::resolveFrame(WrenchTopic& topic, const std::string& frame,
     p = X.translation();
     return true;
   } catch (const tf2::TransformException& e) {
-    ROS_INFO("DEBUG frames: %s", tf_buffer_.allFramesAsString().c_str());
     ROS_ERROR_THROTTLE(kThrottle, "wrench '%s': frame '%s' is neither a URDF link nor known to "
                        "tf2 relative to '%s': %s",
                        topic.settings.topic.c_str(), frame.c_str(), link.c_str(), e.what());

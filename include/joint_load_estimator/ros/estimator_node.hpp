@@ -56,6 +56,8 @@ class EstimatorNode {
   bool resolveFrame(WrenchTopic& topic, const std::string& frame, const ros::Time& stamp,
                     Eigen::Matrix3d& R, Eigen::Vector3d& p);
   bool checkTimeJump(const ros::Time& stamp);
+  double relative(const ros::Time& stamp);
+  ros::Time absolute(double t) const;
   void publish(const ros::Time& received);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
@@ -80,6 +82,7 @@ class EstimatorNode {
   tf2_ros::TransformListener tf_listener_;
   diagnostic_updater::Updater updater_;
   ros::Time last_stamp_;
+  ros::Time time_ref_;  // origin of the estimator's time axis
   ros::Time last_now_;
   NodeCounters counters_;
   long published_at_last_diag_ = 0, received_at_last_diag_ = 0;
