@@ -17,3 +17,14 @@ add_executable(bench_node_latency bench/node_latency.cpp)
 target_link_libraries(bench_node_latency ${catkin_LIBRARIES})
 target_include_directories(bench_node_latency PRIVATE ${catkin_INCLUDE_DIRS})
 add_dependencies(bench_node_latency ${PROJECT_NAME}_generate_messages_cpp)
+
+if(CATKIN_ENABLE_TESTING)
+  add_executable(bench_speed_messages bench/speed_messages.cpp)
+  target_link_libraries(bench_speed_messages joint_load_estimator_core benchmark::benchmark
+    ${catkin_LIBRARIES})
+  target_include_directories(bench_speed_messages PRIVATE ${catkin_INCLUDE_DIRS})
+  target_compile_definitions(bench_speed_messages PRIVATE
+    JLE_BENCH_DATA="${CMAKE_CURRENT_SOURCE_DIR}/test/data")
+  add_dependencies(bench_speed_messages ${PROJECT_NAME}_generate_messages_cpp)
+  add_dependencies(tests bench_speed_messages bench_node_latency)
+endif()
