@@ -30,9 +30,8 @@ std::vector<int> publishedSegments(const Model<double>& model,
   return segments;
 }
 
-bool rigidFrameInLink(const Model<double>& model, const std::string& link,
-                      const std::string& frame, Eigen::Matrix3d& R_link_frame,
-                      Eigen::Vector3d& p_link_frame) {
+bool rigidFrameInLink(const Model<double>& model, const std::string& link, const std::string& frame,
+                      Eigen::Matrix3d& R_link_frame, Eigen::Vector3d& p_link_frame) {
   const Frame<double>& l = model.frames[static_cast<std::size_t>(model.frameIndex(link))];
   for (const Frame<double>& f : model.frames) {
     if (f.name != frame) continue;
@@ -44,8 +43,7 @@ bool rigidFrameInLink(const Model<double>& model, const std::string& link,
   return false;
 }
 
-JointStateMap::JointStateMap(const Model<double>& model,
-                             const std::vector<int>& published_segments)
+JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>& published_segments)
     : coordinate_names_(model.coordinate_names),
       q_(static_cast<std::size_t>(model.nq), 0.0),
       received_(static_cast<std::size_t>(model.nq), 0),
@@ -74,8 +72,7 @@ void JointStateMap::bind(const std::vector<std::string>& names) {
 }
 
 int JointStateMap::update(const std::vector<std::string>& names,
-                          const std::vector<double>& position,
-                          const std::vector<double>& effort) {
+                          const std::vector<double>& position, const std::vector<double>& effort) {
   if (names != layout_) bind(names);
   int unknown = -1;
   for (std::size_t i = 0; i < names.size(); ++i) {

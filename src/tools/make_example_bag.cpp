@@ -25,7 +25,8 @@
 
 namespace {
 
-const char* const kUsage = R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]
+const char* const kUsage =
+    R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]
                         [--samples N] [--seed 1] [--effort] [--sensor-frame panda_link8]
                         [--tcp-frame panda_hand_tcp]
 
@@ -39,8 +40,10 @@ force/torque sensor measures a payload and a push:
                     link), the wrench applied TO the robot, moment about SENSOR's
                     origin, in SENSOR's frame
 both at RATE, stamped t0 + i / RATE (t0 = 1000 s, i = 0 .. N-1, N = round(DURATION *
-RATE) or --samples); bag time = stamp. At each stamp the wrench is written first, so
-that whoever reads the bag in time order has the wrench of that instant.
+RATE) or --samples). Bag time = stamp for the joint states, stamp - 1 us for the
+wrenches: whoever reads the bag in time order (rosbag play, process_bag) gets the
+wrench of an instant before the joint state of that instant (at equal bag times the
+order of rosbag's reader is not defined).
 
 Trajectory: each coordinate k (model.coordinate_names order)
   q_k(t) = c_k + A_k sin(w_k t + p_k),  w_k = 2 pi f_k,  t = stamp - t0
@@ -191,9 +194,8 @@ class Uniform {
 
 double homePosition(const std::string& joint) {
   static const std::map<std::string, double> kReady = {
-      {"panda_joint1", 0.0},          {"panda_joint2", -kPi / 4},
-      {"panda_joint3", 0.0},          {"panda_joint4", -3 * kPi / 4},
-      {"panda_joint5", 0.0},          {"panda_joint6", kPi / 2},
+      {"panda_joint1", 0.0},          {"panda_joint2", -kPi / 4},   {"panda_joint3", 0.0},
+      {"panda_joint4", -3 * kPi / 4}, {"panda_joint5", 0.0},        {"panda_joint6", kPi / 2},
       {"panda_joint7", kPi / 4},      {"panda_finger_joint1", 0.02}};
   const auto it = kReady.find(joint);
   return it == kReady.end() ? 0.0 : it->second;
@@ -209,7 +211,8 @@ int frameOf(const jle::Model<double>& model, const std::string& option, const st
 void run(const Options& options) {
   const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf);
   if (model.floating_base)
-    throw std::runtime_error(options.urdf + ": a floating-base model; make_example_bag moves "
+    throw std::runtime_error(options.urdf +
+                             ": a floating-base model; make_example_bag moves "
                              "fixed-base arms only");
   const int sensor = frameOf(model, "--sensor-frame", options.sensor_frame, options.urdf);
   const int tcp = frameOf(model, "--tcp-frame", options.tcp_frame, options.urdf);
@@ -225,7 +228,8 @@ void run(const Options& options) {
   for (std::size_t k = 0; k < nq; ++k) {
     const std::string& name = model.coordinate_names[k];
     const int s = model.segmentOfJoint(name);
-    const bool prismatic = model.joint_type[static_cast<std::size_t>(s)] == jle::JointType::kPrismatic;
+    const bool prismatic =
+        model.joint_type[static_cast<std::size_t>(s)] == jle::JointType::kPrismatic;
     home[k] = homePosition(name);
     amplitude[k] = prismatic ? uniform(0.005, 0.015) : uniform(0.15, 0.45);
     omega[k] = kTwoPi * uniform(0.1, 0.4);
@@ -259,8 +263,7 @@ void run(const Options& options) {
     const Eigen::Matrix3d& R_segment_sensor = sensor_frame.R_segment_frame;
     const Eigen::Vector3d& p_segment_sensor = sensor_frame.p_segment_frame;
     for (long long i = 0; i < options.samples; ++i) {
-      const std::int64_t ns =
-          kEpochNs + std::llround(static_cast<double>(i) * 1e9 / options.rate);
+      const std::int64_t ns = kEpochNs + std::llround(static_cast<double>(i) * 1e9 / options.rate);
       const ros::Time stamp(static_cast<std::uint32_t>(ns / 1000000000),
                             static_cast<std::uint32_t>(ns % 1000000000));
       const double t = static_cast<double>(ns - kEpochNs) * 1e-9;
@@ -276,12 +279,12 @@ void run(const Options& options) {
       // The payload's acceleration minus gravity at the TCP, segment frame (data.acc
       // is the origin's, gravity included as an upward acceleration of the base).
       const Eigen::Vector3d& w = data.omega[s];
-      const Eigen::Vector3d a_minus_g = data.acc[s] + data.alpha[s].cross(r_tcp) +
-                                        w.cross(w.cross(r_tcp));
+      const Eigen::Vector3d a_minus_g =
+          data.acc[s] + data.alpha[s].cross(r_tcp) + w.cross(w.cross(r_tcp));
       const Eigen::Vector3d f_segment =
           -payload_mass * a_minus_g +
-          data.R_world[s].transpose() * (push * std::sin(push_omega * t + push_phase) *
-                                         push_direction);
+          data.R_world[s].transpose() *
+              (push * std::sin(push_omega * t + push_phase) * push_direction);
       const Eigen::Vector3d f_sensor = R_segment_sensor.transpose() * f_segment;
       const Eigen::Vector3d m_sensor =
           R_segment_sensor.transpose() * (r_tcp - p_segment_sensor).cross(f_segment);
@@ -293,7 +296,7 @@ void run(const Options& options) {
       wrench.wrench.torque.x = m_sensor.x();
       wrench.wrench.torque.y = m_sensor.y();
       wrench.wrench.torque.z = m_sensor.z();
-      bag.write("/ft_sensor/wrench", stamp, wrench);
+      bag.write("/ft_sensor/wrench", stamp - ros::Duration(0, 1000), wrench);
 
       if (options.effort) {
         jle::addExternalWrench(model, data, sensor, f_sensor, m_sensor, jle::WrenchFrame::kLocal);

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 
@@ -47,7 +48,7 @@ std::string quote(const std::string& s) {
 }
 
 struct Result {
-  int status = -1;    // exit status, -1 if the process did not exit normally
+  int status = -1;     // exit status, -1 if the process did not exit normally
   std::string output;  // standard output and error
 };
 
@@ -120,8 +121,8 @@ class ProcessBagTest : public ::testing::Test {
 // ------------------------------------------------------------ a bag written by the test
 
 // The arm's "ready" pose and a smooth motion about it; the fingers still.
-const std::vector<std::string> kJoints = {"panda_joint1", "panda_joint2", "panda_joint3",
-                                          "panda_joint4", "panda_joint5", "panda_joint6",
+const std::vector<std::string> kJoints = {"panda_joint1", "panda_joint2",       "panda_joint3",
+                                          "panda_joint4", "panda_joint5",       "panda_joint6",
                                           "panda_joint7", "panda_finger_joint1"};
 double position(std::size_t k, double t) {
   const double ready[] = {0.0, -kPi / 4, 0.0, -3 * kPi / 4, 0.0, kPi / 2, kPi / 4, 0.02};
@@ -289,13 +290,28 @@ TEST_F(ProcessBagTest, CsvEqualsTheEstimatorDrivenWithTheSameMessages) {
 
   const Expected e = expectedLoads(m);
   const Table csv = readCsv(path("out.csv"));
-  const std::vector<std::string> header = {
-      "t",               "panda_joint2.fx", "panda_joint2.fy",     "panda_joint2.fz",
-      "panda_joint2.mx", "panda_joint2.my", "panda_joint2.mz",     "panda_joint2.effort",
-      "panda_joint4.fx", "panda_joint4.fy", "panda_joint4.fz",     "panda_joint4.mx",
-      "panda_joint4.my", "panda_joint4.mz", "panda_joint4.effort", "panda_joint7.fx",
-      "panda_joint7.fy", "panda_joint7.fz", "panda_joint7.mx",     "panda_joint7.my",
-      "panda_joint7.mz", "panda_joint7.effort"};
+  const std::vector<std::string> header = {"t",
+                                           "panda_joint2.fx",
+                                           "panda_joint2.fy",
+                                           "panda_joint2.fz",
+                                           "panda_joint2.mx",
+                                           "panda_joint2.my",
+                                           "panda_joint2.mz",
+                                           "panda_joint2.effort",
+                                           "panda_joint4.fx",
+                                           "panda_joint4.fy",
+                                           "panda_joint4.fz",
+                                           "panda_joint4.mx",
+                                           "panda_joint4.my",
+                                           "panda_joint4.mz",
+                                           "panda_joint4.effort",
+                                           "panda_joint7.fx",
+                                           "panda_joint7.fy",
+                                           "panda_joint7.fz",
+                                           "panda_joint7.mx",
+                                           "panda_joint7.my",
+                                           "panda_joint7.mz",
+                                           "panda_joint7.effort"};
   EXPECT_EQ(csv.header, header);
   // 300 samples, the first 10 fill the window, every second one is published.
   ASSERT_EQ(e.t.size(), 145u);
@@ -329,12 +345,14 @@ TEST_F(ProcessBagTest, BagOutputHoldsTheLoadsAndTheMeasuredEfforts) {
     // Bag time = the estimate's stamp, which lags the newest sample by the delay.
     EXPECT_EQ(instance.getTime(), msg->header.stamp);
     expectClose(msg->header.stamp.toSec(), e.t[i], "stamp");
-    ASSERT_EQ(msg->name, (std::vector<std::string>{"panda_joint2", "panda_joint4", "panda_joint7"}));
+    ASSERT_EQ(msg->name,
+              (std::vector<std::string>{"panda_joint2", "panda_joint4", "panda_joint7"}));
     for (std::size_t j = 0; j < 3; ++j) {
       const geometry_msgs::Wrench& w = msg->wrench[j];
       const double got[] = {w.force.x,  w.force.y,  w.force.z,     w.torque.x,
                             w.torque.y, w.torque.z, msg->effort[j]};
-      for (int c = 0; c < 7; ++c) expectClose(got[c], e.values[i][7 * j + c], "message " + std::to_string(i));
+      for (int c = 0; c < 7; ++c)
+        expectClose(got[c], e.values[i][7 * j + c], "message " + std::to_string(i));
       // The measured effort of the sample the estimate describes, exactly.
       EXPECT_EQ(msg->measured_effort[j], e.measured[i][j]);
     }
@@ -345,8 +363,9 @@ TEST_F(ProcessBagTest, BagOutputHoldsTheLoadsAndTheMeasuredEfforts) {
 
 // ------------------------------------------------- the analytic bag of make_example_bag
 
-// The settings of the demo, but a Savitzky-Golay fit centred on the estimate, whose
-// error on these slow sines is tiny.
+// A Savitzky-Golay fit centred on the estimate, whose error on these slow sines is
+// tiny; the sensor's wrench, expressed at the TCP (make_example_bag --sensor-frame
+// panda_hand_tcp), acts on panda_link8: 0.1034 m and -pi/4 about z away.
 const char* const kCentredConfig = R"(differentiator:
   type: savitzky_golay
   window: 21
@@ -354,7 +373,7 @@ const char* const kCentredConfig = R"(differentiator:
   delay: centred
 wrenches:
   - topic: /ft_sensor/wrench
-    link: panda_hand
+    link: panda_link8
 )";
 
 struct Comparison {
@@ -393,8 +412,9 @@ Comparison compareWithExact(const std::string& csv_path, const std::string& bag_
 }
 
 TEST_F(ProcessBagTest, AgreesWithTheExactEffortsOfTheExampleBag) {
-  Result r = run(std::string(JLE_MAKE_EXAMPLE_BAG) + " --urdf " + quote(kPanda) +
-                 " --output " + quote(path("example.bag")) + " --duration 1 --effort --seed 7");
+  Result r = run(std::string(JLE_MAKE_EXAMPLE_BAG) + " --urdf " + quote(kPanda) + " --output " +
+                 quote(path("example.bag")) +
+                 " --duration 1 --effort --seed 7 --sensor-frame panda_hand_tcp");
   ASSERT_EQ(r.status, 0) << r.output;
   writeFile(path("centred.yaml"), kCentredConfig);
   r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("example.bag")) + " --urdf " +
@@ -405,15 +425,19 @@ TEST_F(ProcessBagTest, AgreesWithTheExactEffortsOfTheExampleBag) {
   // 1000 samples, the first 20 fill the window.
   EXPECT_EQ(with.rows, 980u);
   EXPECT_GT(with.max_effort, 10.0);
-  // A 4th-order fit over 21 ms of sines below 0.6 Hz: the acceleration error is about
-  // w^2 (w h)^4 A ~ 1e-8 rad/s^2 and the wrench is smoothed as little; 1e-4 N m is
-  // well above that and far below what a wrong sign or frame of the wrench gives.
-  EXPECT_LT(with.max_error, 1e-4);
+  // A centred 4th-order fit over 21 ms of sines below 0.4 Hz (w <= 2.5 rad/s): its
+  // acceleration error is of order A w^6 T^4 ~ 1e-6 * 1e-8 rad/s^2 (T = 10 ms), and the
+  // rounding of stamps near 1000 s (1e-13 s) and of positions adds about 1e-9 rad/s^2;
+  // with inertias below 1 kg m^2 the efforts agree to about 1e-8 N m. 1e-6 N m leaves
+  // a margin and is far below what a wrong sign, frame or instant of the wrench gives
+  // (the payload and push move the efforts by newtons, 1 ms of lag by 1e-3 N m).
+  EXPECT_LT(with.max_error, 1e-6);
 
   // The same without the sensor: the payload and the push are missing, so the check
   // above is not blind to the wrench.
-  writeFile(path("none.yaml"), "differentiator: {type: savitzky_golay, window: 21, order: 4, "
-                               "delay: centred}\n");
+  writeFile(path("none.yaml"),
+            "differentiator: {type: savitzky_golay, window: 21, order: 4, "
+            "delay: centred}\n");
   r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("example.bag")) + " --urdf " +
           quote(kPanda) + " --config " + quote(path("none.yaml")) + " --csv " +
           quote(path("bare.csv")));
@@ -422,8 +446,8 @@ TEST_F(ProcessBagTest, AgreesWithTheExactEffortsOfTheExampleBag) {
 }
 
 TEST_F(ProcessBagTest, ExampleBagIsDeterministic) {
-  const std::string base = std::string(JLE_MAKE_EXAMPLE_BAG) + " --urdf " + quote(kPanda) +
-                           " --samples 200 --output ";
+  const std::string base =
+      std::string(JLE_MAKE_EXAMPLE_BAG) + " --urdf " + quote(kPanda) + " --samples 200 --output ";
   ASSERT_EQ(run(base + quote(path("a.bag"))).status, 0);
   ASSERT_EQ(run(base + quote(path("b.bag"))).status, 0);
   ASSERT_EQ(run(base + quote(path("c.bag")) + " --seed 2").status, 0);
@@ -484,3 +508,8 @@ TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
 }
 
 }  // namespace
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

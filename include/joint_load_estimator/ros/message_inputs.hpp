@@ -29,9 +29,8 @@ std::vector<int> publishedSegments(const Model<double>& model,
 /// segment (rigidly attached: a constant transform from the model). False when `frame`
 /// is not a URDF link or moves relative to `link` (then only tf2 knows it). Throws
 /// std::invalid_argument if `link` is not a URDF link.
-bool rigidFrameInLink(const Model<double>& model, const std::string& link,
-                      const std::string& frame, Eigen::Matrix3d& R_link_frame,
-                      Eigen::Vector3d& p_link_frame);
+bool rigidFrameInLink(const Model<double>& model, const std::string& link, const std::string& frame,
+                      Eigen::Matrix3d& R_link_frame, Eigen::Vector3d& p_link_frame);
 
 /// A wrench (force [N], moment [N m] about the origin of frame F, both in F) expressed
 /// in link L's frame with its moment about L's origin, F's pose in L being
@@ -70,7 +69,7 @@ class JointStateMap {
   void bind(const std::vector<std::string>& names);
 
   std::vector<std::string> coordinate_names_;
-  std::vector<std::string> moving_joint_names_;     // every moving joint, mimics included
+  std::vector<std::string> moving_joint_names_;  // every moving joint, mimics included
   std::vector<std::string> published_joint_names_;
   std::vector<double> q_;
   std::vector<char> received_;
