@@ -2,10 +2,6 @@
 # make_example_bag (a deterministic example bag), process_bag (the node's estimate over
 # a bag, offline), summarize_loads (a table of the loads a node publishes), their test.
 
-# What the node and process_bag share: how messages become estimator inputs.
-target_sources(joint_load_estimator_ros PRIVATE
-  ${CMAKE_CURRENT_SOURCE_DIR}/src/ros/message_inputs.cpp)
-
 add_executable(make_example_bag src/tools/make_example_bag.cpp)
 target_link_libraries(make_example_bag joint_load_estimator_ros)
 
