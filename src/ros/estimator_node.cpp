@@ -115,11 +115,24 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            model.floating_base ? ", floating base" : "");
 }
 
+double EstimatorNode::relative(const ros::Time& stamp) {
+  // The estimator's time axis starts at the first stamp: seconds since 1970 in a double
+  // resolve 2.4e-7 s only, too coarse to difference samples 1 ms apart (and the published
+  // stamp would not be the joint state's). Kept across resets: a negative time is fine.
+  if (time_ref_.isZero()) time_ref_ = stamp;
+  return (stamp - time_ref_).toSec();
+}
+
+ros::Time EstimatorNode::absolute(double t) const { return time_ref_ + ros::Duration(t); }
+
 bool EstimatorNode::checkTimeJump(const ros::Time& stamp) {
   // A looping bag (rosbag play -l) or a restarted simulation sends time backwards:
   // the filters' memory belongs to another timeline.
   const ros::Time now = ros::Time::now();
-  const bool clock_back = !last_now_.isZero() && now < last_now_;
+  // /clock and the joint states come on different connections, so the clock may go
+  // back one message after the stamps did (or before): a clock going back is a jump
+  // only while the stamps do not go forward, else one jump would reset twice.
+  const bool clock_back = !last_now_.isZero() && now < last_now_ && !(stamp > last_stamp_);
   const bool stamp_back =
       !last_stamp_.isZero() && (last_stamp_ - stamp).toSec() > settings_.time_jump_threshold;
   last_now_ = now;
@@ -191,7 +204,7 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
       for (std::size_t j = 0; j < published_segments_.size(); ++j)
         for (std::size_t i = 0; i < n; ++i)
           if (msg->name[i] == loads_msg_.name[j]) effort_[j] = msg->effort[i];
-      effort_history_.emplace_back(stamp.toSec(), effort_);
+      effort_history_.emplace_back(relative(stamp), effort_);
       if (effort_history_.size() > kEffortHistory) effort_history_.pop_front();
     }
     for (std::size_t i = 0; i < q_.size(); ++i) {
@@ -220,7 +233,7 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
       tf2::fromMsg(tf.transform.rotation, base.orientation);
     }
 
-    const SampleStatus status = estimator_->addJointSample(stamp.toSec(), q_.data(), &base);
+    const SampleStatus status = estimator_->addJointSample(relative(stamp), q_.data(), &base);
     switch (status) {
       case SampleStatus::kPublished: publish(received); break;
       case SampleStatus::kDuplicate:
@@ -320,7 +333,7 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
     // Expressed in the link frame, moment about the link origin.
     const Eigen::Vector3d f_link = R * f;
     const Eigen::Vector3d m_link = R * m + p.cross(f_link);
-    if (!estimator_->addWrench(static_cast<int>(k), stamp.toSec(), f_link, m_link)) {
+    if (!estimator_->addWrench(static_cast<int>(k), relative(stamp), f_link, m_link)) {
       ++counters_.dropped_order;
       ROS_WARN_THROTTLE(kThrottle, "wrench '%s': stamp %.9f not newer than the last: dropped",
                         topic.settings.topic.c_str(), stamp.toSec());
@@ -333,7 +346,7 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
 
 void EstimatorNode::publish(const ros::Time& received) {
   const Data<double>& data = estimator_->data();
-  const ros::Time stamp(estimator_->stamp());
+  const ros::Time stamp = absolute(estimator_->stamp());
   // The measured efforts that belong to the stamp the estimate describes.
   const std::vector<double>* measured = nullptr;
   for (auto it = effort_history_.rbegin(); it != effort_history_.rend(); ++it)

@@ -1,0 +1,127 @@
+// Start-up errors (bad_config.test): the node's executable, started in a namespace whose
+// parameters are wrong, must exit non-zero with a message naming the culprit (the
+// parameter, the link, the key); started with good ones, it must run. The parameters are
+// set by the launch file; the test starts the executable itself (fork and exec) and
+// reads its output.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct NodeRun {
+  bool exited = false;  ///< by itself (not killed on the time limit)
+  int exit_code = -1;   ///< when exited
+  std::string output;   ///< stdout and stderr
+};
+
+// Starts the node in namespace `ns` and collects its output until it exits, or until
+// its output contains `until` (then it is asked to stop with SIGINT, as by Ctrl-C), or
+// the time limit (then it is killed).
+NodeRun runNode(const std::string& ns, const std::string& until = "", double limit = 20.0) {
+  NodeRun run;
+  int fds[2];
+  if (pipe(fds) != 0) {
+    ADD_FAILURE() << "pipe failed";
+    return run;
+  }
+  const std::string exe = JLE_NODE, ns_arg = "__ns:=" + ns,
+                    name_arg = "__name:=joint_load_estimator";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // rosconsole's stdout is a pipe here: line-buffer it, so that its messages come as
+    // they are logged.
+    setenv("ROSCONSOLE_STDOUT_LINE_BUFFERED", "1", 1);
+    dup2(fds[1], STDOUT_FILENO);
+    dup2(fds[1], STDERR_FILENO);
+    close(fds[0]);
+    close(fds[1]);
+    execl(exe.c_str(), exe.c_str(), ns_arg.c_str(), name_arg.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(fds[1]);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
+  bool signalled = false, eof = false;
+  while (!eof) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        end - std::chrono::steady_clock::now());
+    if (left.count() <= 0) break;
+    pollfd p{fds[0], POLLIN, 0};
+    if (poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+    char buffer[4096];
+    const ssize_t n = read(fds[0], buffer, sizeof buffer);
+    if (n <= 0) {
+      eof = true;
+      break;
+    }
+    run.output.append(buffer, static_cast<std::size_t>(n));
+    if (!signalled && !until.empty() && run.output.find(until) != std::string::npos) {
+      kill(pid, SIGINT);
+      signalled = true;
+    }
+  }
+  if (!eof) kill(pid, SIGKILL);  // over the time limit: only the process we started
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  run.exited = eof && WIFEXITED(status);
+  if (run.exited) run.exit_code = WEXITSTATUS(status);
+  return run;
+}
+
+// The node refuses the configuration: it exits by itself, non-zero, with a message that
+// contains every one of `culprit`.
+void expectRefused(const std::string& ns, const std::vector<std::string>& culprit) {
+  const NodeRun run = runNode(ns);
+  ASSERT_TRUE(run.exited) << "the node in " << ns << " did not exit:\n" << run.output;
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  for (const std::string& c : culprit)
+    EXPECT_NE(run.output.find(c), std::string::npos) << "the message does not name '" << c << "':\n"
+                                                     << run.output;
+}
+
+// The control: with a good model and the default configuration the node starts (it says
+// so), runs until asked to stop, and then exits cleanly. Without it, the tests below
+// could pass on a node that cannot start at all.
+TEST(BadConfig, GoodConfigurationRuns) {
+  const NodeRun run = runNode("/good", "7 segments, 6 coordinates");
+  ASSERT_TRUE(run.exited) << run.output;
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("7 segments, 6 coordinates"), std::string::npos) << run.output;
+}
+
+TEST(BadConfig, MissingRobotDescription) {
+  expectRefused("/no_description", {"'/no_description/robot_description'", "is not set"});
+}
+
+TEST(BadConfig, RobotDescriptionThatIsNotXml) {
+  expectRefused("/not_xml", {"'/not_xml/robot_description'", "malformed XML"});
+}
+
+TEST(BadConfig, ModelWithANegativeMass) {
+  expectRefused("/bad_model", {"link 'heavy_link'", "negative mass"});
+}
+
+TEST(BadConfig, YamlKeyOfTheWrongType) {
+  expectRefused("/wrong_type", {"'differentiator/window'", "must be an integer"});
+}
+
+TEST(BadConfig, MisspeltYamlKey) {
+  expectRefused("/unknown_key", {"unknown parameter 'decimaton'"});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
