@@ -12,6 +12,7 @@ packages=(
   python3-rosbag python3-sensor-msgs python3-geometry-msgs python3-std-msgs
   liborocos-kdl-dev libkdl-parser-dev liburdf-dev
   ros-robot-state-publisher rosbash
+  python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -17,6 +17,15 @@ if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests -j1 >"$ws/run_te
   echo "run_tests failed (log: $ws/run_tests.log)"
   exit 1
 fi
+# The benchmarks, once each on a tiny input, so that they cannot rot (no timing is
+# judged here).
+bench_status=0
+for b in bench_speed_core bench_speed_messages; do
+  "$ws/devel/lib/joint_load_estimator/$b" --benchmark_min_time=0.0001 >"$ws/$b.log" 2>&1 ||
+    { echo "benchmark $b failed (log: $ws/$b.log)"; bench_status=1; }
+done
+bash "$repo/tools/accuracy.sh" --quick >"$ws/accuracy_quick.log" 2>&1 ||
+  { tail -20 "$ws/accuracy_quick.log"; echo "accuracy --quick failed"; bench_status=1; }
 grep -E "^\[  (FAILED|PASSED) |^\[ *FAILED *\]|^\[ROSTEST\]|FAILURE" "$ws/run_tests.log" | sort | uniq -c | sort -rn | head -40 || true
 status=0
 catkin_test_results --verbose build/test_results >"$ws/test_results.txt" 2>&1 || status=$?
@@ -28,4 +37,5 @@ echo "$summary" | awk '{gsub(",", ""); t=$2; e=$4; f=$6; s=$8; printf "tests: %d
 if [ "$(echo "$summary" | awk '{gsub(",", ""); print $2}')" = "0" ]; then
   echo "no test ran"; exit 1
 fi
+[ "$bench_status" -eq 0 ] || exit 1
 exit $status

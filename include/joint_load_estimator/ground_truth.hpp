@@ -11,6 +11,7 @@
 #pragma once
 
 #include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>
@@ -90,12 +91,13 @@ enum class MotionKind : std::uint8_t {
   /// 2 or 3 sines (equally likely): amplitude in [0.05, 0.3), frequency in [0.1, 0.6) Hz,
   /// phase in [0, 2 pi); p0 in [-0.5, 0.5).
   kSines,
-  /// Smooth steps back to back from t = 0 until the duration is covered, each coordinate
-  /// on its own schedule: durations in [0.6, 1.5) s, heights in [-0.6, 0.6); p0 as above.
+  /// p0 in [-0.5, 0.5), then smooth steps back to back from t = 0 until the duration is
+  /// covered, each coordinate on its own schedule: per step a duration in [0.6, 1.5) s
+  /// and a target in p0 + [-0.4, 0.4) (so |height| < 0.8 and q stays within p0 +- 0.4).
   kRamps,
   /// Holds and moves alternating, shared by all coordinates (so the robot is entirely
   /// at rest during a hold): holds in [0.2, 0.8) s (the first at t = 0), moves in
-  /// [0.6, 1.5) s; each coordinate's height per move in [-0.6, 0.6); p0 as above.
+  /// [0.6, 1.5) s. Per coordinate p0 as above, then a target in p0 + [-0.4, 0.4) per move.
   kStopAndGo,
   /// A quadratic: p0 in [-0.5, 0.5), p1 in [-0.5, 0.5) /s, p2 in [-0.5, 0.5) /s^2.
   kQuadratic,
@@ -105,7 +107,8 @@ constexpr double kPrismaticScale = 0.1;  ///< [m/rad] prismatic motion per revol
 
 /// A random motion of every coordinate of `model` over [0, duration] (model order,
 /// size nq). Draw order: for each coordinate in turn, the parameters in the order they
-/// are listed in MotionKind (kStopAndGo draws its shared schedule first).
+/// are listed in MotionKind (kStopAndGo draws its shared schedule first: hold, then
+/// move and hold alternately while the time is below the duration).
 std::vector<CoordinateMotion> randomMotion(const Model<double>& model, MotionKind kind,
                                            double duration, std::uint64_t seed);
 

@@ -125,26 +125,32 @@ std::vector<CoordinateMotion> randomMotion(const Model<double>& model, MotionKin
         break;
       }
       case MotionKind::kRamps: {
+        m.p0 = scale * rng.uniform(-0.5, 0.5);
+        double at = 0.0;  // offset from p0 reached so far
         for (double t = 0.0; t < duration;) {
           SmoothStep s;
           s.start = t;
           s.duration = rng.uniform(0.6, 1.5);
-          s.height = scale * rng.uniform(-0.6, 0.6);
+          const double target = scale * rng.uniform(-0.4, 0.4);
+          s.height = target - at;
+          at = target;
           m.steps.push_back(s);
           t += s.duration;
         }
-        m.p0 = scale * rng.uniform(-0.5, 0.5);
         break;
       }
       case MotionKind::kStopAndGo: {
+        m.p0 = scale * rng.uniform(-0.5, 0.5);
+        double at = 0.0;
         for (const auto& move : moves) {
           SmoothStep s;
           s.start = move.first;
           s.duration = move.second;
-          s.height = scale * rng.uniform(-0.6, 0.6);
+          const double target = scale * rng.uniform(-0.4, 0.4);
+          s.height = target - at;
+          at = target;
           m.steps.push_back(s);
         }
-        m.p0 = scale * rng.uniform(-0.5, 0.5);
         break;
       }
       case MotionKind::kQuadratic:

@@ -1,5 +1,6 @@
 #include <joint_load_estimator/ros/estimator_node.hpp>
 
+#include <joint_load_estimator/ros/message_inputs.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <tf2_eigen/tf2_eigen.h>
@@ -273,12 +274,7 @@ bool EstimatorNode::resolveFrame(WrenchTopic& topic, const std::string& frame,
     return true;
   }
   // A URDF frame on the same segment as the link: a constant transform from the model.
-  for (const Frame<double>& f : model.frames) {
-    if (f.name != frame) continue;
-    const Frame<double>& l = model.frames[static_cast<std::size_t>(model.frameIndex(link))];
-    if (f.segment != l.segment) break;  // moves relative to the link: ask tf2
-    topic.R_link_frame = l.R_segment_frame.transpose() * f.R_segment_frame;
-    topic.p_link_frame = l.R_segment_frame.transpose() * (f.p_segment_frame - l.p_segment_frame);
+  if (rigidFrameInLink(model, link, frame, topic.R_link_frame, topic.p_link_frame)) {
     topic.rigid = true;
     topic.last_frame = frame;
     R = topic.R_link_frame;
@@ -331,8 +327,8 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
       return;
     }
     // Expressed in the link frame, moment about the link origin.
-    const Eigen::Vector3d f_link = R * f;
-    const Eigen::Vector3d m_link = R * m + p.cross(f_link);
+    Eigen::Vector3d f_link, m_link;
+    wrenchInLink(R, p, f, m, f_link, m_link);
     if (!estimator_->addWrench(static_cast<int>(k), relative(stamp), f_link, m_link)) {
       ++counters_.dropped_order;
       ROS_WARN_THROTTLE(kThrottle, "wrench '%s': stamp %.9f not newer than the last: dropped",

@@ -111,9 +111,9 @@ Enum choose(const std::string& key, const std::string& value,
 }
 
 DifferentiatorConfig parseDifferentiator(const XmlRpcValue& value, const std::string& prefix) {
-  DifferentiatorConfig c;
+  DifferentiatorConfig c = nodeDefaultDifferentiator();
   Section s(value, prefix);
-  std::string type = "savitzky_golay", model = "constant_acceleration";
+  std::string type = "kalman", model = "constant_jerk";
   s.read("type", type);
   c.type = choose<DifferentiatorType>(s.name("type"), type,
                                       {{"finite_difference", DifferentiatorType::kFiniteDifference},
@@ -203,8 +203,20 @@ XmlRpcValue fromYaml(const YAML::Node& node) {
 
 }  // namespace
 
+DifferentiatorConfig nodeDefaultDifferentiator() {
+  // On the accuracy study's error-delay Pareto front, closest to the best in every
+  // scene (docs/accuracy.md): constant-jerk Kalman, q = 1e4, r = 1e-4 rad.
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kKalman;
+  c.kalman_model = KalmanModel::kConstantJerk;
+  c.process_noise = 1e4;
+  c.measurement_noise = 1e-4;
+  return c;
+}
+
 NodeSettings parseSettings(const XmlRpcValue& params) {
   NodeSettings n;
+  n.estimator.differentiator = nodeDefaultDifferentiator();
   Section s(params, "");
   s.read("robot_description", n.robot_description);
   s.read("joint_states_topic", n.joint_states_topic);
@@ -216,6 +228,9 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
   s.read("base_frame", n.base_frame);
   s.read("time_jump_threshold", n.time_jump_threshold);
   s.read("keep_fixed_joints", n.keep_fixed_joints);
+  // diagnostic_updater reads its own key from the same namespace.
+  double diagnostic_period = 1.0;
+  s.read("diagnostic_period", diagnostic_period);
   s.read("decimation", n.estimator.decimation);
   if (n.estimator.decimation < 1) throw SettingsError("parameter 'decimation' must be >= 1");
   if (s.has("gravity")) {

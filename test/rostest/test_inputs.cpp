@@ -217,7 +217,7 @@ TEST(Inputs, StaleWrenchStopPublishesNothing) { runStale("stop", Policy::kStop);
 // ---------------------------------------------------------------------------------
 
 // rosbag play -l: /clock jumps back 5 s and the stamps restart with the bag. The node
-// warns once, refills its filter (the default Savitzky-Golay window: 9 samples) and
+// warns once, refills its filter (a Savitzky-Golay window: 9 samples) and
 // publishes again, never a stamp of the timeline it left.
 TEST(Inputs, BackwardTimeJumpRestartsTheFilters) {
   NodeUnderTest node("jump");
@@ -225,7 +225,7 @@ TEST(Inputs, BackwardTimeJumpRestartsTheFilters) {
   DiagnosticsRecorder& diag = diagnostics();
   ASSERT_TRUE(node.connect());
   Reference ref(kUr5);
-  // The bag: 30 samples of constant accelerations, which the default quadratic fit
+  // The bag: 30 samples of constant accelerations, which the quadratic fit
   // reproduces exactly (rounding aside, as in loads.test: bound kRel).
   const ros::Time bag_start(300, 0);
   VectorXd q0 = ur5Pose(), v0(6), a(6);

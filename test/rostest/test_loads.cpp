@@ -145,7 +145,7 @@ TEST(Loads, FiniteDifferenceIsExactAtWallClockStamps) {
   EXPECT_LT(worst, kExactRel);
 }
 
-// The default filter (Savitzky-Golay, window W = 9, order 2, delay 0: causal), fed only
+// A Savitzky-Golay filter (window W = 9, order 2, delay 0: causal), fed only
 // positions of a sum of sines at 1 kHz. Its error is truncation, predictable from the
 // Taylor series of the signal about the newest sample t: the least-squares quadratic over
 // the W samples at t + h (s + c), s = -(W-1)/2..(W-1)/2, c = -(W-1)/2 (the window's

@@ -40,6 +40,9 @@ struct NodeSettings {
   EstimatorConfig estimator;
 };
 
+/// The node's differentiator when the parameters name none (see docs/accuracy.md).
+DifferentiatorConfig nodeDefaultDifferentiator();
+
 /// Parses the struct `params` (a node's private namespace, or a YAML file's root).
 /// Unknown keys are an error too: a misspelt key silently ignored is a bug report later.
 NodeSettings parseSettings(const XmlRpc::XmlRpcValue& params);

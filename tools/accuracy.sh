@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# The accuracy study in one command: builds bench/accuracy, runs every scene through
+# jle::Estimator, and writes docs/accuracy.csv, docs/accuracy.md,
+# docs/accuracy_error_vs_time.png and docs/accuracy_error_vs_delay.png.
+#   tools/accuracy.sh           the full study (about a minute after the build)
+#   tools/accuracy.sh --quick   a tiny input, into $JLE_WS/accuracy_quick instead of docs/
+#                               (for CI: it fails if the study or the report no longer run,
+#                               or if exact inputs are not reproduced)
+# JLE_WS as for tools/build.sh; JLE_JOBS build jobs (default 2).
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
+export JLE_WS=$ws
+quick=()
+case "${1:-}" in
+  "") out="$repo/docs" ;;
+  --quick) quick=(--quick); out="$ws/accuracy_quick" ;;
+  *) echo "usage: tools/accuracy.sh [--quick]" >&2; exit 2 ;;
+esac
+mkdir -p "$ws" "$out"
+log="$ws/accuracy_build.log"
+if ! bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" accuracy >"$log" 2>&1; then
+  tail -40 "$log"
+  echo "accuracy: build failed (log: $log)" >&2
+  exit 1
+fi
+"$ws/devel/lib/joint_load_estimator/accuracy" "${quick[@]}" --csv "$out/accuracy.csv"
+/usr/bin/python3 "$repo/bench/plot_accuracy.py" "$out/accuracy.csv" --md "$out/accuracy.md" \
+  --png-prefix "$out/accuracy" --command "tools/accuracy.sh${quick:+ --quick}"
+echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png"
