@@ -7,6 +7,8 @@
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "../test/unit/random_models.hpp"
+
 #include <benchmark/benchmark.h>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
@@ -187,6 +189,28 @@ void differentiation(benchmark::State& state, jle::DifferentiatorType type, int 
   }
 }
 
+// Scaling: random serial chains and random trees of n moving joints (seeded), all 6-D
+// joint wrenches and the kinematics per sample. Google Benchmark fits the times to
+// a n and reports the coefficient and the RMS of the fit: a small RMS shows linearity.
+void scaling(benchmark::State& state, bool tree) {
+  jle_test::RandomModelSpec spec;
+  spec.joints = static_cast<int>(state.range(0));
+  spec.tree = tree;
+  spec.seed = 11;
+  const jle::Model<double> model = jle::modelFromUrdfString(jle_test::randomUrdf(spec));
+  jle::Data<double> data(model);
+  const States s = randomStates(model.nq);
+  const Eigen::Vector3d g(0, 0, -9.80665);
+  int k = 0;
+  for (auto _ : state) {
+    jle::forwardKinematics(model, data, s.q[k], s.qd[k], s.qdd[k], g);
+    jle::inverseDynamics(model, data);
+    benchmark::DoNotOptimize(data.moment.data());
+    k = (k + 1) % kStates;
+  }
+  state.SetComplexityN(state.range(0));
+}
+
 // One saving switched relative to the defaults (all exact savings on).
 jle::EstimatorConfig savingsVariant(const std::string& variant) {
   jle::EstimatorConfig c;
@@ -245,6 +269,11 @@ void estimatorStep(benchmark::State& state, const std::string& file, const std::
   BENCHMARK_CAPTURE(estimatorStep, name##_reuse_off, file, joints, still, "reuse_off");   \
   BENCHMARK_CAPTURE(estimatorStep, name##_static_on, file, joints, still, "static_on");   \
   BENCHMARK_CAPTURE(estimatorStep, name##_float, file, joints, still, "float")
+BENCHMARK_CAPTURE(scaling, chain, false)
+    ->RangeMultiplier(10)->Range(1, 1000)->Arg(300)->Arg(30)->Arg(3)->Complexity(benchmark::oN);
+BENCHMARK_CAPTURE(scaling, tree, true)
+    ->RangeMultiplier(10)->Range(1, 1000)->Arg(300)->Arg(30)->Arg(3)->Complexity(benchmark::oN);
+
 JLE_SAVING(talos_all_moving, "/urdf/talos_reduced.urdf", "", false);
 JLE_SAVING(talos_one_knee_moving, "/urdf/talos_reduced.urdf", "leg_left_4_joint", false);
 JLE_SAVING(talos_all_still, "/urdf/talos_reduced.urdf", "", true);
