@@ -5,8 +5,8 @@
 // of one set of coefficients.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Householder>
 
 #include <cmath>
 #include <stdexcept>
@@ -109,6 +109,7 @@ class DifferentiatorBank {
     count_ = 0;
     head_ = 0;
     if (config_.type != DifferentiatorType::kKalman) tau_prev_.setConstant(std::nan(""));
+    dt_prev_ = -1.0;  // a restarted filter is a fresh one, to the bit: no cached F, Q
   }
 
   /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.
@@ -149,34 +150,65 @@ class DifferentiatorBank {
     // stays well conditioned at any rate and any offset of the clock.
     const double newest = times_[ring(0)], oldest = times_[ring(w - 1)];
     const double mid = 0.5 * (newest + oldest), half = 0.5 * (newest - oldest);
-    bool same = half == half_prev_;
+    // The same spacing as the last fit (a steady rate): the weights are reused. "Same"
+    // means every sample within kSameSpacing of where the last fit had it: stamps are
+    // integers of nanoseconds, so a smaller difference is the rounding of the double
+    // time axis (its ulp is 1e-13 s at 1000 s), not information about the signal.
+    constexpr double kSameSpacing = 1e-10;  // [s]
+    bool same = std::abs(half - half_prev_) <= kSameSpacing;
     for (int k = 0; k < w; ++k) {
       const double tau = (times_[ring(k)] - mid) / half;
-      same = same && std::abs(tau - tau_prev_[k]) <= 1e-12;
+      same = same && std::abs(tau - tau_prev_[k]) * half <= kSameSpacing;
       tau_[k] = tau;
     }
     if (!same) {
-      // Least squares by the normal equations, which the centring keeps well conditioned
-      // (the Gram matrix of 1, tau, ..., tau^5 at uniform points has a condition number
-      // of 1.7e3 to 4.1e3 on [-1, 1] for windows of 6 to 101 samples, against 1.0e7 to
-      // 2.4e7 on the uncentred [-1, 0]). The estimate is a fixed linear
+      // Least squares by Householder QR of the Vandermonde V (w x n), V = Q R: the
+      // weights of derivative d are row d of E pinv(V) = (Q R^-T E^T)^T, where row d of
+      // E evaluates the d-th derivative of 1, tau, ..., tau^(n-1) at the stamp. Their
+      // error grows like cond(V), where the normal equations' grows like cond(V)^2: with
+      // one 1 us interval among 1 ms ones, the 3-point difference (V square) lost a
+      // factor 250 over what its inputs allow, and 1.3e6 at 0.1 ns (docs/stability.md).
+      // The centring and scaling keep cond(V) small for any spacing that is not
+      // degenerate, at any offset of the clock. The estimate is a fixed linear
       // combination of the window: coeff row d . x is the d-th derivative at the stamp.
       V_.resize(w, n_);
       for (int k = 0; k < w; ++k) {
         double p = 1.0;
         for (int j = 0; j < n_; ++j, p *= tau_[k]) V_(k, j) = p;
       }
-      gram_.noalias() = V_.transpose() * V_;
-      ldlt_.compute(gram_);
-      pinv_ = ldlt_.solve(V_.transpose());  // n x w
-      const double te = (stamp_ - mid) / half;
-      Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxOrder + 1> e(3, n_);
+      // In place: R on and above the diagonal, the reflectors' essential parts below.
       for (int j = 0; j < n_; ++j) {
-        e(0, j) = std::pow(te, j);
-        e(1, j) = j >= 1 ? j * std::pow(te, j - 1) : 0.0;
-        e(2, j) = j >= 2 ? j * (j - 1) * std::pow(te, j - 2) : 0.0;
+        double beta;
+        V_.col(j).tail(w - j).makeHouseholderInPlace(h_[j], beta);
+        V_(j, j) = beta;
+        if (j + 1 < n_)
+          V_.bottomRightCorner(w - j, n_ - j - 1)
+              .applyHouseholderOnTheLeft(V_.col(j).tail(w - j - 1), h_[j], work_.data());
       }
-      coeff_.noalias() = e * pinv_;
+      const Vandermonde& QR = V_;
+      const double te = (stamp_ - mid) / half;
+      // Y = R^-T E^T (n x 3) by forward substitution.
+      Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxOrder + 1, 3> Y(n_, 3);
+      for (int j = 0; j < n_; ++j) {
+        Y(j, 0) = std::pow(te, j);
+        Y(j, 1) = j >= 1 ? j * std::pow(te, j - 1) : 0.0;
+        Y(j, 2) = j >= 2 ? j * (j - 1) * std::pow(te, j - 2) : 0.0;
+        for (int i = 0; i < j; ++i) Y.row(j) -= QR(i, j) * Y.row(i);
+        Y.row(j) /= QR(j, j);
+      }
+      // coeff^T = Q [Y; 0] (w x 3): the reflectors H_{n-1} .. H_0 applied in turn,
+      // H_j = I - h_j v_j v_j^T with v_j = (0 .. 0, 1, QR(j+1 .., j)).
+      coeff_t_.setZero(w, 3);
+      coeff_t_.topRows(n_) = Y;
+      for (int j = n_ - 1; j >= 0; --j) {
+        const int len = w - j - 1;
+        Eigen::Matrix<double, 1, 3> vx =
+            coeff_t_.row(j) + QR.col(j).segment(j + 1, len).transpose() * coeff_t_.bottomRows(len);
+        vx *= h_[j];
+        coeff_t_.row(j) -= vx;
+        coeff_t_.bottomRows(len).noalias() -= QR.col(j).segment(j + 1, len) * vx;
+      }
+      coeff_ = coeff_t_.transpose();
       coeff_.row(1) /= half;
       coeff_.row(2) /= half * half;
       tau_prev_.head(w) = tau_.head(w);
@@ -196,6 +228,8 @@ class DifferentiatorBank {
       const double r2 = config_.measurement_noise * config_.measurement_noise;
       P_(0, 0) = r2;
       for (int i = 1; i < n; ++i) P_(i, i) = 1e12 * r2;
+      K_.setZero(n);
+      gain_settled_ = false;
       prev_t_ = t;
       count_ = 1;
       stamp_ = t;
@@ -205,36 +239,66 @@ class DifferentiatorBank {
     const double dt = t - prev_t_;
     prev_t_ = t;
     // Exact discretisation for this dt: F = exp(A dt) of the integrator chain, Q the
-    // integrated white noise of density q on the highest derivative.
-    SmallMatrix F = SmallMatrix::Identity(n, n);
-    SmallMatrix Q(n, n);
-    double fact[2 * kMaxOrder + 2];
-    fact[0] = 1.0;
-    for (int i = 1; i < 2 * kMaxOrder + 2; ++i) fact[i] = fact[i - 1] * i;
-    for (int i = 0; i < n; ++i)
-      for (int j = i + 1; j < n; ++j) F(i, j) = std::pow(dt, j - i) / fact[j - i];
-    const double q = config_.process_noise;
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) {
-        const int a = n - 1 - i, b = n - 1 - j;
-        Q(i, j) = q * std::pow(dt, a + b + 1) / (fact[a] * fact[b] * (a + b + 1));
+    // integrated white noise of density q on the highest derivative. Recomputed only
+    // when dt changes by more than the time axis resolves (see fitSavitzkyGolay).
+    bool changed = false;
+    if (!(std::abs(dt - dt_prev_) <= 1e-10)) {
+      changed = true;
+      double fact[2 * kMaxOrder + 2], dt_pow[2 * kMaxOrder + 2];
+      fact[0] = 1.0;
+      dt_pow[0] = 1.0;
+      for (int i = 1; i < 2 * kMaxOrder + 2; ++i) {
+        fact[i] = fact[i - 1] * i;
+        dt_pow[i] = dt_pow[i - 1] * dt;
       }
-    // Predict, then update with the position measurement: the gain is the same for
-    // every channel, so the covariance is propagated once.
-    P_ = F * P_ * F.transpose() + Q;
-    const double S = P_(0, 0) + config_.measurement_noise * config_.measurement_noise;
-    const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
-    P_ -= K * P_.row(0);
-    P_ = 0.5 * (P_ + P_.transpose()).eval();
-    for (int c = 0; c < channels_; ++c) {
-      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> s = F * state_.col(c);
-      s += K * (x[c] - s[0]);
-      state_.col(c) = s;
+      F_.setIdentity(n, n);
+      Q_.resize(n, n);
+      for (int i = 0; i < n; ++i)
+        for (int j = i + 1; j < n; ++j) F_(i, j) = dt_pow[j - i] / fact[j - i];
+      const double q = config_.process_noise;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const int a = n - 1 - i, b = n - 1 - j;
+          Q_(i, j) = q * dt_pow[a + b + 1] / (fact[a] * fact[b] * (a + b + 1));
+        }
+      dt_prev_ = dt;
     }
+    const SmallMatrix& F = F_;
+    const SmallMatrix& Q = Q_;
+    // Predict, then update with the position measurement: the gain is the same for
+    // every channel, so the covariance is propagated once; at a steady rate it reaches
+    // its fixed point (the Riccati recursion converges), after which the gain stays.
+    const bool steady = !changed && gain_settled_;
+    if (!steady) {
+      P_ = F * P_ * F.transpose() + Q;
+      const double S = P_(0, 0) + config_.measurement_noise * config_.measurement_noise;
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
+      P_ -= K * P_.row(0);
+      P_ = 0.5 * (P_ + P_.transpose()).eval();
+      gain_settled_ = count_ >= n && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
+      K_ = K;
+    }
+    if (n == 3)
+      kalmanChannels<3>(x);
+    else
+      kalmanChannels<4>(x);
     stamp_ = t;
     out_ = state_.topRows(3);
     if (count_ < n) ++count_;
     return count_ >= n;
+  }
+
+  // x <- F x + K (measurement - (F x)_0) for every channel, at fixed size N.
+  template <int N>
+  void kalmanChannels(const double* x) {
+    const Eigen::Matrix<double, N, N> F = F_;
+    const Eigen::Matrix<double, N, 1> K = K_;
+    for (int c = 0; c < channels_; ++c) {
+      Eigen::Map<Eigen::Matrix<double, N, 1>> state(state_.col(c).data());
+      Eigen::Matrix<double, N, 1> s = F * state;
+      s += K * (x[c] - s[0]);
+      state = s;
+    }
   }
 
   DifferentiatorConfig config_;
@@ -246,6 +310,10 @@ class DifferentiatorBank {
   double stamp_ = 0.0;
   double prev_t_ = 0.0;
   double half_prev_ = 0.0;
+  double dt_prev_ = -1.0;  // Kalman: dt of F_ and Q_
+  SmallMatrix F_, Q_;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K_;  // Kalman gain
+  bool gain_settled_ = false;
   Eigen::VectorXd times_;
   Eigen::MatrixXd values_;  // window x channels
   Eigen::MatrixXd coeff_;   // 3 x window
@@ -254,9 +322,9 @@ class DifferentiatorBank {
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_prev_;
   using Vandermonde = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 101, kMaxOrder + 1>;
   Vandermonde V_;
-  SmallMatrix gram_;
-  Eigen::LDLT<SmallMatrix> ldlt_;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, 101> pinv_;
+  Eigen::Matrix<double, kMaxOrder + 1, 1> h_;     // Householder coefficients
+  Eigen::Matrix<double, kMaxOrder + 1, 1> work_;  // workspace of applyHouseholderOnTheLeft
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 101, 3> coeff_t_;  // w x 3
   Eigen::MatrixXd state_;  // Kalman: n x channels
   SmallMatrix P_;
 };
