@@ -54,6 +54,9 @@ struct Savings {
   /// When the filtered inputs have not changed since the last computation, reuse its
   /// result instead of recomputing (exact: same inputs, same outputs).
   bool reuse_unchanged = true;
+  /// With reuse_unchanged: publish the reused result with the new stamp (true) or
+  /// publish nothing for an unchanged sample (false; the node's choice, not the estimator's).
+  bool republish_unchanged = true;
 };
 
 struct EstimatorConfig {

@@ -236,7 +236,10 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
 
     const SampleStatus status = estimator_->addJointSample(relative(stamp), q_.data(), &base);
     switch (status) {
-      case SampleStatus::kPublished: publish(received); break;
+      case SampleStatus::kPublished:
+        if (!estimator_->lastWasReused() || settings_.estimator.savings.republish_unchanged)
+          publish(received);
+        break;
       case SampleStatus::kDuplicate:
       case SampleStatus::kOutOfOrder:
         ++counters_.dropped_order;

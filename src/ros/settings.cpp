@@ -258,6 +258,7 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
     sv.read("massless_chains", v.massless_chains);
     sv.read("gyroscopic", v.gyroscopic);
     sv.read("reuse_unchanged", v.reuse_unchanged);
+    sv.read("republish_unchanged", v.republish_unchanged);
     sv.read("static_velocity", v.static_velocity);
     sv.read("static_acceleration", v.static_acceleration);
     if (v.static_velocity < 0.0 || v.static_acceleration < 0.0)
