@@ -26,6 +26,8 @@ for b in bench_speed_core bench_speed_messages; do
 done
 bash "$repo/tools/accuracy.sh" --quick >"$ws/accuracy_quick.log" 2>&1 ||
   { tail -20 "$ws/accuracy_quick.log"; echo "accuracy --quick failed"; bench_status=1; }
+bash "$repo/tools/stability.sh" --quick >"$ws/stability_quick.log" 2>&1 ||
+  { tail -20 "$ws/stability_quick.log"; echo "stability --quick failed"; bench_status=1; }
 grep -E "^\[  (FAILED|PASSED) |^\[ *FAILED *\]|^\[ROSTEST\]|FAILURE" "$ws/run_tests.log" | sort | uniq -c | sort -rn | head -40 || true
 status=0
 catkin_test_results --verbose build/test_results >"$ws/test_results.txt" 2>&1 || status=$?

@@ -146,7 +146,7 @@ struct Model {
       if (kind[i] == 0) gyroscopic[i] = 0;
       if (kind[i] == 1) {
         const Vector3 Jd = inertia_com[i] * dir[i];
-        gyroscopic[i] = Jd.cross(dir[i]).norm() > eps * (Scalar(1) + Jd.norm());
+        gyroscopic[i] = Jd.cross(dir[i]).norm() > eps * Jd.norm();  // relative: any scale
       }
     }
   }

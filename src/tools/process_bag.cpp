@@ -352,6 +352,15 @@ class BagProcessor {
                  what.c_str());
   }
 
+  // The estimator's time axis, as the node's: seconds since the whole second of the
+  // first stamp (a double holds epoch seconds only to 2.4e-7 s), mapped back exactly
+  // for the output.
+  double relative(const ros::Time& stamp) {
+    if (time_ref_.isZero()) time_ref_ = ros::Time(stamp.sec, 0);
+    return (stamp - time_ref_).toSec();
+  }
+  ros::Time absolute(double t) const { return time_ref_ + ros::Duration(t); }
+
   void onJointState(const ros::Time& bag_time) {
     ++counters_.joint_states;
     const sensor_msgs::JointState& msg = joint_msg_;
@@ -368,7 +377,7 @@ class BagProcessor {
       return;
     }
     const ros::Time stamp = msg.header.stamp.isZero() ? bag_time : msg.header.stamp;
-    const double t = stamp.toSec();
+    const double t = relative(stamp);
     // A stamp older than the previous by more than the threshold: a jump back (the node
     // also resets when its clock goes back, which a bag read in order cannot do).
     if (have_last_ && last_t_ - t > settings_.time_jump_threshold) {
@@ -444,7 +453,7 @@ class BagProcessor {
     const Clock::time_point c0 = Clock::now();
     Eigen::Vector3d f_link, m_link;
     jle::wrenchInLink(topic.R_link_frame, topic.p_link_frame, f, m, f_link, m_link);
-    const bool taken = estimator_.addWrench(static_cast<int>(k), stamp.toSec(), f_link, m_link);
+    const bool taken = estimator_.addWrench(static_cast<int>(k), relative(stamp), f_link, m_link);
     compute_ += Clock::now() - c0;
     if (!taken) ++counters_.dropped_order;
   }
@@ -463,8 +472,9 @@ class BagProcessor {
         break;
       }
     }
+    const ros::Time t = absolute(stamp);
     double* row = row_.data();
-    *row++ = stamp;
+    *row++ = t.toSec();
     for (std::size_t i = 0; i < segments_.size(); ++i) {
       const std::size_t s = static_cast<std::size_t>(segments_[i]);
       geometry_msgs::Wrench& w = loads_.wrench[i];
@@ -480,7 +490,6 @@ class BagProcessor {
     }
     if (csv_) csv_->writeRow(row_.data(), row_.size());
     if (out_bag_) {
-      const ros::Time t(stamp);
       loads_.header.stamp = t;
       loads_.header.seq = static_cast<std::uint32_t>(counters_.published - 1);
       out_bag_->write(out_topic_, t, loads_);
@@ -535,6 +544,7 @@ class BagProcessor {
   std::string bag_temporary_, out_topic_;
   std::unique_ptr<jle::CsvWriter> csv_;
   bool have_last_ = false;
+  ros::Time time_ref_;  // origin of the estimator's time axis
   double last_t_ = 0.0;
   Clock::duration compute_{0};
   Counters counters_;

@@ -234,6 +234,9 @@ Expected expectedLoads(const Messages& m) {
                                       model.segmentOfJoint("panda_joint7")};
   std::map<double, std::vector<double>> efforts;  // by stamp, of the published joints
   Expected e;
+  // process_bag's time axis: seconds since the whole second of the first stamp.
+  const ros::Time origin(m.joints.front().first.sec, 0);
+  auto rel = [&](const ros::Time& t) { return (t - origin).toSec(); };
   std::size_t w = 0;
   for (const auto& j : m.joints) {
     for (; w < m.wrenches.size() && m.wrenches[w].first <= j.first; ++w) {
@@ -242,20 +245,20 @@ Expected expectedLoads(const Messages& m) {
       const Eigen::Vector3d mo(msg.torque.x, msg.torque.y, msg.torque.z);
       const Eigen::Vector3d f_link = kR_link8_tcp * f;
       const Eigen::Vector3d m_link = kR_link8_tcp * mo + kP_link8_tcp.cross(f_link);
-      estimator.addWrench(0, m.wrenches[w].first.toSec(), f_link, m_link);
+      estimator.addWrench(0, rel(m.wrenches[w].first), f_link, m_link);
     }
     std::vector<double> q(static_cast<std::size_t>(model.nq));
     for (std::size_t i = 0; i < j.second.name.size(); ++i)
       for (int k = 0; k < model.nq; ++k)
         if (model.coordinate_names[static_cast<std::size_t>(k)] == j.second.name[i])
           q[static_cast<std::size_t>(k)] = j.second.position[i];
-    std::vector<double>& effort = efforts[j.first.toSec()];
+    std::vector<double>& effort = efforts[rel(j.first)];
     for (const char* name : {"panda_joint2", "panda_joint4", "panda_joint7"})
       for (std::size_t i = 0; i < j.second.name.size(); ++i)
         if (j.second.name[i] == name) effort.push_back(j.second.effort[i]);
-    if (estimator.addJointSample(j.first.toSec(), q.data()) != jle::SampleStatus::kPublished)
+    if (estimator.addJointSample(rel(j.first), q.data()) != jle::SampleStatus::kPublished)
       continue;
-    e.t.push_back(estimator.stamp());
+    e.t.push_back((origin + ros::Duration(estimator.stamp())).toSec());
     std::vector<double> row;
     for (int s : published) {
       const jle::Data<double>& d = estimator.data();
