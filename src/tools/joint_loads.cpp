@@ -1,5 +1,6 @@
 // joint_loads: the joint wrenches and efforts of a URDF robot along a CSV of joint
 // states (and applied wrenches), one output row per input row. docs/joint_loads.md.
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
@@ -17,6 +18,9 @@
 #include <vector>
 
 namespace {
+
+using jle::cli::UsageError;
+using jle::cli::optionValues;
 
 const char* const kUsage =
     R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS.csv]
@@ -57,43 +61,12 @@ URDF the model refuses, a CSV defect: the message names FILE:LINE and the column
 2 a usage error (an unknown, missing or repeated option, a bad option value).
 )";
 
-/// A defect of the command line: exit status 2.
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 struct Options {
   std::string urdf, input, output;
   Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};
   jle::WrenchFrame frame = jle::WrenchFrame::kChild;
 };
 
-// --key value or --key=value, each known key at most once.
-std::map<std::string, std::string> optionValues(int argc, char** argv,
-                                                const std::vector<std::string>& keys) {
-  std::map<std::string, std::string> values;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const std::size_t eq = arg.find('=');
-    const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
-    bool known = false;
-    for (const std::string& k : keys) known = known || k == key;
-    if (!known)
-      throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
-                                                   : "unexpected argument '" + arg + "'");
-    std::string value;
-    if (eq != std::string::npos) {
-      value = arg.substr(eq + 1);
-    } else {
-      if (i + 1 >= argc) throw UsageError(key + " needs a value");
-      value = argv[++i];
-    }
-    if (value.empty()) throw UsageError(key + ": empty value");
-    if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
-  }
-  return values;
-}
 
 Eigen::Vector3d parseGravity(const std::string& text) {
   Eigen::Vector3d g;

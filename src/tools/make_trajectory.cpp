@@ -1,5 +1,6 @@
 // make_trajectory: a deterministic analytic joint-state CSV (and optionally an applied
 // wrench) for joint_loads. The formula is in kUsage and docs/joint_loads.md.
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -16,6 +17,9 @@
 #include <vector>
 
 namespace {
+
+using jle::cli::UsageError;
+using jle::cli::optionValues;
 
 const char* const kUsage =
     R"(usage: make_trajectory --urdf ROBOT.urdf [--duration 2.0] [--rate 1000] [--seed 1]
@@ -57,11 +61,6 @@ Exit status: 0 success; 1 a data error (unreadable URDF, unwritable output);
 
 constexpr double kTwoPi = 6.283185307179586;
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 struct Options {
   std::string urdf, output, wrench_link;
   double duration = 2.0;
@@ -69,31 +68,6 @@ struct Options {
   std::uint32_t seed = 1;
 };
 
-// --key value or --key=value, each known key at most once.
-std::map<std::string, std::string> optionValues(int argc, char** argv,
-                                                const std::vector<std::string>& keys) {
-  std::map<std::string, std::string> values;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const std::size_t eq = arg.find('=');
-    const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
-    bool known = false;
-    for (const std::string& k : keys) known = known || k == key;
-    if (!known)
-      throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
-                                                   : "unexpected argument '" + arg + "'");
-    std::string value;
-    if (eq != std::string::npos) {
-      value = arg.substr(eq + 1);
-    } else {
-      if (i + 1 >= argc) throw UsageError(key + " needs a value");
-      value = argv[++i];
-    }
-    if (value.empty()) throw UsageError(key + ": empty value");
-    if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
-  }
-  return values;
-}
 
 double parseNumber(const std::string& key, const std::string& text) {
   char* end = nullptr;

@@ -1,6 +1,7 @@
 // process_bag: the node's estimate, offline, for every joint state of a bag: the same
 // settings file, the same jle::Estimator, the same message handling
 // (ros/message_inputs.hpp), in the bag's time order. docs/demo.md.
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/estimator.hpp>
@@ -29,6 +30,9 @@
 #include <vector>
 
 namespace {
+
+using jle::cli::UsageError;
+using jle::cli::optionValues;
 
 const char* const kUsage =
     R"(usage: process_bag --bag IN.bag --urdf ROBOT.urdf [--config CONFIG.yaml]
@@ -70,41 +74,11 @@ missing topic, an unresolvable wrench frame, no loads at all: the message names 
 culprit); 2 a usage error.
 )";
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 struct Options {
   std::string bag, urdf, config, output, csv;
   std::string prefix = "/joint_load_estimator";
 };
 
-// --key value or --key=value, each known key at most once.
-std::map<std::string, std::string> optionValues(int argc, char** argv,
-                                                const std::vector<std::string>& keys) {
-  std::map<std::string, std::string> values;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const std::size_t eq = arg.find('=');
-    const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
-    bool known = false;
-    for (const std::string& k : keys) known = known || k == key;
-    if (!known)
-      throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
-                                                   : "unexpected argument '" + arg + "'");
-    std::string value;
-    if (eq != std::string::npos) {
-      value = arg.substr(eq + 1);
-    } else {
-      if (i + 1 >= argc) throw UsageError(key + " needs a value");
-      value = argv[++i];
-    }
-    if (value.empty()) throw UsageError(key + ": empty value");
-    if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
-  }
-  return values;
-}
 
 Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = optionValues(

@@ -1,0 +1,48 @@
+// Command-line options of the package's tools: --key value or --key=value, each known
+// key at most once; a defect of the command line is a UsageError (exit status 2).
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace jle {
+namespace cli {
+
+/// A defect of the command line: the tools exit with status 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The values of the options in argv, keyed by option ("--urdf"). Throws UsageError
+/// naming an unknown option, an unexpected argument, a missing or empty value, or an
+/// option given twice.
+inline std::map<std::string, std::string> optionValues(int argc, char** argv,
+                                                       const std::vector<std::string>& keys) {
+  std::map<std::string, std::string> values;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const std::size_t eq = arg.find('=');
+    const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
+    bool known = false;
+    for (const std::string& k : keys) known = known || k == key;
+    if (!known)
+      throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
+                                                   : "unexpected argument '" + arg + "'");
+    std::string value;
+    if (eq != std::string::npos) {
+      value = arg.substr(eq + 1);
+    } else {
+      if (i + 1 >= argc) throw UsageError(key + " needs a value");
+      value = argv[++i];
+    }
+    if (value.empty()) throw UsageError(key + ": empty value");
+    if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
+  }
+  return values;
+}
+
+}  // namespace cli
+}  // namespace jle
