@@ -1,0 +1,83 @@
+// No heap allocation per timestep: the global operator new of this test binary counts
+// its calls, and the per-sample paths (the core passes, the estimator with every
+// differentiator) must not add to the count once their buffers are built.
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+const std::string kData = JLE_TEST_DATA;
+
+TEST(NoAllocation, CorePassesOnTalos) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/talos_reduced.urdf");
+  jle::Data<double> data(model);
+  Eigen::VectorXd q = Eigen::VectorXd::Constant(model.nq, 0.2), qd = q, qdd = q;
+  const Eigen::Vector3d g(0, 0, -9.80665), f(1, 2, 3), m(0.1, 0.2, 0.3);
+  const int sole = model.frameIndex("left_sole_link");
+  ASSERT_GT(g_allocations.load(), 100);  // the counter sees the model being built
+  const long before = g_allocations;
+  for (int k = 0; k < 1000; ++k) {
+    q[0] = 1e-3 * k;
+    jle::forwardKinematics(model, data, q, qd, qdd, g);
+    jle::addExternalWrench(model, data, sole, f, m, jle::WrenchFrame::kWorld);
+    jle::inverseDynamics(model, data);
+    const jle::Wrench<double> w = jle::jointWrench(model, data, 5, jle::WrenchFrame::kParent);
+    ASSERT_TRUE(w.force.allFinite());
+  }
+  EXPECT_EQ(g_allocations - before, 0);
+}
+
+TEST(NoAllocation, EstimatorWithEachDifferentiator) {
+  const jle::Model<double> model =
+      jle::modelFromUrdfFile(kData + "/urdf/chains/panda_chain.urdf");
+  for (jle::DifferentiatorType type :
+       {jle::DifferentiatorType::kFiniteDifference, jle::DifferentiatorType::kSavitzkyGolay,
+        jle::DifferentiatorType::kKalman}) {
+    jle::EstimatorConfig config;
+    config.differentiator.type = type;
+    jle::WrenchInputConfig ft;
+    ft.name = "ft";
+    ft.link = "panda_hand";
+    config.wrenches.push_back(ft);
+    jle::Estimator estimator(model, config);
+    std::vector<double> q(static_cast<std::size_t>(model.nq), 0.0);
+    long published = 0;
+    long before = 0;
+    for (int k = 0; k < 2000; ++k) {
+      if (k == 100) before = g_allocations;  // buffers built, filters warm
+      // Jittered stamps: the filters recompute their weights at every sample.
+      const double t = 1e-3 * k + 2e-4 * std::sin(k);
+      for (std::size_t i = 0; i < q.size(); ++i) q[i] = 0.5 * std::sin(t + i);
+      estimator.addWrench(0, t, Eigen::Vector3d(1, 0, -5), Eigen::Vector3d(0, 0.1, 0));
+      published += estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished;
+    }
+    EXPECT_EQ(g_allocations - before, 0) << "differentiator " << static_cast<int>(type);
+    EXPECT_GT(published, 1800);
+  }
+}
+
+}  // namespace
