@@ -323,6 +323,9 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
       return;
     }
     const ros::Time stamp = msg->header.stamp.isZero() ? ros::Time::now() : msg->header.stamp;
+    // A looping bag may deliver the new loop's first wrench before its first joint
+    // state: the jump is detected here too, so that wrench is not refused as old.
+    checkTimeJump(stamp);
     Eigen::Matrix3d R;
     Eigen::Vector3d p;
     if (!resolveFrame(topic, frame, stamp, R, p)) {
