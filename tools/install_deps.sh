@@ -13,6 +13,7 @@ packages=(
   liborocos-kdl-dev libkdl-parser-dev liburdf-dev
   ros-robot-state-publisher rosbash
   python3-matplotlib
+  clang libclang-rt-14-dev  # libFuzzer for test/fuzz/build_and_run.sh
 )
 missing=()
 for p in "${packages[@]}"; do

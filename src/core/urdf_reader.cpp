@@ -238,17 +238,34 @@ struct Builder {
         I + l.mass * (X.p.squaredNorm() * Matrix3::Identity() - X.p * X.p.transpose());
   }
 
+  // Depth first from `link` (already placed on `segment` at X_segment_link), children
+  // in document order, with an explicit stack: a URDF thousands of links deep must not
+  // exhaust the call stack.
   void visit(int link, int segment, const Pose& X_segment_link) {
-    addLink(link, segment, X_segment_link);
-    for (int j : links[link].child_joints) {
-      const JointDesc& joint = joints[j];
+    struct Pending {
+      int joint;
+      int segment;            // segment the joint's parent link lies on
+      Pose X_segment_parent;  // the parent link's placement on it
+    };
+    std::vector<Pending> stack;
+    auto place = [&](int l, int seg, const Pose& X) {
+      addLink(l, seg, X);
+      const std::vector<int>& children = links[l].child_joints;
+      for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back({*it, seg, X});
+    };
+    place(link, segment, X_segment_link);
+    while (!stack.empty()) {
+      const Pending pending = stack.back();
+      stack.pop_back();
+      const JointDesc& joint = joints[pending.joint];
       const int child = link_index.at(joint.child);
       const std::string what = "joint '" + joint.name + "'";
       const bool keep = std::find(options.keep_fixed_joints.begin(),
                                   options.keep_fixed_joints.end(),
                                   joint.name) != options.keep_fixed_joints.end();
+      const Pose X = pending.X_segment_parent * joint.origin;
       if (joint.type == "fixed" && !keep) {
-        visit(child, segment, X_segment_link * joint.origin);
+        place(child, pending.segment, X);
         continue;
       }
       JointType type;
@@ -262,17 +279,16 @@ struct Builder {
         fail(what + ": a floating joint must be the only joint of the root link");
       else
         fail(what + ": unsupported joint type '" + joint.type + "'");
-      const int s = addSegment(segment, type, joint.child, joint.name);
-      const Pose X = X_segment_link * joint.origin;
+      const int s = addSegment(pending.segment, type, joint.child, joint.name);
       model.R_parent_joint[s] = X.R;
       model.p_parent_joint[s] = X.p;
-      model.R_parentsegment_parentlink[s] = X_segment_link.R;
+      model.R_parentsegment_parentlink[s] = pending.X_segment_parent.R;
       if (isMoving(type)) {
         const double norm = joint.axis.norm();
         if (!(norm > 1e-12)) fail(what + ": axis of zero length");
         model.axis[s] = joint.axis / norm;
       }
-      visit(child, s, Pose());
+      place(child, s, Pose());
     }
   }
 

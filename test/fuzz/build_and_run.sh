@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz_urdf, fuzz_csv, fuzz_messages) with clang++
+# -fsanitize=fuzzer,address,undefined straight from the sources (no catkin), replays
+# the regression inputs of each (test/fuzz/regressions/<target>/), then fuzzes each
+# for a bounded time starting from its seed corpus (test/fuzz/corpus/<target>/).
+# Fails on a crash, a sanitizer report, a leak or a timeout; a crashing input is left
+# as crash-* in the work directory: copy it into regressions/<target>/.
+#   build_and_run.sh [SECONDS_PER_TARGET (default 30)] [TARGET...]
+#   JLE_FUZZ_DIR  work directory (default ~/.cache/joint_load_estimator/fuzz)
+#   CXX           compiler (default clang++; Debian 12: packages clang, libclang-rt-14-dev)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+seconds=${1:-30}
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_csv fuzz_messages)
+work=${JLE_FUZZ_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/fuzz}
+cxx=${CXX:-clang++}
+mkdir -p "$work/obj"
+
+san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+common=(-std=c++17 -O1 -g $san -I"$repo/include" -I/usr/include/eigen3
+        -DJLE_FUZZ_DATA="\"$repo/test/data\"" -Wall -Wextra)
+# The library sources each target needs (compiled once, shared; without the fuzzer
+# runtime so that they hold no main).
+declare -A needs=(
+  [fuzz_urdf]="src/core/urdf_reader.cpp"
+  [fuzz_csv]="src/core/urdf_reader.cpp src/core/csv.cpp"
+  [fuzz_messages]="src/core/urdf_reader.cpp src/core/estimator.cpp src/ros/message_inputs.cpp"
+)
+object() {  # source -> object path, rebuilt when the source or a header is newer
+  local src=$1 obj="$work/obj/$(echo "$1" | tr / _).o"
+  if [ ! -f "$obj" ] || [ -n "$(find "$repo/$src" "$repo/include" -newer "$obj" -print -quit)" ]; then
+    "$cxx" "${common[@]}" -fsanitize=fuzzer-no-link -c "$repo/$src" -o "$obj"
+  fi
+  echo "$obj"
+}
+
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=${JLE_FUZZ_LEAKS:-1}:allocator_may_return_null=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+status=0
+for t in "${targets[@]}"; do
+  objs=()
+  for s in ${needs[$t]}; do objs+=("$(object "$s")"); done
+  "$cxx" "${common[@]}" -fsanitize=fuzzer "$here/$t.cpp" "${objs[@]}" -ltinyxml2 -o "$work/$t"
+  # Regressions first: each must now run clean.
+  reg="$here/regressions/$t"
+  if [ -d "$reg" ] && [ -n "$(ls -A "$reg")" ]; then
+    if ! "$work/$t" -runs=0 "$reg"/* >"$work/$t.regressions.log" 2>&1; then
+      tail -30 "$work/$t.regressions.log"
+      echo "FAIL  $t: a regression input fails again (log: $work/$t.regressions.log)"
+      status=1
+      continue
+    fi
+  fi
+  # Fuzz: a scratch corpus seeded from the repository's (which stays untouched).
+  mkdir -p "$work/corpus/$t"
+  start=$(date +%s)
+  if (cd "$work" && "$work/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+        -max_len=16384 -print_final_stats=1 "$work/corpus/$t" "$here/corpus/$t" \
+        >"$work/$t.log" 2>&1); then
+    echo "ok    $t: $(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$work/$t.log" |
+      grep -oE '[0-9]+$') runs in $(($(date +%s) - start)) s"
+  else
+    grep -E "ERROR: |runtime error:|SUMMARY|Test unit written" "$work/$t.log" | head -20 || true
+    echo "FAIL  $t (log: $work/$t.log; copy the crash-* input into $reg/)"
+    status=1
+  fi
+done
+exit $status

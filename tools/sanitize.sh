@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Builds the unit tests with AddressSanitizer + UndefinedBehaviorSanitizer in a second
+# catkin workspace and runs every gtest unit-test binary directly (the rostest node
+# tests, test_node_*, need a master and are left to tools/test.sh). Fails on a failed
+# test or on any sanitizer report.
+#   JLE_WS_SAN  workspace (default ~/.cache/joint_load_estimator/ws_asan)
+#   JLE_JOBS    parallel build jobs (default 2)
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=${JLE_WS_SAN:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws_asan}
+jobs=${JLE_JOBS:-2}
+mkdir -p "$ws/src"
+ln -sfn "$repo" "$ws/src/joint_load_estimator"
+export PATH=/usr/bin:$PATH
+cd "$ws"
+# The unit tests only (the benchmarks and node tests are not rebuilt here).
+targets="test_urdf_reader test_closed_form test_invariance test_kdl test_cli
+  test_differentiation test_estimator test_savings test_ground_truth test_stability
+  test_no_allocation test_process_bag"
+flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+    -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
+    -j"$jobs" $targets >"$ws/build.log" 2>&1; then
+  tail -40 "$ws/build.log"
+  echo "sanitizer build failed (log: $ws/build.log)"
+  exit 1
+fi
+
+# halt_on_error: the first report ends the binary with a non-zero status.
+# LeakSanitizer cannot run under ptrace (a debugger, strace, some sandboxes): it is kept
+# on unless JLE_SAN_LEAKS=0 (it then says "LeakSanitizer does not work under ptrace").
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=${JLE_SAN_LEAKS:-1}:detect_stack_use_after_return=1:strict_string_checks=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+bin="$ws/devel/lib/joint_load_estimator"
+status=0
+ran=0
+for t in "$bin"/test_*; do
+  name=$(basename "$t")
+  [ -x "$t" ] && [ -f "$t" ] || continue
+  case "$name" in test_node_*) continue ;; esac
+  log="$ws/$name.log"
+  start=$(date +%s)
+  if "$t" >"$log" 2>&1 && ! grep -qE "ERROR: (Address|Leak)Sanitizer|runtime error:" "$log"; then
+    echo "ok    $name ($(($(date +%s) - start)) s)"
+  else
+    echo "FAIL  $name (log: $log)"
+    grep -E "ERROR: .*Sanitizer|runtime error:|^\[  FAILED  \]|SUMMARY" "$log" | head -20 || true
+    status=1
+  fi
+  ran=$((ran + 1))
+done
+[ "$ran" -gt 0 ] || { echo "no unit test binary in $bin"; exit 1; }
+echo "sanitizers: $ran unit test binaries, $([ $status -eq 0 ] && echo clean || echo FAILED)"
+exit $status
