@@ -2,6 +2,7 @@
 // key at most once; a defect of the command line is a UsageError (exit status 2).
 #pragma once
 
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -42,6 +43,28 @@ inline std::map<std::string, std::string> optionValues(int argc, char** argv,
     if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
   }
   return values;
+}
+
+/// The main() of a tool: --help/-h prints `usage`; then run(parse(argc, argv)). A
+/// UsageError exits 2 and any other error 1, each with one line on stderr that starts
+/// with the tool's name.
+template <typename Parse, typename Run>
+int runTool(int argc, char** argv, const char* name, const char* usage, Parse parse, Run run) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::fputs(usage, stdout);
+      return 0;
+    }
+  try {
+    run(parse(argc, argv));
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "%s: %s (see %s --help)\n", name, e.what(), name);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace cli

@@ -153,23 +153,5 @@ void run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  Options options;
-  try {
-    options = parseOptions(argc, argv);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "joint_loads: %s (see joint_loads --help)\n", e.what());
-    return 2;
-  }
-  try {
-    run(options);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "joint_loads: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  return jle::cli::runTool(argc, argv, "joint_loads", kUsage, parseOptions, run);
 }

@@ -1,6 +1,7 @@
 // make_example_bag: a deterministic example bag of an arm with a wrist force/torque
 // sensor, for the demo and for process_bag's tests and benchmarks. The formulas are in
 // kUsage and docs/demo.md.
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -323,19 +324,5 @@ void run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  try {
-    run(parseOptions(argc, argv));
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "make_example_bag: %s (see make_example_bag --help)\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "make_example_bag: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  return jle::cli::runTool(argc, argv, "make_example_bag", kUsage, parseOptions, run);
 }

@@ -193,19 +193,5 @@ void run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  try {
-    run(parseOptions(argc, argv));
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "make_trajectory: %s (see make_trajectory --help)\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "make_trajectory: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  return jle::cli::runTool(argc, argv, "make_trajectory", kUsage, parseOptions, run);
 }
