@@ -314,7 +314,7 @@ def main():
               f"{fmt(least['rms_effort'])} N m with {ms(least['delay_ms'])} ms of delay.")
         if shipped_rows:
             r = shipped_rows[0]
-            w(f" The shipped default, {shipped}: {fmt(r['rms_effort'])} N m, delay "
+            w(f" The previous default, {shipped}: {fmt(r['rms_effort'])} N m, delay "
               f"{ms(r['delay_ms'])} ms, {us(r['time_per_sample_us'])} us.")
         w(" Per scene: *Other scenes* below.\n\n")
     else:
