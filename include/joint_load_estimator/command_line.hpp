@@ -17,29 +17,33 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The values of the options in argv, keyed by option ("--urdf"). Throws UsageError
-/// naming an unknown option, an unexpected argument, a missing or empty value, or an
-/// option given twice.
+/// The values of the options in argv, keyed by option ("--urdf"); a flag (no value)
+/// maps to "1". Throws UsageError naming an unknown option, an unexpected argument, a
+/// missing or empty value, or an option given twice.
 inline std::map<std::string, std::string> optionValues(int argc, char** argv,
-                                                       const std::vector<std::string>& keys) {
+                                                       const std::vector<std::string>& keys,
+                                                       const std::vector<std::string>& flags = {}) {
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const std::size_t eq = arg.find('=');
     const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
-    bool known = false;
+    bool known = false, flag = false;
     for (const std::string& k : keys) known = known || k == key;
-    if (!known)
+    for (const std::string& k : flags) flag = flag || k == arg;
+    if (!known && !flag)
       throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
                                                    : "unexpected argument '" + arg + "'");
-    std::string value;
-    if (eq != std::string::npos) {
-      value = arg.substr(eq + 1);
-    } else {
-      if (i + 1 >= argc) throw UsageError(key + " needs a value");
-      value = argv[++i];
+    std::string value = "1";
+    if (!flag) {
+      if (eq != std::string::npos) {
+        value = arg.substr(eq + 1);
+      } else {
+        if (i + 1 >= argc) throw UsageError(key + " needs a value");
+        value = argv[++i];
+      }
+      if (value.empty()) throw UsageError(key + ": empty value");
     }
-    if (value.empty()) throw UsageError(key + ": empty value");
     if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
   }
   return values;

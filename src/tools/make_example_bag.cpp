@@ -1,6 +1,7 @@
 // make_example_bag: a deterministic example bag of an arm with a wrist force/torque
 // sensor, for the demo and for process_bag's tests and benchmarks. The formulas are in
 // kUsage and docs/demo.md.
+#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
@@ -25,6 +26,9 @@
 #include <vector>
 
 namespace {
+
+using jle::cli::UsageError;
+using jle::cli::optionValues;
 
 const char* const kUsage =
     R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]
@@ -84,11 +88,6 @@ constexpr double kTwoPi = 6.283185307179586;
 constexpr double kPi = 3.141592653589793;
 constexpr std::int64_t kEpochNs = 1000000000000LL;  // t0 = 1000 s
 
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 struct Options {
   std::string urdf, output;
   std::string sensor_frame = "panda_link8", tcp_frame = "panda_hand_tcp";
@@ -99,35 +98,6 @@ struct Options {
   bool effort = false;
 };
 
-// --key value or --key=value, each known key at most once; flags take no value.
-std::map<std::string, std::string> optionValues(int argc, char** argv,
-                                                const std::vector<std::string>& keys,
-                                                const std::vector<std::string>& flags) {
-  std::map<std::string, std::string> values;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const std::size_t eq = arg.find('=');
-    const std::string key = arg.compare(0, 2, "--") == 0 ? arg.substr(0, eq) : arg;
-    bool known = false, flag = false;
-    for (const std::string& k : keys) known = known || k == key;
-    for (const std::string& k : flags) flag = flag || k == arg;
-    if (!known && !flag)
-      throw UsageError(arg.compare(0, 1, "-") == 0 ? "unknown option '" + arg + "'"
-                                                   : "unexpected argument '" + arg + "'");
-    std::string value = "1";
-    if (!flag) {
-      if (eq != std::string::npos) {
-        value = arg.substr(eq + 1);
-      } else {
-        if (i + 1 >= argc) throw UsageError(key + " needs a value");
-        value = argv[++i];
-      }
-      if (value.empty()) throw UsageError(key + ": empty value");
-    }
-    if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
-  }
-  return values;
-}
 
 double parseNumber(const std::string& key, const std::string& text) {
   char* end = nullptr;
@@ -178,20 +148,7 @@ Options parseOptions(int argc, char** argv) {
   return options;
 }
 
-/// Uniform numbers in [0, 1) with 53 random bits, the same from every standard library.
-class Uniform {
- public:
-  explicit Uniform(std::uint32_t seed) : generator_(seed) {}
-  double operator()() {
-    const std::uint32_t a = static_cast<std::uint32_t>(generator_()) >> 5;  // 27 bits
-    const std::uint32_t b = static_cast<std::uint32_t>(generator_()) >> 6;  // 26 bits
-    return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
-  }
-  double operator()(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
-
- private:
-  std::mt19937 generator_;
-};
+using jle::Uniform;
 
 double homePosition(const std::string& joint) {
   static const std::map<std::string, double> kReady = {

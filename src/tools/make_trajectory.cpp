@@ -1,5 +1,6 @@
 // make_trajectory: a deterministic analytic joint-state CSV (and optionally an applied
 // wrench) for joint_loads. The formula is in kUsage and docs/joint_loads.md.
+#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -102,20 +103,7 @@ Options parseOptions(int argc, char** argv) {
   return options;
 }
 
-/// Uniform numbers in [0, 1) with 53 random bits, the same from every standard library.
-class Uniform {
- public:
-  explicit Uniform(std::uint32_t seed) : generator_(seed) {}
-  double operator()() {
-    const std::uint32_t a = static_cast<std::uint32_t>(generator_()) >> 5;  // 27 bits
-    const std::uint32_t b = static_cast<std::uint32_t>(generator_()) >> 6;  // 26 bits
-    return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
-  }
-  double operator()(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
-
- private:
-  std::mt19937 generator_;
-};
+using jle::Uniform;
 
 struct Sine {
   double amplitude = 0.0, omega = 0.0, phase = 0.0;
