@@ -1,0 +1,90 @@
+// Force plates: what a plate measures, its centre of pressure, and the reaction it
+// applies to the foot standing on it. ROS-free.
+//
+// Conventions (README, "Force plates"):
+// - The plate frame's z axis is the outward normal of the contact surface (pointing
+//   out of the plate, towards the foot). A plate whose own z axis points down (AMTI,
+//   Bertec) is given a plate frame rotated by pi about x in tf2 or in the config.
+// - A plate reports the wrench the foot applies TO the plate, expressed in the plate
+//   frame, moment about the plate origin (which may lie below the surface:
+//   surface_height is the surface's z in the plate frame).
+// - The foot receives the opposite wrench (the ground reaction).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <string>
+
+namespace jle {
+
+struct ForcePlateConfig {
+  std::string name;  ///< for messages and topics
+  std::string link;  ///< URDF link of the foot that stands on the plate (the reaction acts on it)
+  /// Pose of the plate frame in the world (a lab-fixed plate).
+  Eigen::Matrix3d R_world_plate = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_world_plate = Eigen::Vector3d::Zero();  ///< [m]
+  double surface_height = 0.0;  ///< [m] z of the contact surface in the plate frame
+  /// [N] below this force pressing into the plate there is no contact: the reading
+  /// (sensor noise, a swinging foot above it) is ignored.
+  double contact_threshold = 20.0;
+};
+
+/// One plate sample, decoded.
+struct PlateReading {
+  bool contact = false;
+  /// [N] force pressing into the plate (along -z of the plate frame); positive in contact.
+  double normal_force = 0.0;
+  /// [m] centre of pressure in the plate frame, on the surface (z = surface_height);
+  /// zero without contact.
+  Eigen::Vector3d cop_plate = Eigen::Vector3d::Zero();
+  /// [N m] free moment of the foot on the plate about the normal through the COP.
+  double free_moment = 0.0;
+  /// The ground reaction on the foot, plate frame, moment about the plate origin
+  /// [N, N m]; zero without contact.
+  Eigen::Vector3d force_on_foot_plate = Eigen::Vector3d::Zero();
+  Eigen::Vector3d moment_on_foot_plate = Eigen::Vector3d::Zero();
+};
+
+/// Decodes a plate sample: the wrench the foot applies to the plate (plate frame,
+/// moment about the plate origin). Non-finite input gives no contact.
+inline PlateReading readForcePlate(const ForcePlateConfig& plate, const Eigen::Vector3d& force_plate,
+                                   const Eigen::Vector3d& moment_plate) {
+  PlateReading r;
+  if (!force_plate.allFinite() || !moment_plate.allFinite()) return r;
+  r.normal_force = -force_plate.z();
+  if (!(r.normal_force >= plate.contact_threshold) || r.normal_force <= 0.0) return r;
+  r.contact = true;
+  // The point p on the surface z = h about which the foot's moment has no component
+  // in the plane: moment_plate = p x F + (0, 0, free_moment).
+  const double h = plate.surface_height;
+  const double fz = force_plate.z();
+  r.cop_plate.x() = (h * force_plate.x() - moment_plate.y()) / fz;
+  r.cop_plate.y() = (moment_plate.x() + h * force_plate.y()) / fz;
+  r.cop_plate.z() = h;
+  r.free_moment = moment_plate.z() -
+                  (r.cop_plate.x() * force_plate.y() - r.cop_plate.y() * force_plate.x());
+  r.force_on_foot_plate = -force_plate;
+  r.moment_on_foot_plate = -moment_plate;
+  return r;
+}
+
+/// The ground reaction of a plate reading in the world frame, moment about the world
+/// point `point_world` [m] (e.g. the foot link's origin). Exact: the moment is carried
+/// from the COP, so no large lever arm about a far origin enters.
+inline void plateReactionInWorld(const ForcePlateConfig& plate, const PlateReading& reading,
+                                 const Eigen::Vector3d& point_world, Eigen::Vector3d& force_world,
+                                 Eigen::Vector3d& moment_world) {
+  if (!reading.contact) {
+    force_world.setZero();
+    moment_world.setZero();
+    return;
+  }
+  force_world.noalias() = plate.R_world_plate * reading.force_on_foot_plate;
+  const Eigen::Vector3d cop_world = plate.p_world_plate + plate.R_world_plate * reading.cop_plate;
+  // On the foot: the reaction force at the COP plus the opposite free moment about the normal.
+  const Eigen::Vector3d free_world = plate.R_world_plate.col(2) * (-reading.free_moment);
+  moment_world = (cop_world - point_world).cross(force_world) + free_world;
+}
+
+}  // namespace jle
