@@ -10,6 +10,11 @@
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
+#include <kdl/frames.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/tree.hpp>
+#include <kdl/treefksolverpos_recursive.hpp>
+#include <kdl_parser/kdl_parser.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -296,6 +301,37 @@ TEST_F(BodyTool, SubtalarJointTurnsTheSoleMedially) {
     const Vector3d d = linkWorld(model, pose(model, "subtalar_inversion_" + s, 10.0), "heel_" + s) -
                        linkWorld(model, pose(model, "", 0.0), "heel_" + s);
     EXPECT_NEAR(d.y(), side * hf * s10, 1e-14);
+  }
+}
+
+// What robot_state_publisher (KDL) makes of the file, so that rviz draws what the
+// estimator computes: every joint, and every link's pose at an arbitrary q, agree.
+TEST(Body, KdlReadsTheSameTree) {
+  const jle::Model<double> model = bundled();
+  KDL::Tree tree;
+  ASSERT_TRUE(kdl_parser::treeFromFile(kBundled, tree));
+  EXPECT_EQ(tree.getNrOfJoints(), 10u);
+  EXPECT_EQ(tree.getRootSegment()->first, "pelvis");
+  // q: 0.1 k - 0.45 rad for the k-th coordinate (neither side enforces the limits).
+  jle::VectorX<double> q(model.nq);
+  for (int k = 0; k < model.nq; ++k) q[k] = 0.1 * k - 0.45;
+  KDL::JntArray kq(tree.getNrOfJoints());
+  for (const auto& entry : tree.getSegments()) {
+    const KDL::Joint& joint = entry.second.segment.getJoint();
+    if (joint.getType() == KDL::Joint::None) continue;
+    const int s = model.segmentOfJoint(joint.getName());
+    kq(entry.second.q_nr) = q[model.coordinate[s]];
+  }
+  jle::Data<double> data(model);
+  const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
+  jle::forwardKinematics(model, data, q, zero, zero, Vector3d(0.0, 0.0, -kG));
+  KDL::TreeFkSolverPos_recursive fk(tree);
+  for (const jle::Frame<double>& f : model.frames) {
+    KDL::Frame pose;
+    ASSERT_GE(fk.JntToCart(kq, pose, f.name), 0) << f.name;
+    const Vector3d ours = linkWorld(model, data, f.name);
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(ours[i], pose.p(i), 1e-14) << f.name << " " << i;  // [m] under 1 m
   }
 }
 
