@@ -35,11 +35,12 @@ trap cleanup EXIT
 
 roscore -p "$port" >"$ROS_HOME/roscore.log" 2>&1 &
 core_pid=$!
-for _ in $(seq 100); do
+for _ in $(seq 100); do  # up to 10 s for the master
   rosparam list >/dev/null 2>&1 && break
   kill -0 "$core_pid" 2>/dev/null || { cat "$ROS_HOME/roscore.log"; echo "roscore died"; exit 1; }
   sleep 0.1
 done
+rosparam list >/dev/null 2>&1 || { echo "FAILED: no ROS master on $ROS_MASTER_URI"; exit 1; }
 rosparam set -t "$urdf" /robot_description
 rosparam load "$config" /joint_load_estimator
 
