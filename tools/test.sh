@@ -28,12 +28,16 @@ bash "$repo/tools/accuracy.sh" --quick >"$ws/accuracy_quick.log" 2>&1 ||
   { tail -20 "$ws/accuracy_quick.log"; echo "accuracy --quick failed"; bench_status=1; }
 bash "$repo/tools/stability.sh" --quick >"$ws/stability_quick.log" 2>&1 ||
   { tail -20 "$ws/stability_quick.log"; echo "stability --quick failed"; bench_status=1; }
-# Robustness: the soak (1e6 samples with bad messages mixed in), the fuzzers
+# Robustness: the soaks (1e6 samples with bad messages mixed in, in process and
+# through the real node over ROS), the fuzzers
 # (regressions first, then 30 s each), the unit tests under ASan + UBSan (a second
 # workspace).
 "$ws/devel/lib/joint_load_estimator/soak" >"$ws/soak.log" 2>&1 ||
   { tail -20 "$ws/soak.log"; echo "soak failed (log: $ws/soak.log)"; bench_status=1; }
 tail -12 "$ws/soak.log" || true
+bash "$repo/test/soak/node_soak.sh" >"$ws/node_soak.log" 2>&1 ||
+  { tail -30 "$ws/node_soak.log"; echo "node soak failed (log: $ws/node_soak.log)"; bench_status=1; }
+tail -20 "$ws/node_soak.log" || true
 bash "$repo/test/fuzz/build_and_run.sh" 30 >"$ws/fuzz.log" 2>&1 ||
   { tail -30 "$ws/fuzz.log"; echo "fuzzing failed (log: $ws/fuzz.log)"; bench_status=1; }
 grep -E "^(fuzz|#[0-9]+ +DONE)" "$ws/fuzz.log" | tail -6 || true
