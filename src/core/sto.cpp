@@ -116,8 +116,8 @@ std::vector<std::string> stoColumnNames(const Model<double>& model,
       else throw std::invalid_argument("no .sto name for column '" + name + "'");
       continue;
     }
-    int segment = -1;
-    for (int s : model.moving_segments)
+    int segment = -1;  // a moving joint, or a fixed one kept as a segment (process_bag)
+    for (int s = 1; s < model.nsegments(); ++s)
       if (model.joint_name[s] == head) segment = s;
     if (segment < 0) throw std::invalid_argument("no .sto name for column '" + name + "'");
     const bool prismatic = model.joint_type[segment] == JointType::kPrismatic;
