@@ -101,6 +101,8 @@ class CsvWriter {
   void writeHeader(const std::vector<std::string>& names);
   /// One record of `count` numbers. Does not allocate once the first row is written.
   void writeRow(const double* values, std::size_t count);
+  /// Text written as it is (another format's header or body, e.g. sto.hpp).
+  void writeText(std::string_view text);
   /// Flushes, syncs and renames the file onto the path (flushes standard output).
   /// Throws CsvError on any write error.
   void commit();
@@ -126,10 +128,30 @@ struct StateColumns {
     std::array<int, 6> column{};
   };
   int t = -1;
+  /// A floating base (ExtraStateInputs::floating_base), -1 where absent: the root link's
+  /// pose base.x, .y, .z, .qx, .qy, .qz, .qw; its twist base.vx, .vy, .vz, .wx, .wy, .wz
+  /// and its acceleration base.ax, .ay, .az, .alx, .aly, .alz, each all six or none.
+  std::array<int, 7> base_pose{-1, -1, -1, -1, -1, -1, -1};
+  std::array<int, 6> base_twist{-1, -1, -1, -1, -1, -1};
+  std::array<int, 6> base_acceleration{-1, -1, -1, -1, -1, -1};
+  bool hasBaseTwist() const { return base_twist[0] >= 0; }
+  bool hasBaseAcceleration() const { return base_acceleration[0] >= 0; }
+  /// Per plate of ExtraStateInputs::plates: plate@NAME.fx, .fy, .fz, .mx, .my, .mz.
+  std::vector<std::array<int, 6>> plates;
   /// Per coordinate (size model.nq, the order of model.coordinate_names): the columns of
   /// JOINT.q, JOINT.qd, JOINT.qdd.
   std::vector<int> q, qd, qdd;
   std::vector<WrenchColumns> wrenches;  ///< in the order of their first column
+};
+
+/// What a joint-state CSV may hold beyond the joints and the wrenches.
+struct ExtraStateInputs {
+  /// The base floats: the base.* pose columns are required, twist and acceleration
+  /// optional. Without it a base.* column is refused.
+  bool floating_base = false;
+  /// Force plates: for each NAME, plate@NAME.fx ... .mz are required; a plate@ column
+  /// of another name is refused.
+  std::vector<std::string> plates;
 };
 
 /// Maps a joint-state CSV header onto `model`. Throws CsvError at line 1 naming the
@@ -137,7 +159,8 @@ struct StateColumns {
 /// unknown links in wrench@LINK, missing t or JOINT.q/qd/qdd of a joint that has its
 /// own coordinate, an incomplete wrench. Columns of mimic joints are accepted and
 /// ignored (a mimic follows its leader).
-StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader);
+StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader,
+                              const ExtraStateInputs& extra = {});
 
 /// Header of a joint-state CSV: t, JOINT.q, JOINT.qd, JOINT.qdd per coordinate (the
 /// order of model.coordinate_names), then the six columns of each wrench link.

@@ -53,6 +53,8 @@ struct Model {
   std::vector<JointType> joint_type;
   std::vector<std::string> link_name;   ///< URDF link whose frame is the segment frame
   std::vector<std::string> joint_name;  ///< URDF joint entering the segment ("" for the root)
+  /// URDF parent link of that joint ("" for the root): the frame WrenchFrame::kParent names.
+  std::vector<std::string> parent_link_name;
   std::vector<Matrix3> R_parent_joint;  ///< joint frame at q = 0 in the parent segment frame
   std::vector<Vector3> p_parent_joint;  ///< joint origin in the parent segment frame [m]
   /// Orientation of the joint's URDF parent link in the parent segment frame (identity
@@ -161,6 +163,7 @@ struct Model {
     out.joint_type = joint_type;
     out.link_name = link_name;
     out.joint_name = joint_name;
+    out.parent_link_name = parent_link_name;
     out.coordinate = coordinate;
     out.coordinate_names = coordinate_names;
     out.moving_segments = moving_segments;

@@ -94,6 +94,11 @@ constexpr std::array<const char*, 6> kWrenchComponents = {"fx", "fy", "fz", "mx"
 constexpr std::array<const char*, 3> kStateSuffixes = {"q", "qd", "qdd"};
 constexpr std::array<const char*, 7> kLoadSuffixes = {"fx", "fy", "fz", "mx", "my", "mz", "effort"};
 const std::string kWrenchPrefix = "wrench@";
+const std::string kBasePrefix = "base.";
+const std::string kPlatePrefix = "plate@";
+constexpr std::array<const char*, 7> kBasePose = {"x", "y", "z", "qx", "qy", "qz", "qw"};
+constexpr std::array<const char*, 6> kBaseTwist = {"vx", "vy", "vz", "wx", "wy", "wz"};
+constexpr std::array<const char*, 6> kBaseAcceleration = {"ax", "ay", "az", "alx", "aly", "alz"};
 
 template <std::size_t N>
 int indexOf(const std::array<const char*, N>& names, std::string_view name) {
@@ -325,6 +330,11 @@ void CsvWriter::writeRow(const double* values, std::size_t count) {
   put();
 }
 
+void CsvWriter::writeText(std::string_view text) {
+  line_.assign(text.data(), text.size());
+  put();
+}
+
 void CsvWriter::commit() {
   const std::string where = path_.empty() ? std::string("standard output") : path_;
   if (std::fflush(file_) != 0 || std::ferror(file_))
@@ -344,8 +354,10 @@ void CsvWriter::commit() {
 
 // ---------------------------------------------------------------------------- layout
 
-StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader) {
+StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader,
+                              const ExtraStateInputs& extra) {
   StateColumns out;
+  out.plates.assign(extra.plates.size(), {-1, -1, -1, -1, -1, -1});
   out.q.assign(static_cast<std::size_t>(model.nq), -1);
   out.qd.assign(static_cast<std::size_t>(model.nq), -1);
   out.qdd.assign(static_cast<std::size_t>(model.nq), -1);
@@ -359,6 +371,39 @@ StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reade
     }
     const std::size_t dot = name.rfind('.');
     const std::string suffix = dot == std::string::npos ? "" : name.substr(dot + 1);
+    // base.x ... base.alz (never base.q, base.qd, base.qdd: a joint may be named "base").
+    const std::string part =
+        name.compare(0, kBasePrefix.size(), kBasePrefix) == 0 ? name.substr(kBasePrefix.size()) : "";
+    const int pose_index = indexOf(kBasePose, part);
+    const int twist_index = indexOf(kBaseTwist, part);
+    const int acceleration_index = indexOf(kBaseAcceleration, part);
+    if (pose_index >= 0 || twist_index >= 0 || acceleration_index >= 0) {
+      if (!extra.floating_base)
+        problems.add(name, "a floating-base column, but the base is fixed (see --floating-base)");
+      else if (pose_index >= 0)
+        out.base_pose[static_cast<std::size_t>(pose_index)] = c;
+      else if (twist_index >= 0)
+        out.base_twist[static_cast<std::size_t>(twist_index)] = c;
+      else
+        out.base_acceleration[static_cast<std::size_t>(acceleration_index)] = c;
+      continue;
+    }
+    if (name.compare(0, kPlatePrefix.size(), kPlatePrefix) == 0) {
+      const int component = indexOf(kWrenchComponents, suffix);
+      if (dot == std::string::npos || dot <= kPlatePrefix.size() || component < 0) {
+        problems.add(name, "expected plate@NAME.fx, .fy, .fz, .mx, .my or .mz");
+        continue;
+      }
+      const std::string plate = name.substr(kPlatePrefix.size(), dot - kPlatePrefix.size());
+      const auto p = std::find(extra.plates.begin(), extra.plates.end(), plate);
+      if (p == extra.plates.end()) {
+        problems.add(name, "unknown plate '" + plate + "' (no --plate " + plate + "=...)");
+        continue;
+      }
+      out.plates[static_cast<std::size_t>(p - extra.plates.begin())]
+                [static_cast<std::size_t>(component)] = c;
+      continue;
+    }
     if (name.compare(0, kWrenchPrefix.size(), kWrenchPrefix) == 0) {
       const int component = indexOf(kWrenchComponents, suffix);
       if (dot == std::string::npos || dot <= kWrenchPrefix.size() || component < 0) {
@@ -425,6 +470,36 @@ StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reade
       if (w.column[i] < 0) absent.push_back(kWrenchPrefix + w.link + "." + kWrenchComponents[i]);
     if (!absent.empty())
       problems.add("wrench@" + w.link + ": missing " +
+                   (absent.size() == 1 ? "column " : "columns ") + nameList(absent) +
+                   " (all six components are required)");
+  }
+  if (extra.floating_base) {
+    std::vector<std::string> absent;
+    for (std::size_t i = 0; i < kBasePose.size(); ++i)
+      if (out.base_pose[i] < 0) absent.push_back(kBasePrefix + kBasePose[i]);
+    if (!absent.empty())
+      problems.add("floating base: missing " + std::string(absent.size() == 1 ? "column " : "columns ") +
+                   nameList(absent) + " (the root link's pose is required)");
+    const auto group = [&](const std::array<int, 6>& cols, const std::array<const char*, 6>& names,
+                           const char* what) {
+      std::vector<std::string> missing_part, present;
+      for (std::size_t i = 0; i < 6; ++i)
+        (cols[i] < 0 ? missing_part : present).push_back(kBasePrefix + names[i]);
+      if (!present.empty() && !missing_part.empty())
+        problems.add(std::string("floating base ") + what + ": missing " +
+                     (missing_part.size() == 1 ? "column " : "columns ") + nameList(missing_part) +
+                     " (all six or none)");
+    };
+    group(out.base_twist, kBaseTwist, "twist");
+    group(out.base_acceleration, kBaseAcceleration, "acceleration");
+    // A group given in part counts as absent for the caller; the header is refused anyway.
+  }
+  for (std::size_t p = 0; p < extra.plates.size(); ++p) {
+    std::vector<std::string> absent;
+    for (std::size_t i = 0; i < 6; ++i)
+      if (out.plates[p][i] < 0) absent.push_back(kPlatePrefix + extra.plates[p] + "." + kWrenchComponents[i]);
+    if (!absent.empty())
+      problems.add("plate " + extra.plates[p] + ": missing " +
                    (absent.size() == 1 ? "column " : "columns ") + nameList(absent) +
                    " (all six components are required)");
   }

@@ -206,6 +206,7 @@ struct Builder {
     model.joint_type.push_back(type);
     model.link_name.push_back(link);
     model.joint_name.push_back(joint);
+    model.parent_link_name.emplace_back();
     model.R_parent_joint.push_back(Matrix3::Identity());
     model.p_parent_joint.push_back(Vector3::Zero());
     model.R_parentsegment_parentlink.push_back(Matrix3::Identity());
@@ -283,6 +284,7 @@ struct Builder {
       model.R_parent_joint[s] = X.R;
       model.p_parent_joint[s] = X.p;
       model.R_parentsegment_parentlink[s] = pending.X_segment_parent.R;
+      model.parent_link_name[s] = joint.parent;
       if (isMoving(type)) {
         const double norm = joint.axis.norm();
         if (!(norm > 1e-12)) fail(what + ": axis of zero length");

@@ -7,6 +7,7 @@
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/ros/message_inputs.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
@@ -36,7 +37,8 @@ using jle::cli::optionValues;
 
 const char* const kUsage =
     R"(usage: process_bag --bag IN.bag --urdf ROBOT.urdf [--config CONFIG.yaml]
-                   [--output OUT.bag | --csv OUT.csv] [--topic-prefix /joint_load_estimator]
+                   [--output OUT.bag | --csv OUT.csv] [--sto OUT.sto]
+                   [--topic-prefix /joint_load_estimator]
 
 Runs the joint_load_estimator node's estimate over a bag, offline and as fast as the
 machine allows: the joint states and the configured wrench topics are read in the
@@ -56,8 +58,12 @@ publishes when the bag is played to it, without the timing of a live system.
                        joint JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort (the columns of
                        joint_loads; wrenches in the child link frame, moment about the
                        joint origin), %.17g
-                       Both outputs are written beside PATH and renamed onto it on
-                       success only. With neither, the loads are computed and counted.
+  --sto PATH           also (or only) write them as an OpenSim storage file: the
+                       same numbers, tab-separated, under OpenSim's column names
+                       (time, JOINT_moment or JOINT_force, and
+                       JOINT_on_CHILD_in_CHILD_fx ... _mz; docs/joint_loads.md)
+                       Every output is written beside PATH and renamed onto it on
+                       success only. With none, the loads are computed and counted.
   --topic-prefix NS    namespace of the output topic (default /joint_load_estimator)
   --help               this text
 
@@ -75,14 +81,15 @@ culprit); 2 a usage error.
 )";
 
 struct Options {
-  std::string bag, urdf, config, output, csv;
+  std::string bag, urdf, config, output, csv, sto;
   std::string prefix = "/joint_load_estimator";
 };
 
 
 Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = optionValues(
-      argc, argv, {"--bag", "--urdf", "--config", "--output", "--csv", "--topic-prefix"});
+      argc, argv,
+      {"--bag", "--urdf", "--config", "--output", "--csv", "--sto", "--topic-prefix"});
   Options o;
   if (!v.count("--bag")) throw UsageError("--bag IN.bag is required");
   if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
@@ -93,6 +100,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--config")) o.config = v["--config"];
   if (v.count("--output")) o.output = v["--output"];
   if (v.count("--csv")) o.csv = v["--csv"];
+  if (v.count("--sto")) o.sto = v["--sto"];
   if (v.count("--topic-prefix")) o.prefix = v["--topic-prefix"];
   if (o.prefix[0] != '/') o.prefix = "/" + o.prefix;
   while (o.prefix.size() > 1 && o.prefix.back() == '/') o.prefix.pop_back();
@@ -296,13 +304,18 @@ class BagProcessor {
       }
       out_topic_ = options_.prefix + "/joint_loads";
     }
+    std::vector<std::string> names{"t"};
+    for (const std::string& joint : loads_.name)
+      for (const char* c : {".fx", ".fy", ".fz", ".mx", ".my", ".mz", ".effort"})
+        names.push_back(joint + c);
     if (!options_.csv.empty()) {
       csv_ = std::make_unique<jle::CsvWriter>(options_.csv);
-      std::vector<std::string> names{"t"};
-      for (const std::string& joint : loads_.name)
-        for (const char* c : {".fx", ".fy", ".fz", ".mx", ".my", ".mz", ".effort"})
-          names.push_back(joint + c);
       csv_->writeHeader(names);
+    }
+    if (!options_.sto.empty()) {
+      sto_ = std::make_unique<jle::StoWriter>(options_.sto);
+      sto_->writeHeader(
+          jle::stoColumnNames(estimator_.model(), names, jle::WrenchFrame::kChild));
     }
   }
 
@@ -316,6 +329,7 @@ class BagProcessor {
       bag_temporary_.clear();
     }
     if (csv_) csv_->commit();
+    if (sto_) sto_->commit();
   }
 
   // Once per kind of problem, with the count in the summary (the node throttles). The
@@ -434,7 +448,7 @@ class BagProcessor {
 
   void write() {
     ++counters_.published;
-    if (!out_bag_ && !csv_) return;
+    if (!out_bag_ && !csv_ && !sto_) return;
     const jle::Data<double>& data = estimator_.data();
     const double stamp = estimator_.stamp();
     // The measured efforts that belong to the stamp the estimate describes (as the node).
@@ -463,6 +477,7 @@ class BagProcessor {
           measured ? (*measured)[i] : std::numeric_limits<double>::quiet_NaN();
     }
     if (csv_) csv_->writeRow(row_.data(), row_.size());
+    if (sto_) sto_->writeRow(row_.data(), row_.size());
     if (out_bag_) {
       loads_.header.stamp = t;
       loads_.header.seq = static_cast<std::uint32_t>(counters_.published - 1);
@@ -475,6 +490,7 @@ class BagProcessor {
     const double samples = static_cast<double>(counters_.joint_states);
     const std::string to = !options_.output.empty() ? " to " + options_.output
                            : !options_.csv.empty()  ? " to " + options_.csv
+                           : !options_.sto.empty()  ? " to " + options_.sto
                                                     : " (not written)";
     std::fprintf(stderr,
                  "process_bag: %ld joint states, %ld wrenches -> %ld loads%s\n"
@@ -517,6 +533,7 @@ class BagProcessor {
   std::unique_ptr<rosbag::Bag> out_bag_;
   std::string bag_temporary_, out_topic_;
   std::unique_ptr<jle::CsvWriter> csv_;
+  std::unique_ptr<jle::StoWriter> sto_;
   bool have_last_ = false;
   ros::Time time_ref_;  // origin of the estimator's time axis
   double last_t_ = 0.0;

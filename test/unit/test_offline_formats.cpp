@@ -1,0 +1,546 @@
+// joint_loads' floating base and force plates, per-kg efforts, and the OpenSim storage
+// files of joint_loads and process_bag, run as processes. Expected values are worked by
+// hand in the tests (Newton-Euler of one rigid body; the statics of a standing body),
+// not taken from the library.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kData = JLE_TEST_DATA;
+const std::string kFreeBody = kData + "/urdf/free_body.urdf";
+const std::string kStand = kData + "/urdf/two_leg_stand.urdf";
+const std::string kPandaDemo = kData + "/urdf/panda_demo.urdf";
+constexpr double kG = 9.80665;
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string num(double x) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", x);
+  return b;
+}
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+// A table of text cells (a parser of the test's own), from CSV or from the body of a .sto.
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int column(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+  }
+  double number(std::size_t row, const std::string& name) const {
+    const int c = column(name);
+    EXPECT_GE(c, 0) << "no column " << name;
+    return c < 0 || row >= rows.size() ? NAN : std::strtod(rows[row][c].c_str(), nullptr);
+  }
+};
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> cells;
+  std::stringstream s(line);
+  std::string cell;
+  while (std::getline(s, cell, sep)) cells.push_back(cell);
+  return cells;
+}
+
+Table parseCsv(const std::string& text) {
+  Table t;
+  std::stringstream s(text);
+  std::string line;
+  if (std::getline(s, line)) t.header = split(line, ',');
+  while (std::getline(s, line))
+    if (!line.empty()) t.rows.push_back(split(line, ','));
+  return t;
+}
+
+// A .sto: the header lines up to endheader, then a tab-separated table.
+struct Sto {
+  std::vector<std::string> header_lines;
+  Table table;
+};
+
+Sto parseSto(const std::string& text) {
+  Sto sto;
+  std::stringstream s(text);
+  std::string line;
+  while (std::getline(s, line)) {
+    if (line == "endheader") break;
+    sto.header_lines.push_back(line);
+  }
+  if (std::getline(s, line)) sto.table.header = split(line, '\t');
+  while (std::getline(s, line))
+    if (!line.empty()) sto.table.rows.push_back(split(line, '\t'));
+  return sto;
+}
+
+class OfflineFormatsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/jle_test_offline_XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name), std::ios::binary) << text;
+  }
+  Result run(const std::string& program, const std::vector<std::string>& args) const {
+    std::string command = quote(program);
+    for (const std::string& a : args) command += " " + quote(a);
+    command += " >" + quote(path("stdout.txt")) + " 2>" + quote(path("stderr.txt"));
+    const int raw = std::system(command.c_str());
+    Result r;
+    r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = readFile(path("stdout.txt"));
+    r.err = readFile(path("stderr.txt"));
+    return r;
+  }
+  Result jointLoads(const std::vector<std::string>& args) const { return run(JLE_JOINT_LOADS, args); }
+  std::string dir_;
+};
+
+// ------------------------------------------------------------- one free rigid body
+
+// The free body's fixture: m = 2 kg, centre of mass c = (0.1, 0, 0) in the link frame,
+// inertia about it diag(0.01, 0.02, 0.03).
+const double kMass = 2.0;
+const Eigen::Vector3d kCom(0.1, 0.0, 0.0);
+const Eigen::Matrix3d kInertia = Eigen::Vector3d(0.01, 0.02, 0.03).asDiagonal();
+
+// What the world must apply to a free rigid body (Newton-Euler, world frame, moment
+// about the link origin): F = m (a_G - g), M = J_G alpha + w x J_G w + c_w x F with
+// a_G = a + alpha x c_w + w x (w x c_w), c_w = R c, J_G = R J R^T.
+void freeBodyResidual(const Eigen::Matrix3d& R, const Eigen::Vector3d& a, const Eigen::Vector3d& w,
+                      const Eigen::Vector3d& alpha, Eigen::Vector3d& F, Eigen::Vector3d& M) {
+  const Eigen::Vector3d c = R * kCom;
+  const Eigen::Matrix3d J = R * kInertia * R.transpose();
+  const Eigen::Vector3d a_G = a + alpha.cross(c) + w.cross(w.cross(c));
+  F = kMass * (a_G - Eigen::Vector3d(0, 0, -kG));
+  M = J * alpha + w.cross(J * w) + c.cross(F);
+}
+
+const char* const kBaseHeader =
+    "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw,base.vx,base.vy,base.vz,"
+    "base.wx,base.wy,base.wz,base.ax,base.ay,base.az,base.alx,base.aly,base.alz";
+
+TEST_F(OfflineFormatsTest, FreeBodyResidualIsNewtonEuler) {
+  // Two states, the second turned and spinning about a skew axis (the gyroscopic term
+  // and the rotation of J_G both enter).
+  struct State {
+    Eigen::Quaterniond q;
+    Eigen::Vector3d p, v, w, a, alpha;
+  };
+  const std::vector<State> states = {
+      {Eigen::Quaterniond::Identity(), {0, 0, 1}, {0, 0, 0}, {0, 0, 2}, {1, 2, 3}, {0, 0, 5}},
+      {Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
+       {0.3, -0.2, 1.1}, {0.5, 0, 0}, {1.5, -0.5, 0.8}, {-2, 0.5, 1}, {3, -1, 2}}};
+  std::string csv = std::string(kBaseHeader) + "\n";
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const State& s = states[i];
+    csv += num(0.1 * i);
+    for (double x : {s.p.x(), s.p.y(), s.p.z(), s.q.x(), s.q.y(), s.q.z(), s.q.w(), s.v.x(),
+                     s.v.y(), s.v.z(), s.w.x(), s.w.y(), s.w.z(), s.a.x(), s.a.y(), s.a.z(),
+                     s.alpha.x(), s.alpha.y(), s.alpha.z()})
+      csv += "," + num(x);
+    csv += "\n";
+  }
+  write("in.csv", csv);
+  const Result r = jointLoads({"--urdf", kFreeBody, "--input", path("in.csv"), "--floating-base"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table t = parseCsv(r.out);
+  ASSERT_EQ(t.rows.size(), states.size());
+  EXPECT_EQ(t.header, (std::vector<std::string>{"t", "base.fx", "base.fy", "base.fz", "base.mx",
+                                                "base.my", "base.mz"}));
+  // The first state by hand: c = (0.1, 0, 0); a_G = a + alpha x c + w x (w x c) =
+  // (1, 2, 3) + (0, 0.5, 0) + (-0.4, 0, 0); F = 2 (0.6, 2.5, 3 + g);
+  // M = (0, 0, 0.03 * 5) + c x F = (0, -0.1 F_z, 0.15 + 0.1 F_y).
+  // 1e-12: a few roundings of numbers of order 30.
+  EXPECT_NEAR(t.number(0, "base.fx"), 1.2, 1e-12);
+  EXPECT_NEAR(t.number(0, "base.fy"), 5.0, 1e-12);
+  EXPECT_NEAR(t.number(0, "base.fz"), 2 * (3 + kG), 1e-12);
+  EXPECT_NEAR(t.number(0, "base.mx"), 0.0, 1e-12);
+  EXPECT_NEAR(t.number(0, "base.my"), -0.2 * (3 + kG), 1e-12);
+  EXPECT_NEAR(t.number(0, "base.mz"), 0.15 + 0.5, 1e-12);
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const State& s = states[i];
+    Eigen::Vector3d F, M;
+    freeBodyResidual(s.q.toRotationMatrix(), s.a, s.w, s.alpha, F, M);
+    const char* names[] = {"base.fx", "base.fy", "base.fz", "base.mx", "base.my", "base.mz"};
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(t.number(i, names[k]), F[k], 1e-12) << i << names[k];
+      EXPECT_NEAR(t.number(i, names[k + 3]), M[k], 1e-12) << i << names[k + 3];
+    }
+  }
+}
+
+// Pose only: the twist and the acceleration estimated from the rows (three-point
+// quadratic, docs/joint_loads.md), on a non-uniform time grid, the quaternion's sign
+// flipped on every other row. The motion: p = (A sin wt, 0, 1 + A cos wt), a turn
+// theta = C sin wt about the fixed unit axis u.
+TEST_F(OfflineFormatsTest, PoseOnlyBaseMotionIsEstimatedWithinTheMethodsOrder) {
+  const double A = 0.1, C = 0.3, w = M_PI, h = 0.01;
+  const Eigen::Vector3d u = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const int n = 101;
+  std::vector<double> t(n);
+  for (int i = 0; i < n; ++i) t[i] = i * h + 0.2 * h * std::sin(1.7 * i);  // steps 0.6h .. 1.4h
+  std::string csv = "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n";
+  for (int i = 0; i < n; ++i) {
+    const double s = std::sin(w * t[i]), c = std::cos(w * t[i]);
+    Eigen::Quaterniond q(Eigen::AngleAxisd(C * s, u));
+    if (i % 2) q.coeffs() = -q.coeffs();
+    csv += num(t[i]) + "," + num(A * s) + ",0," + num(1 + A * c) + "," + num(q.x()) + "," +
+           num(q.y()) + "," + num(q.z()) + "," + num(q.w()) + "\n";
+  }
+  write("in.csv", csv);
+  const Result r = jointLoads({"--urdf", kFreeBody, "--input", path("in.csv"), "--floating-base"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table out = parseCsv(r.out);
+  ASSERT_EQ(out.rows.size(), static_cast<std::size_t>(n));
+  // Error bounds of the stencils (docs/joint_loads.md), per component, with the maxima
+  // of the derivatives: |x'''| <= A w^3 (position), C w^3 (angle), |x''''| <= A w^4, C w^4.
+  // Centred, steps h1, h2: first derivative h1 h2 |x'''|/6, second |h2 - h1| |x'''|/3 +
+  // (h1^2 + h2^2) |x''''|/12. One-sided (first, last row): first derivative
+  // h1 (h1 + h2) |x'''|/6, second (2 h1 + h2) |x'''|/3. A factor 2 covers the next terms.
+  double worst_force = 0, worst_moment = 0;
+  for (int i = 0; i < n; ++i) {
+    const int m = i == 0 ? 0 : i == n - 1 ? 2 : 1;
+    const int first = i - m;
+    const double h1 = t[first + 1] - t[first], h2 = t[first + 2] - t[first + 1];
+    double e1, e2;  // per unit of |x'''| (and |x''''| scaled by w)
+    if (m == 1) {
+      e1 = h1 * h2 / 6;
+      e2 = std::abs(h2 - h1) / 3 + (h1 * h1 + h2 * h2) * w / 12;
+    } else {
+      const double a = m == 0 ? h1 : h2, b = m == 0 ? h2 : h1;
+      e1 = a * (a + b) / 6;
+      e2 = (2 * a + b) / 3;
+    }
+    const double a_err = 2 * std::sqrt(2.0) * A * std::pow(w, 3) * e2;
+    const double w_err = 2 * C * std::pow(w, 3) * e1;
+    const double al_err = 2 * C * std::pow(w, 3) * e2;
+    const double s = std::sin(w * t[i]), c = std::cos(w * t[i]);
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(C * s, u).toRotationMatrix();
+    const Eigen::Vector3d a(-A * w * w * s, 0, -A * w * w * c);
+    const Eigen::Vector3d om = u * (C * w * c), al = u * (-C * w * w * s);
+    Eigen::Vector3d F, M;
+    freeBodyResidual(R, a, om, al, F, M);
+    // |dF| <= m (|da| + |c| |dalpha| + 2 |c| |w| |dw|); |dM| <= |J| |dalpha| +
+    // 2 |J| |w| |dw| + |c| |dF|, with |c| = 0.1, |J| <= 0.03.
+    const double wmax = C * w;
+    const double bound_F = kMass * (a_err + 0.1 * al_err + 0.2 * wmax * w_err);
+    const double bound_M = 0.03 * al_err + 0.06 * wmax * w_err + 0.1 * bound_F;
+    const Eigen::Vector3d F_out(out.number(i, "base.fx"), out.number(i, "base.fy"),
+                                out.number(i, "base.fz"));
+    const Eigen::Vector3d M_out(out.number(i, "base.mx"), out.number(i, "base.my"),
+                                out.number(i, "base.mz"));
+    EXPECT_LE((F_out - F).norm(), bound_F) << "row " << i;
+    EXPECT_LE((M_out - M).norm(), bound_M) << "row " << i;
+    worst_force = std::max(worst_force, (F_out - F).norm() / bound_F);
+    worst_moment = std::max(worst_moment, (M_out - M).norm() / bound_M);
+  }
+  // The input moves: a residual of a body at rest (m g) would be off by m A w^2 ~ 2 N.
+  RecordProperty("worst_force_error_over_bound", std::to_string(worst_force));
+  RecordProperty("worst_moment_error_over_bound", std::to_string(worst_moment));
+}
+
+// ------------------------------------------------------- standing on two force plates
+
+// The two-leg fixture standing still, every angle zero, pelvis origin 0.9 m up: total
+// mass 22 kg, centre of mass x_G = (10 * 0.02 + 2 * 1 * 0.05) / 22 = 0.3 / 22 m. Each
+// plate carries half the weight at a COP under the centre of mass, x_c = x_G. The left
+// plate lies under the left ankle (0, 0.1, 0), yaw 0; the right one under the right
+// ankle (0, -0.1, 0), turned 90 degrees: its x axis is the world's y.
+const double kWeight = 22 * kG;
+const double kXc = 0.3 / 22;
+
+std::string standRow(double t, double left_fz, double left_mx, double left_my, double right_fz,
+                     double right_mx, double right_my) {
+  std::string row = num(t) + ",0,0,0.9,0,0,0,1,0,0,0,0,0,0,0,0,0,0,0,0";  // at rest
+  for (const char* j : {"hip_l", "ankle_l", "hip_r", "ankle_r"}) {
+    (void)j;
+    row += ",0,0,0";
+  }
+  for (double x : {0.0, 0.0, left_fz, left_mx, left_my, 0.0, 0.0, 0.0, right_fz, right_mx, right_my, 0.0})
+    row += "," + num(x);
+  return row + "\n";
+}
+
+std::string standCsv() {
+  std::string csv = kBaseHeader;
+  for (const char* j : {"hip_l", "ankle_l", "hip_r", "ankle_r"})
+    for (const char* s : {"q", "qd", "qdd"}) csv += std::string(",") + j + "." + s;
+  for (const char* p : {"left", "right"})
+    for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"})
+      csv += std::string(",plate@") + p + "." + c;
+  csv += "\n";
+  // Row 0: both feet, half the weight each. The foot pushes down, F = (0, 0, -W/2) in
+  // the plate frame; its moment about the plate origin is r x F with r the COP in the
+  // plate frame: left r = (x_c, 0, 0) -> (0, x_c W/2, 0); right (turned) r = (0, -x_c, 0)
+  // -> (x_c W/2, 0, 0).
+  csv += standRow(0.0, -kWeight / 2, 0, kXc * kWeight / 2, -kWeight / 2, kXc * kWeight / 2, 0);
+  // Row 1: all the weight on the left plate, COP at (x_c, -0.1) in its frame (under the
+  // centre of mass): r x F = (y F_z, -x F_z, 0) = (0.1 W, x_c W, 0);
+  // the right plate reads 5 N of noise, below the contact threshold.
+  csv += standRow(0.01, -kWeight, 0.1 * kWeight, kXc * kWeight, -5.0, 0, 0);
+  return csv;
+}
+
+const std::vector<std::string> kPlates = {"--plate", "left=foot_l,0,0.1,0", "--plate",
+                                          "right=foot_r,0,-0.1,0,90"};
+
+std::vector<std::string> standArgs(const std::string& input, std::vector<std::string> more = {}) {
+  std::vector<std::string> args = {"--urdf", kStand, "--input", input, "--floating-base"};
+  args.insert(args.end(), kPlates.begin(), kPlates.end());
+  args.insert(args.end(), more.begin(), more.end());
+  return args;
+}
+
+TEST_F(OfflineFormatsTest, StandingOnTwoPlatesLeavesNoResidualAndLoadsTheAnkles) {
+  write("in.csv", standCsv());
+  const Result r = jointLoads(standArgs(path("in.csv")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table t = parseCsv(r.out);
+  ASSERT_EQ(t.rows.size(), 2u);
+  // The plates explain the whole weight and its moment: 1e-11 covers rounding of terms
+  // of order W = 216 N.
+  for (std::size_t row = 0; row < 2; ++row)
+    for (const char* c : {"base.fx", "base.fy", "base.fz", "base.mx", "base.my", "base.mz"})
+      EXPECT_NEAR(t.number(row, c), 0.0, 1e-11) << row << " " << c;
+  // Row 0, the left foot (1 kg, centre of mass (0.05, 0, -0.05) from the ankle) in
+  // equilibrium under the ankle wrench, its weight and the reaction W/2 up at the COP,
+  // (x_c, 0, -0.1) from the ankle. About y: M + (-x_c W/2) + 0.05 g = 0 (r x F, y
+  // component z F_x - x F_z), so M_y = x_c W/2 - 0.05 g = 0.15 g - 0.05 g = 0.1 g; the
+  // force is (0, 0, -(W/2 - g)) (the leg holds the foot down against the push).
+  EXPECT_NEAR(t.number(0, "ankle_l.my"), 0.1 * kG, 1e-11);
+  EXPECT_NEAR(t.number(0, "ankle_l.effort"), 0.1 * kG, 1e-11);
+  EXPECT_NEAR(t.number(0, "ankle_l.fz"), -(kWeight / 2 - kG), 1e-11);
+  EXPECT_NEAR(t.number(0, "ankle_l.mx"), 0.0, 1e-11);
+  EXPECT_NEAR(t.number(0, "ankle_r.my"), 0.1 * kG, 1e-11);  // the turned plate, same load
+  // The left hip holds leg and foot: about y, the reaction at (x_c, 0, -0.9) from the
+  // hip gives -x_c W/2, the foot's weight at (0.05, 0, -0.85) gives 0.05 g, the leg's
+  // weight (on the hip's vertical) nothing: M_y = x_c W/2 - 0.05 g = 0.1 g again.
+  EXPECT_NEAR(t.number(0, "hip_l.my"), 0.1 * kG, 1e-11);
+  // COPs in the world, contact flags.
+  EXPECT_EQ(t.number(0, "plate@left.contact"), 1.0);
+  EXPECT_NEAR(t.number(0, "plate@left.cop_x"), kXc, 1e-14);
+  EXPECT_NEAR(t.number(0, "plate@left.cop_y"), 0.1, 1e-14);
+  EXPECT_NEAR(t.number(0, "plate@right.cop_x"), kXc, 1e-14);
+  EXPECT_NEAR(t.number(0, "plate@right.cop_y"), -0.1, 1e-14);
+  EXPECT_NEAR(t.number(0, "plate@right.cop_z"), 0.0, 1e-14);
+  // Row 1: the right foot in the air (5 N is below the 20 N threshold): no contact, its
+  // COP written as zeros, its ankle holds only the foot (M_y = -0.05 g: the foot's weight
+  // 5 cm forward pulls its toe down, about -y).
+  EXPECT_EQ(t.number(1, "plate@right.contact"), 0.0);
+  for (const char* c : {"plate@right.cop_x", "plate@right.cop_y", "plate@right.cop_z"})
+    EXPECT_EQ(t.number(1, c), 0.0) << c;
+  EXPECT_NEAR(t.number(1, "ankle_r.my"), -0.05 * kG, 1e-12);
+  EXPECT_NEAR(t.number(1, "ankle_r.fz"), kG, 1e-12);
+  EXPECT_NEAR(t.number(1, "plate@left.cop_y"), 0.0, 1e-14);
+  // With --contact-threshold 1 the 5 N count, and the residual shows them: the world
+  // must pull down by 5 N.
+  const Result r2 = jointLoads(standArgs(path("in.csv"), {"--contact-threshold", "1"}));
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  const Table t2 = parseCsv(r2.out);
+  EXPECT_EQ(t2.number(1, "plate@right.contact"), 1.0);
+  EXPECT_NEAR(t2.number(1, "base.fz"), -5.0, 1e-11);
+}
+
+TEST_F(OfflineFormatsTest, PerKgEffortsDivideByTheBodyMass) {
+  write("in.csv", standCsv());
+  Result r = jointLoads(standArgs(path("in.csv"), {"--per-kg"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  Table t = parseCsv(r.out);
+  // Default mass: the URDF's total, 22 kg. The ankle moment 0.1 g (above) per kg.
+  EXPECT_NEAR(t.number(0, "ankle_l.effort_per_kg"), 0.1 * kG / 22, 1e-12);
+  EXPECT_EQ(t.column("ankle_l.effort_per_kg"), t.column("ankle_l.effort") + 1);
+  r = jointLoads(standArgs(path("in.csv"), {"--per-kg", "--body-mass", "70"}));
+  ASSERT_EQ(r.status, 0) << r.err;
+  t = parseCsv(r.out);
+  EXPECT_NEAR(t.number(0, "ankle_l.effort_per_kg"), 0.1 * kG / 70, 1e-12);
+  EXPECT_NEAR(t.number(0, "hip_r.effort_per_kg"), t.number(0, "hip_r.effort") / 70, 1e-15);
+  // Without --per-kg no such column.
+  r = jointLoads(standArgs(path("in.csv")));
+  EXPECT_EQ(parseCsv(r.out).column("ankle_l.effort_per_kg"), -1);
+}
+
+// ------------------------------------------------------------------- OpenSim .sto
+
+void expectStoMatchesCsv(const Sto& sto, const Table& csv, const std::map<std::string, std::string>& names) {
+  // OpenSim's Storage header.
+  ASSERT_GE(sto.header_lines.size(), 5u);
+  EXPECT_EQ(sto.header_lines[0], "Inverse Dynamics Generalized Forces");
+  EXPECT_EQ(sto.header_lines[1], "version=1");
+  EXPECT_EQ(sto.header_lines[2], "nRows=" + std::to_string(csv.rows.size()));
+  EXPECT_EQ(sto.header_lines[3], "nColumns=" + std::to_string(csv.header.size()));
+  EXPECT_EQ(sto.header_lines[4], "inDegrees=no");
+  ASSERT_EQ(sto.table.header.size(), csv.header.size());
+  ASSERT_EQ(sto.table.rows.size(), csv.rows.size());
+  for (const auto& [csv_name, sto_name] : names) {
+    const int c = csv.column(csv_name), s = sto.table.column(sto_name);
+    ASSERT_GE(c, 0) << csv_name;
+    ASSERT_GE(s, 0) << sto_name;
+    for (std::size_t row = 0; row < csv.rows.size(); ++row)
+      EXPECT_EQ(sto.table.rows[row][s], csv.rows[row][c]) << sto_name << " row " << row;
+  }
+}
+
+TEST_F(OfflineFormatsTest, JointLoadsWritesOpenSimStorage) {
+  write("in.csv", standCsv());
+  for (const char* frame : {"child", "parent", "world"}) {
+    const Result csv = jointLoads(standArgs(path("in.csv"), {"--per-kg", "--frame", frame}));
+    ASSERT_EQ(csv.status, 0) << csv.err;
+    const Result sto = jointLoads(standArgs(
+        path("in.csv"), {"--per-kg", "--frame", frame, "--format", "sto", "--output", path("o.sto")}));
+    ASSERT_EQ(sto.status, 0) << sto.err;
+    const std::string in = std::string(frame) == "child"    ? "foot_l"
+                           : std::string(frame) == "parent" ? "leg_l"
+                                                            : "ground";
+    const Sto s = parseSto(readFile(path("o.sto")));
+    expectStoMatchesCsv(s, parseCsv(csv.out),
+                        {{"t", "time"},
+                         {"base.fx", "pelvis_tx_force"},
+                         {"base.fz", "pelvis_tz_force"},
+                         {"base.my", "pelvis_my_moment"},
+                         {"ankle_l.effort", "ankle_l_moment"},
+                         {"ankle_l.effort_per_kg", "ankle_l_moment_per_kg"},
+                         {"ankle_l.fz", "ankle_l_on_foot_l_in_" + in + "_fz"},
+                         {"ankle_l.my", "ankle_l_on_foot_l_in_" + in + "_my"},
+                         {"plate@left.contact", "left_contact"},
+                         {"plate@left.cop_x", "left_ground_force_px"},
+                         {"plate@right.cop_z", "right_ground_force_pz"}});
+    EXPECT_EQ(s.table.header[0], "time");
+  }
+}
+
+TEST_F(OfflineFormatsTest, ProcessBagWritesOpenSimStorage) {
+  Result r = run(JLE_MAKE_EXAMPLE_BAG,
+                 {"--urdf", kPandaDemo, "--samples", "200", "--output", path("in.bag")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run(JLE_PROCESS_BAG, {"--bag", path("in.bag"), "--urdf", kPandaDemo, "--csv",
+                            path("o.csv"), "--sto", path("o.sto")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table csv = parseCsv(readFile(path("o.csv")));
+  ASSERT_GT(csv.rows.size(), 10u);
+  expectStoMatchesCsv(parseSto(readFile(path("o.sto"))), csv,
+                      {{"t", "time"},
+                       {"panda_joint2.effort", "panda_joint2_moment"},
+                       {"panda_joint4.mx", "panda_joint4_on_panda_link4_in_panda_link4_mx"},
+                       {"panda_joint7.fz", "panda_joint7_on_panda_link7_in_panda_link7_fz"}});
+  // Only a .sto.
+  r = run(JLE_PROCESS_BAG,
+          {"--bag", path("in.bag"), "--urdf", kPandaDemo, "--sto", path("only.sto")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(readFile(path("only.sto")), readFile(path("o.sto")));
+}
+
+// ------------------------------------------------------------------------ refusals
+
+TEST_F(OfflineFormatsTest, RefusesBadPlatesBaseColumnsAndPlateNames) {
+  write("in.csv", standCsv());
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::string message;
+  };
+  const std::string in = path("in.csv");
+  const std::vector<Case> cases = {
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0.1"},
+       2, "--plate: 'left=foot_l,0,0.1' is not NAME=LINK,X,Y,Z[,YAW_DEG]"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,a,0"},
+       2, "--plate: 'left=foot_l,0,a,0'"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=toe,0,0,0"}, 2,
+       "--plate left: unknown link 'toe'"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0,0",
+        "--plate", "left=foot_r,0,0,0"},
+       2, "plate 'left' is given twice"},
+      // The CSV has plate@right.* columns, but only the left plate is declared.
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0.1,0"}, 1,
+       "in.csv:1: columns 'plate@right.fx', 'plate@right.fy', 'plate@right.fz', "
+       "'plate@right.mx', 'plate@right.my', 'plate@right.mz': unknown plate 'right'"},
+      // Base columns for a fixed base.
+      {{"--urdf", kStand, "--input", in, "--plate", "left=foot_l,0,0.1,0", "--plate",
+        "right=foot_r,0,-0.1,0,90"},
+       1, "a floating-base column, but the base is fixed"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--body-mass", "70"}, 2,
+       "--body-mass is only used with --per-kg"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--format", "mot"}, 2,
+       "--format: 'mot' is not csv or sto"},
+  };
+  for (const Case& c : cases) {
+    const Result r = jointLoads(c.args);
+    EXPECT_EQ(r.status, c.status) << c.message << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.rfind("joint_loads: ", 0), 0u) << r.err;
+  }
+  // Incomplete base pose and twist.
+  write("base.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.vx\n0,0,0,1,0,0,0,0\n");
+  Result r = jointLoads({"--urdf", kFreeBody, "--input", path("base.csv"), "--floating-base"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("base.csv:1: floating base: missing column 'base.qw' (the root link's "
+                       "pose is required); floating base twist: missing columns 'base.vy', "
+                       "'base.vz', 'base.wx', 'base.wy', 'base.wz' (all six or none)"),
+            std::string::npos)
+      << r.err;
+  // A quaternion that is not a unit one, named with its line.
+  write("q.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
+                 "0.1,0,0,1,0,0,0,2\n0.2,0,0,1,0,0,0,1\n");
+  r = jointLoads({"--urdf", kFreeBody, "--input", path("q.csv"), "--floating-base"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("q.csv:3: column 'base.qw': the quaternion"), std::string::npos) << r.err;
+  // Times that do not increase (the estimate needs them), and too few rows.
+  write("t.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
+                 "0.1,0,0,1,0,0,0,1\n0.1,0,0,1,0,0,0,1\n");
+  r = jointLoads({"--urdf", kFreeBody, "--input", path("t.csv"), "--floating-base"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("t.csv:4: column 't': time does not increase"), std::string::npos) << r.err;
+  write("two.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
+                   "0.1,0,0,1,0,0,0,1\n");
+  r = jointLoads({"--urdf", kFreeBody, "--input", path("two.csv"), "--floating-base",
+                  "--output", path("two.out")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("2 rows; estimating the base twist"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("two.out")));
+}
+
+}  // namespace
