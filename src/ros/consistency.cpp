@@ -3,6 +3,7 @@
 // their diagnostics, and the sensors' bias calibration (~calibrate_bias, bias_file).
 #include <joint_load_estimator/ros/estimator_node.hpp>
 
+#include <tf2_eigen/tf2_eigen.h>
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
