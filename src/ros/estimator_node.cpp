@@ -48,6 +48,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (const std::string& w : model.warnings) ROS_WARN("robot model: %s", w.c_str());
   if (model.floating_base && settings_.base_frame.empty())
     settings_.base_frame = model.link_name[0];
+  completeSensorLinks(model, settings_);
   estimator_ = std::make_unique<Estimator>(model, settings_.estimator);
 
   for (int i = 0; i < model.nq; ++i) coordinate_of_[model.coordinate_names[i]] = i;
