@@ -60,10 +60,11 @@ void addExternalWrench(const Model<Scalar>& model, Data<Scalar>& data, int frame
 
 namespace detail {
 
-// One segment of the backward pass: its own inertial terms added to what its children
-// and the applied wrenches left in force/moment, then handed to its parent.
+// One segment of the backward pass in two halves: solveSegment adds its own inertial
+// terms to what its children and the applied wrenches left in force/moment (and sets
+// its effort); passToParent hands the result to its parent.
 template <typename Scalar>
-inline void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+inline void solveSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   Vector3& f = data.force[i];
   Vector3& m = data.moment[i];
@@ -85,6 +86,14 @@ inline void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int 
     case JointType::kPrismatic: data.effort[i] = model.axis[i].dot(f); break;
     default: data.effort[i] = Scalar(0); break;
   }
+}
+
+// The second half of a segment's step: its joint wrench handed to its parent.
+template <typename Scalar>
+inline void passToParent(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  const Vector3& f = data.force[i];
+  const Vector3& m = data.moment[i];
   const int p = model.parent[i];
   if (p < 0) return;
   // The child's joint wrench acts on the parent reversed; in the parent's sum it
@@ -93,6 +102,12 @@ inline void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int 
   data.force[p] += f_p;
   data.moment[p].noalias() += data.R_parent_child[i] * m;
   data.moment[p] += data.p_parent_child[i].cross(f_p);
+}
+
+template <typename Scalar>
+inline void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+  solveSegment(model, data, i);
+  passToParent(model, data, i);
 }
 
 }  // namespace detail
@@ -128,6 +143,27 @@ void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data,
   }
   for (auto it = segments.rbegin(); it != segments.rend(); ++it)
     detail::backwardSegment(model, data, *it);
+}
+
+/// The backward pass over `segments` (as above) with a hook: `at_joint(i)` is called
+/// once segment i's joint wrench is solved (data.force[i], data.moment[i], child frame,
+/// about the joint origin) and before it is handed to the parent. It may replace that
+/// wrench, e.g. by the reading of a force/torque sensor mounted at the joint: the
+/// parent and everything proximal then see the replacement, which is the same as
+/// applying the difference (computed minus replacement) to segment i at its joint
+/// origin. data.effort[i] keeps the computed value. No allocation.
+template <typename Scalar, typename AtJoint>
+void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data,
+                     const std::vector<int>& segments, AtJoint&& at_joint) {
+  for (int i : segments) {
+    data.force[i] = -data.f_ext[i];
+    data.moment[i] = -data.n_ext[i];
+  }
+  for (auto it = segments.rbegin(); it != segments.rend(); ++it) {
+    detail::solveSegment(model, data, *it);
+    at_joint(*it);
+    detail::passToParent(model, data, *it);
+  }
 }
 
 /// The joint wrench of segment i (exerted by its parent, moment about the joint

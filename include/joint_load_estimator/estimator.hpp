@@ -32,6 +32,16 @@ struct WrenchInputConfig {
   double sign = 1.0;  ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies (force plate)
   double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
   StalePolicy stale_policy = StalePolicy::kHold;
+  /// Non-empty: the input is a force/torque sensor mounted at this FIXED joint of the
+  /// URDF (kept as its own segment; `link` must be empty or the joint's child link). It
+  /// measures the joint wrench: what the proximal side (the joint's parent link) exerts
+  /// on the distal side (its child link); samples are given like any input's, in the
+  /// child link frame, moment about its origin (the joint origin). It is not applied as
+  /// an external load: the joint's wrench is predicted from the model of the distal
+  /// subtree and the other inputs (predictedWrench), and the measurement replaces the
+  /// prediction before it is passed on, so the joints proximal to the sensor carry the
+  /// measured wrench (the sensor knows about unmodelled payloads and contacts).
+  std::string sensor_joint;
 };
 
 /// Arithmetic of the dynamics (the filters always run in double).
@@ -126,6 +136,19 @@ class Estimator {
   /// The filtered wrench of input k applied at the last published sample (sign
   /// applied, link frame).
   Wrench<double> appliedWrench(int k) const;
+  /// Segment of sensor input k's joint (WrenchInputConfig::sensor_joint), -1 for an
+  /// applied wrench.
+  int sensorSegment(int k) const { return inputs_[k].sensor_segment; }
+  /// For a sensor input k at the last published sample: the joint wrench its joint
+  /// would transmit according to the model (child link frame, moment about the joint
+  /// origin), and whether the measurement was used (false while a sensor with the
+  /// kZero policy is stale: then the proximal joints carry the prediction).
+  const Wrench<double>& predictedWrench(int k) const { return inputs_[k].predicted; }
+  bool sensorUsed(int k) const { return inputs_[k].used; }
+  /// Measured minus predicted for sensor input k (same frame and point): the load the
+  /// distal side exerts on its surroundings beyond what the model and the other inputs
+  /// explain (e.g. a tool pushing on a surface), or a sensor bias. Zero when unused.
+  Wrench<double> sensorResidual(int k) const;
   /// Nominal delay of the estimate behind the newest sample, in samples.
   int delaySamples() const { return bank_.config().delay; }
   /// Segments whose loads are computed (all, or what the wanted joints need).
@@ -149,7 +172,14 @@ class Estimator {
     int count = 0;
     bool stale = true;
     bool needed = true;
+    int sensor_segment = -1;  // sensor input: the segment of its joint
+    Wrench<double> predicted;  // sensor input: prediction at the last computation
+    bool used = false;         // sensor input: its measurement replaced the prediction
   };
+  // The backward pass hook of a sensor's segment: keeps the prediction, substitutes
+  // the measurement.
+  template <typename Scalar>
+  void atSensor(Data<Scalar>& data, const Model<Scalar>& model, int segment);
   void compute(const BaseState<double>& base_state);
   // Value of input k at time t (linear between samples, held past the newest).
   Eigen::Matrix<double, 6, 1> sampleInput(Input& input, double t);
@@ -163,6 +193,8 @@ class Estimator {
   std::vector<int> kinematics_segments_;  // closed under parents
   std::vector<int> dynamics_segments_;    // closed under children
   std::vector<char> coordinate_needed_;
+  std::vector<int> sensor_of_segment_;  // per segment: sensor input index, or -1
+  bool have_sensors_ = false;
   bool prune_ = false;
   std::vector<double> last_inputs_;  // the filtered inputs of the last computation
   bool have_result_ = false;

@@ -62,10 +62,31 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   if (!config_.gravity_world.allFinite()) throw std::invalid_argument("gravity is not finite");
   base_channel_ = model_.nq;
   wrench_channel_ = base_channel_ + (model_.floating_base ? 7 : 0);
+  sensor_of_segment_.assign(static_cast<std::size_t>(model_.nsegments()), -1);
   for (const WrenchInputConfig& c : config_.wrenches) {
     Input input;
     input.config = c;
-    input.frame = model_.frameIndex(c.link);  // throws naming the link
+    if (!c.sensor_joint.empty()) {
+      const std::string what = "wrench input '" + c.name + "': sensor_joint '" + c.sensor_joint + "'";
+      int s = -1;
+      try {
+        s = model_.segmentOfJoint(c.sensor_joint);
+      } catch (const std::invalid_argument&) {
+        throw std::invalid_argument(what + " is not a joint kept as a segment (keep_fixed_joints)");
+      }
+      if (model_.joint_type[s] != JointType::kFixed)
+        throw std::invalid_argument(what + " is not a fixed joint");
+      if (c.link.empty()) input.config.link = model_.link_name[s];
+      if (input.config.link != model_.link_name[s])
+        throw std::invalid_argument(what + ": link must be its child link '" +
+                                    model_.link_name[s] + "', not '" + c.link + "'");
+      if (sensor_of_segment_[s] >= 0)
+        throw std::invalid_argument(what + " has two sensor inputs");
+      input.sensor_segment = s;
+      sensor_of_segment_[s] = static_cast<int>(inputs_.size());
+      have_sensors_ = true;
+    }
+    input.frame = model_.frameIndex(input.config.link);  // throws naming the link
     if (!(c.sign == 1.0 || c.sign == -1.0))
       throw std::invalid_argument("wrench input '" + c.name + "': sign must be +1 or -1");
     if (!(c.timeout > 0.0))
@@ -85,6 +106,9 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
     dyn.assign(dyn.size(), 1);
   } else {
     for (const std::string& j : config_.joints) dyn[model_.segmentOfJoint(j)] = 1;
+    // A sensor's prediction needs its distal subtree, whatever is published.
+    for (const Input& input : inputs_)
+      if (input.sensor_segment >= 0) dyn[input.sensor_segment] = 1;
     for (int i = 1; i < n; ++i)
       if (dyn[model_.parent[i]]) dyn[i] = 1;
   }
@@ -291,7 +315,7 @@ void Estimator::compute(const BaseState<double>& base_state) {
                       kinematics_segments_, static_);
   }
   for (std::size_t k = 0; k < inputs_.size(); ++k) {
-    if (!inputs_[k].needed) continue;
+    if (!inputs_[k].needed || inputs_[k].sensor_segment >= 0) continue;  // sensors: atSensor
     const int c = wrench_channel_ + 6 * static_cast<int>(k);
     const Eigen::Vector3d f(bank_.value(c), bank_.value(c + 1), bank_.value(c + 2));
     const Eigen::Vector3d m(bank_.value(c + 3), bank_.value(c + 4), bank_.value(c + 5));
@@ -302,7 +326,11 @@ void Estimator::compute(const BaseState<double>& base_state) {
       addExternalWrench(model_, data_, inputs_[k].frame, f, m, WrenchFrame::kLocal);
   }
   if (config_.precision == Precision::kFloat) {
-    inverseDynamics(model_f_, data_f_, dynamics_segments_);
+    if (have_sensors_)
+      inverseDynamics(model_f_, data_f_, dynamics_segments_,
+                      [this](int i) { atSensor(data_f_, model_f_, i); });
+    else
+      inverseDynamics(model_f_, data_f_, dynamics_segments_);
     for (int i : dynamics_segments_) {
       data_.force[i] = data_f_.force[i].cast<double>();
       data_.moment[i] = data_f_.moment[i].cast<double>();
@@ -312,9 +340,40 @@ void Estimator::compute(const BaseState<double>& base_state) {
       data_.R_world[i] = data_f_.R_world[i].cast<double>();
       data_.p_world[i] = data_f_.p_world[i].cast<double>();
     }
+  } else if (have_sensors_) {
+    inverseDynamics(model_, data_, dynamics_segments_, [this](int i) { atSensor(data_, model_, i); });
   } else {
     inverseDynamics(model_, data_, dynamics_segments_);
   }
+}
+
+template <typename Scalar>
+void Estimator::atSensor(Data<Scalar>& data, const Model<Scalar>& model, int segment) {
+  const int k = sensor_of_segment_[static_cast<std::size_t>(segment)];
+  if (k < 0) return;
+  Input& input = inputs_[static_cast<std::size_t>(k)];
+  input.predicted.force = data.force[segment].template cast<double>();
+  input.predicted.moment = data.moment[segment].template cast<double>();
+  // A stale sensor read as zero would claim the distal side weighs nothing: unused.
+  input.used = !(input.stale && input.config.stale_policy == StalePolicy::kZero);
+  if (!input.used) return;
+  // The filtered measurement, from the child link frame (identity for the segment's own
+  // link, kept general) to the segment frame about the joint origin.
+  const Wrench<double> w = appliedWrench(k);
+  const Frame<Scalar>& fr = model.frames[static_cast<std::size_t>(input.frame)];
+  const Eigen::Matrix<Scalar, 3, 1> f = fr.R_segment_frame * w.force.cast<Scalar>();
+  data.force[segment] = f;
+  data.moment[segment] = fr.R_segment_frame * w.moment.cast<Scalar>() + fr.p_segment_frame.cross(f);
+}
+
+Wrench<double> Estimator::sensorResidual(int k) const {
+  const Input& input = inputs_.at(static_cast<std::size_t>(k));
+  Wrench<double> r;
+  if (input.sensor_segment < 0 || !input.used) return r;
+  const int s = input.sensor_segment;
+  r.force = data_.force[s] - input.predicted.force;
+  r.moment = data_.moment[s] - input.predicted.moment;
+  return r;
 }
 
 Wrench<double> Estimator::appliedWrench(int k) const {

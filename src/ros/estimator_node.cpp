@@ -48,6 +48,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (const std::string& w : model.warnings) ROS_WARN("robot model: %s", w.c_str());
   if (model.floating_base && settings_.base_frame.empty())
     settings_.base_frame = model.link_name[0];
+  completeSensorLinks(model, settings_);
   estimator_ = std::make_unique<Estimator>(model, settings_.estimator);
 
   for (int i = 0; i < model.nq; ++i) coordinate_of_[model.coordinate_names[i]] = i;
@@ -110,10 +111,43 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   updater_.setHardwareID(model.link_name[0]);
   updater_.add("joint loads", this, &EstimatorNode::diagnose);
+
+  // Predicted against measured: every sensor's residual, the floating base's.
+  for (std::size_t k = 0; k < wrench_topics_.size(); ++k) {
+    WrenchTopic& topic = *wrench_topics_[k];
+    const std::string& joint = topic.settings.input.sensor_joint;
+    if (joint.empty()) continue;
+    sensor_topics_.push_back(k);
+    topic.consistency_pub = private_nh_.advertise<geometry_msgs::WrenchStamped>("consistency/" + joint, 10);
+  }
+  total_weight_ = model.totalMass() * settings_.estimator.gravity_world.norm();
+  if (!sensor_topics_.empty() || model.floating_base)
+    updater_.add("consistency", this, &EstimatorNode::diagnoseConsistency);
+  loadBiasFile();
+  ros::AdvertiseServiceOptions calibrate =
+      ros::AdvertiseServiceOptions::create<joint_load_estimator::CalibrateBias>(
+          "calibrate_bias",
+          [this](joint_load_estimator::CalibrateBias::Request& req,
+                 joint_load_estimator::CalibrateBias::Response& res) {
+            return onCalibrateBias(req, res);
+          },
+          ros::VoidConstPtr(), &service_queue_);
+  calibrate_srv_ = private_nh_.advertiseService(calibrate);
+  service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
+  service_spinner_->start();
   ROS_INFO("joint_load_estimator: %d segments, %d coordinates, %zu joints published, %zu wrench "
            "inputs%s",
            model.nsegments(), model.nq, n, settings_.wrenches.size(),
            model.floating_base ? ", floating base" : "");
+}
+
+EstimatorNode::~EstimatorNode() {
+  {
+    std::lock_guard<std::mutex> lock(calibration_mutex_);
+    shutting_down_ = true;
+  }
+  calibration_cv_.notify_all();
+  if (service_spinner_) service_spinner_->stop();
 }
 
 double EstimatorNode::relative(const ros::Time& stamp) {
@@ -332,6 +366,17 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
       ++counters_.dropped_frame;
       return;
     }
+    if (!topic.settings.input.sensor_joint.empty()) {
+      // The sensor's offset, as it reports; the residual goes out in the reading's frame.
+      {
+        std::lock_guard<std::mutex> lock(calibration_mutex_);
+        f -= topic.bias_force;
+        m -= topic.bias_torque;
+        topic.sensor_frame = frame;
+      }
+      topic.R_link_sensor = R;
+      topic.p_link_sensor = p;
+    }
     // Expressed in the link frame, moment about the link origin.
     Eigen::Vector3d f_link, m_link;
     wrenchInLink(R, p, f, m, f_link, m_link);
@@ -384,6 +429,7 @@ void EstimatorNode::publish(const ros::Time& received) {
     wrench_msg_.wrench.torque = tf2::toMsg(data.moment[0], wrench_msg_.wrench.torque);
     residual_pub_.publish(wrench_msg_);
   }
+  publishConsistency(stamp);
   ++counters_.published;
   const double latency = (ros::Time::now() - received).toSec();
   latency_sum_ += latency;

@@ -12,6 +12,17 @@ ModelOptions modelOptions(const NodeSettings& settings) {
   return options;
 }
 
+void completeSensorLinks(const Model<double>& model, NodeSettings& settings) {
+  for (std::size_t k = 0; k < settings.wrenches.size(); ++k) {
+    WrenchInputConfig& input = settings.wrenches[k].input;
+    if (input.sensor_joint.empty() || !input.link.empty()) continue;
+    for (int s = 1; s < model.nsegments(); ++s)
+      if (model.joint_name[static_cast<std::size_t>(s)] == input.sensor_joint)
+        input.link = model.link_name[static_cast<std::size_t>(s)];
+    if (k < settings.estimator.wrenches.size()) settings.estimator.wrenches[k].link = input.link;
+  }
+}
+
 std::vector<int> publishedSegments(const Model<double>& model,
                                    const std::vector<std::string>& joints) {
   if (joints.empty()) return model.moving_segments;

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -153,9 +154,17 @@ WrenchTopicSettings parseWrench(const XmlRpcValue& value, const std::string& pre
   Section s(value, prefix);
   if (value.getType() != XmlRpcValue::TypeStruct) wrongType(prefix, value, "a map");
   if (!s.has("topic")) throw SettingsError("parameter '" + s.name("topic") + "' is required");
-  if (!s.has("link")) throw SettingsError("parameter '" + s.name("link") + "' is required");
+  s.read("sensor_joint", w.input.sensor_joint);
+  // A sensor's link is its joint's child link (the estimator fills it in).
+  if (!s.has("link") && w.input.sensor_joint.empty())
+    throw SettingsError("parameter '" + s.name("link") + "' is required");
   s.read("topic", w.topic);
   s.read("link", w.input.link);
+  s.read("force_threshold", w.force_threshold);
+  s.read("moment_threshold", w.moment_threshold);
+  if (!(w.force_threshold > 0.0) || !(w.moment_threshold > 0.0))
+    throw SettingsError("parameters '" + s.name("force_threshold") + "' and '" +
+                        s.name("moment_threshold") + "' must be positive");
   s.read("frame", w.frame);
   s.read("sign", w.input.sign);
   if (!(w.input.sign == 1.0 || w.input.sign == -1.0))
@@ -278,6 +287,19 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
   }
   if (n.time_jump_threshold <= 0.0)
     throw SettingsError("parameter 'time_jump_threshold' must be positive");
+  s.read("base_residual_threshold", n.base_residual_threshold);
+  if (!(n.base_residual_threshold > 0.0))
+    throw SettingsError("parameter 'base_residual_threshold' must be positive");
+  s.read("still_velocity", n.still_velocity);
+  if (!(n.still_velocity > 0.0)) throw SettingsError("parameter 'still_velocity' must be positive");
+  s.read("bias_file", n.bias_file);
+  // A sensor's joint is kept as its own segment: its wrench is what the sensor measures.
+  for (const WrenchTopicSettings& w : n.wrenches) {
+    const std::string& j = w.input.sensor_joint;
+    if (!j.empty() &&
+        std::find(n.keep_fixed_joints.begin(), n.keep_fixed_joints.end(), j) == n.keep_fixed_joints.end())
+      n.keep_fixed_joints.push_back(j);
+  }
   s.finish();
   return n;
 }

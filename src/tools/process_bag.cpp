@@ -556,6 +556,7 @@ void run(const Options& options) {
                              "(the base pose comes from tf2); use the node");
   const jle::Model<double> model =
       jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));
+  jle::completeSensorLinks(model, settings);
   if (model.floating_base)
     throw std::runtime_error(options.urdf +
                              ": a floating-base model is not supported by "

@@ -24,6 +24,10 @@ struct WrenchTopicSettings {
   WrenchInputConfig input;
   std::string topic;
   std::string frame;  ///< expressed-in frame; empty: the message's header.frame_id
+  /// Sensor inputs (input.sensor_joint set): the residual (measured - predicted) above
+  /// either threshold is a diagnostic warning.
+  double force_threshold = 5.0;   ///< [N]
+  double moment_threshold = 0.5;  ///< [N m]
 };
 
 struct NodeSettings {
@@ -36,7 +40,15 @@ struct NodeSettings {
   std::string base_frame;             ///< tf2 frame of the base; empty: the URDF root link
   double time_jump_threshold = 1.0;   ///< [s] a stamp older than this is a jump back: reset
   std::vector<WrenchTopicSettings> wrenches;
-  std::vector<std::string> keep_fixed_joints;
+  std::vector<std::string> keep_fixed_joints;  ///< sensor joints are added by the parser
+  /// Floating base: a residual force above this fraction of the total weight is a
+  /// diagnostic warning.
+  double base_residual_threshold = 0.1;
+  /// ~calibrate_bias: the robot is still while every estimated |q-dot| stays below this.
+  double still_velocity = 0.02;  ///< [rad/s or m/s]
+  /// YAML file of the sensor biases: loaded at start if it exists, written by
+  /// ~calibrate_bias. Empty: not loaded, and calibrate_bias writes none.
+  std::string bias_file;
   EstimatorConfig estimator;
 };
 

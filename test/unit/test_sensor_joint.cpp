@@ -1,0 +1,207 @@
+// A force/torque sensor at a fixed joint (WrenchInputConfig::sensor_joint): its
+// prediction, its residual and the substitution of its reading for the joints
+// proximal to it, against numbers worked by hand for wrist_sensor_arm.urdf and
+// against the backward pass with the unmodelled contact applied as an external
+// wrench.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+namespace {
+
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+const std::string kUrdf = std::string(JLE_TEST_DATA) + "/urdf/wrist_sensor_arm.urdf";
+constexpr double kG = 9.80665;
+constexpr double kToolMass = 0.8;
+const Vector3d kToolCom(0.0, 0.02, 0.11);  // sensor frame [m]
+const Vector3d kTip(0.0, 0.0, 0.2);        // sensor frame [m]
+// Rounding: the readings pass through the 3-point filter, whose weights for
+// samples 1 ms apart sum to one only to ~1e-12 (measured 2e-12 relative on the
+// ~8 N reading), plus a few dozen operations on loads of order 10 N, 1 N m.
+constexpr double kExact = 1e-10;
+
+jle::Model<double> arm() {
+  jle::ModelOptions options;
+  options.keep_fixed_joints = {"ft_joint"};
+  return jle::modelFromUrdfFile(kUrdf, options);
+}
+
+jle::EstimatorConfig sensorConfig() {
+  jle::EstimatorConfig c;
+  c.differentiator.type = jle::DifferentiatorType::kFiniteDifference;
+  jle::WrenchInputConfig ft;
+  ft.name = "ft";
+  ft.sensor_joint = "ft_joint";
+  c.wrenches.push_back(ft);
+  return c;
+}
+
+Eigen::Matrix3d Ry(double a) { return Eigen::AngleAxisd(a, Vector3d::UnitY()).toRotationMatrix(); }
+
+// The reading of a sensor at rest with the tool alone (sensor frame, about its
+// origin): the proximal side holds the tool's weight, m g upward, which is
+// (-cos q2, 0, -sin q2) in the sensor frame (turned by q1 about z, then q2 +
+// pi/2 about y from the world).
+void staticReading(double q2, Vector3d& f, Vector3d& m) {
+  f = kToolMass * kG * Vector3d(-std::cos(q2), 0.0, -std::sin(q2));
+  m = kToolCom.cross(f);
+}
+
+// Feeds constant q and a constant reading until the estimator publishes.
+void feedStill(jle::Estimator& e, const VectorXd& q, const Vector3d& f, const Vector3d& m) {
+  for (int k = 0; k < 3; ++k) {
+    const double t = 1.0 + 1e-3 * k;
+    e.addWrench(0, t, f, m);
+    const jle::SampleStatus status = e.addJointSample(t, q.data());
+    if (k == 2) {
+      ASSERT_EQ(status, jle::SampleStatus::kPublished);
+    }
+  }
+}
+
+// The loads with the contact (force c at the tool tip, sensor axes) applied as
+// an external wrench: the other way of getting what the sensor substitution
+// must give.
+void referenceWithContact(const jle::Model<double>& model, jle::Data<double>& data,
+                          const VectorXd& q, const VectorXd& qd, const VectorXd& qdd,
+                          const Vector3d& c) {
+  jle::forwardKinematics(model, data, q, qd, qdd, Vector3d(0, 0, -kG));
+  jle::addExternalWrench(model, data, model.frameIndex("tool_tip"), c, Vector3d(Vector3d::Zero()),
+                         jle::WrenchFrame::kLocal);
+  jle::inverseDynamics(model, data);
+}
+
+TEST(SensorJoint, ReadingEqualToPredictionGivesZeroResidual) {
+  const jle::Model<double> model = arm();
+  jle::Estimator e(model, sensorConfig());
+  const VectorXd q = (VectorXd(2) << 0.4, 0.3).finished();
+  Vector3d f, m;
+  staticReading(q[1], f, m);
+  feedStill(e, q, f, m);
+  ASSERT_GE(e.sensorSegment(0), 0);
+  EXPECT_TRUE(e.sensorUsed(0));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(e.predictedWrench(0).force[i], f[i], kExact);
+    EXPECT_NEAR(e.predictedWrench(0).moment[i], m[i], kExact);
+    EXPECT_NEAR(e.sensorResidual(0).force[i], 0.0, kExact);
+    EXPECT_NEAR(e.sensorResidual(0).moment[i], 0.0, kExact);
+  }
+}
+
+// An unmodelled push c on the tool tip: the sensor reads the prediction minus c
+// (moved to its origin); the residual is (-c, -p_tip x c), the wrench the tool
+// exerts on what pushes it, and the joint loads are those with c applied.
+TEST(SensorJoint, UnmodelledContactIsTheResidualAndLoadsTheProximalJoints) {
+  const jle::Model<double> model = arm();
+  const VectorXd q = (VectorXd(2) << 0.4, 0.3).finished();
+  const Vector3d c(3.0, -2.0, 5.0);
+  Vector3d f, m;
+  staticReading(q[1], f, m);
+  const Vector3d f_read = f - c, m_read = m - kTip.cross(c);
+
+  // Closed form of the effort of j2 at rest: minus the moment about its axis of
+  // the weights of link2 and the tool and of the contact (frame of link1 turned
+  // by q1, which leaves gravity and the axis y alone).
+  const Eigen::Matrix3d R2 = Ry(q[1]), Rs = R2 * Ry(M_PI / 2);
+  const Vector3d r_link2 = R2 * Vector3d(0.15, 0.0, 0.01);
+  const Vector3d r_tool = R2 * Vector3d(0.3, 0.0, 0.0) + Rs * kToolCom;
+  const Vector3d r_tip = R2 * Vector3d(0.3, 0.0, 0.0) + Rs * kTip;
+  const Vector3d weight(0.0, 0.0, -kG);
+  const double tau2 =
+      -(r_link2.cross(1.5 * weight) + r_tool.cross(kToolMass * weight) + r_tip.cross(Rs * c)).y();
+
+  for (int variant = 0; variant < 3; ++variant) {
+    SCOPED_TRACE(variant == 0 ? "all joints" : variant == 1 ? "pruned to j1" : "float");
+    jle::EstimatorConfig config = sensorConfig();
+    if (variant == 1) config.joints = {"j1"};
+    if (variant == 2) config.precision = jle::Precision::kFloat;
+    // Float: 24-bit arithmetic on loads of ~10 N m.
+    const double tol = variant == 2 ? 1e-5 : kExact;
+    jle::Estimator e(model, config);
+    feedStill(e, q, f_read, m_read);
+    const jle::Wrench<double> r = e.sensorResidual(0);
+    const Vector3d moment_expected = -kTip.cross(c);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(r.force[i], -c[i], tol);
+      EXPECT_NEAR(r.moment[i], moment_expected[i], tol);
+    }
+    jle::Data<double> ref(model);
+    referenceWithContact(model, ref, q, VectorXd::Zero(2), VectorXd::Zero(2), c);
+    for (const char* joint : {"j1", "j2"}) {
+      if (variant == 1 && std::string(joint) == "j2") continue;
+      const int s = model.segmentOfJoint(joint);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(e.data().force[s][i], ref.force[s][i], tol) << joint;
+        EXPECT_NEAR(e.data().moment[s][i], ref.moment[s][i], tol) << joint;
+      }
+    }
+    if (variant != 1) {
+      EXPECT_NEAR(e.data().effort[model.segmentOfJoint("j2")], tau2, tol);
+    }
+  }
+}
+
+// Moving (3-point differences are exact on a quadratic): a reading made of the
+// prediction at the exact state minus the contact gives the contact back and
+// the loads with the contact applied, at every sample.
+TEST(SensorJoint, MovingWithContact) {
+  const jle::Model<double> model = arm();
+  jle::Estimator e(model, sensorConfig());
+  jle::Data<double> ref(model);
+  const int s_ft = model.segmentOfJoint("ft_joint");
+  const Vector3d c(-1.0, 4.0, 2.0);
+  const Eigen::Vector2d q0(0.2, -0.4), qd0(0.3, 0.8), qdd(1.5, -2.0);
+  int checked = 0;
+  for (int k = 0; k < 50; ++k) {
+    const double t = 2.0 + 1e-3 * k, s = t - 2.0;
+    const VectorXd qk = q0 + qd0 * s + 0.5 * qdd * s * s, qdk = qd0 + qdd * s;
+    // What the sensor reads: the joint wrench of the exact motion with the
+    // contact.
+    referenceWithContact(model, ref, qk, qdk, qdd, c);
+    e.addWrench(0, t, ref.force[s_ft], ref.moment[s_ft]);
+    if (e.addJointSample(t, qk.data()) != jle::SampleStatus::kPublished) continue;
+    const double ts = e.stamp() - 2.0;
+    referenceWithContact(model, ref, q0 + qd0 * ts + 0.5 * qdd * ts * ts, qd0 + qdd * ts, qdd, c);
+    const jle::Wrench<double> r = e.sensorResidual(0);
+    // Second differences of samples 1 ms apart: rounding of ~1e-16 / 1e-6 on
+    // qdd.
+    const double tol = 1e-8;
+    const Vector3d moment_expected = -kTip.cross(c);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(r.force[i], -c[i], tol);
+      EXPECT_NEAR(r.moment[i], moment_expected[i], tol);
+    }
+    for (int s : model.moving_segments)
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(e.data().force[s][i], ref.force[s][i], tol);
+        EXPECT_NEAR(e.data().moment[s][i], ref.moment[s][i], tol);
+      }
+    ++checked;
+  }
+  EXPECT_GE(checked, 45);
+}
+
+TEST(SensorJoint, RefusedConfigurations) {
+  const jle::Model<double> model = arm();
+  auto build = [&](const std::string& joint, const std::string& link) {
+    jle::EstimatorConfig config = sensorConfig();
+    config.wrenches[0].sensor_joint = joint;
+    config.wrenches[0].link = link;
+    jle::Estimator e(model, config);
+  };
+  EXPECT_NO_THROW(build("ft_joint", "ft_sensor"));
+  EXPECT_THROW(build("j2", ""), std::invalid_argument);  // not fixed
+  EXPECT_THROW(build("tool_joint", ""),
+               std::invalid_argument);  // lumped, not kept
+  EXPECT_THROW(build("ft_joint", "tool"),
+               std::invalid_argument);  // not its child link
+}
+
+}  // namespace
