@@ -230,6 +230,17 @@ jle::EstimatorConfig savingsVariant(const std::string& variant) {
     c.savings.static_acceleration = 1e-3;
   } else if (variant == "float") {
     c.precision = jle::Precision::kFloat;
+  } else if (variant.rfind("cov_", 0) == 0) {
+    // Covariance of the loads (docs/uncertainty.md): cov_full = every source, the state
+    // linearised; cov_qdd = its cheap path (q-ddot, wrench and inertial parts only);
+    // _diag = only the variances.
+    c.uncertainty.enabled = true;
+    c.uncertainty.position_noise = 1e-4;
+    c.uncertainty.mass_fraction = 0.05;
+    c.uncertainty.com_offset = 0.005;
+    c.uncertainty.inertia_fraction = 0.1;
+    c.uncertainty.linearize_state = variant.find("full") != std::string::npos;
+    c.uncertainty.diagonal_only = variant.find("diag") != std::string::npos;
   }
   return c;
 }
@@ -273,6 +284,16 @@ BENCHMARK_CAPTURE(scaling, chain, false)
     ->RangeMultiplier(10)->Range(1, 1000)->Arg(300)->Arg(30)->Arg(3)->Complexity(benchmark::oN);
 BENCHMARK_CAPTURE(scaling, tree, true)
     ->RangeMultiplier(10)->Range(1, 1000)->Arg(300)->Arg(30)->Arg(3)->Complexity(benchmark::oN);
+
+// The covariance of the loads against the same step without it.
+#define JLE_COVARIANCE(name, file)                                                         \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_off, file, "", false, "defaults");          \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full, file, "", false, "cov_full");         \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag, file, "", false, "cov_full_diag"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd, file, "", false, "cov_qdd");           \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag")
+JLE_COVARIANCE(panda, "/urdf/panda.urdf");
+JLE_COVARIANCE(talos, "/urdf/talos_reduced.urdf");
 
 JLE_SAVING(talos_all_moving, "/urdf/talos_reduced.urdf", "", false);
 JLE_SAVING(talos_one_knee_moving, "/urdf/talos_reduced.urdf", "leg_left_4_joint", false);

@@ -138,6 +138,23 @@ class DifferentiatorBank {
   double rate(int c) const { return out_(1, c); }
   double accel(int c) const { return out_(2, c); }
 
+  /// Noise gain of the last estimate: the covariance of (value, rate, accel) per unit
+  /// variance of white noise on the samples (the same for every channel). Savitzky-Golay
+  /// and finite differences: C C^T of the weights C (3 x window) in use. Kalman: the
+  /// noise part of the estimation error, S_k = A_k S_(k-1) A_k^T + K_k K_k^T with
+  /// A_k = (I - K_k H) F_k from S = diag(1, 0, ..) at the first sample: exact through the
+  /// start-up, and at a steady rate the fixed point of the discrete Lyapunov equation,
+  /// after which it is kept (cached) while dt and the gain stay.
+  Eigen::Matrix3d noiseGain() const {
+    if (config_.type == DifferentiatorType::kKalman) return S_.topLeftCorner(3, 3);
+    Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < config_.window; ++k) {
+      const Eigen::Vector3d c = coeff_.col(k);
+      G.noalias() += c * c.transpose();
+    }
+    return G;
+  }
+
  private:
   // Index in the ring of the sample k steps before the newest.
   int ring(int k) const { return (head_ - 1 - k + 2 * config_.window) % config_.window; }
@@ -230,6 +247,9 @@ class DifferentiatorBank {
       for (int i = 1; i < n; ++i) P_(i, i) = 1e12 * r2;
       K_.setZero(n);
       gain_settled_ = false;
+      S_.setZero(n, n);
+      S_(0, 0) = 1.0;  // the state starts at the measurement
+      noise_settled_ = false;
       prev_t_ = t;
       count_ = 1;
       stamp_ = t;
@@ -278,6 +298,15 @@ class DifferentiatorBank {
       gain_settled_ = count_ >= n && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
       K_ = K;
     }
+    // Noise gain: kept once it no longer changes under a settled gain.
+    if (!(steady && noise_settled_)) {
+      SmallMatrix A = -K_ * F.row(0);
+      A += F;  // (I - K H) F with H = (1, 0, ..)
+      SmallMatrix S = A * S_ * A.transpose();
+      S += K_ * K_.transpose();
+      noise_settled_ = steady && (S - S_).cwiseAbs().maxCoeff() <= 1e-14 * S.cwiseAbs().maxCoeff();
+      S_ = S;
+    }
     if (n == 3)
       kalmanChannels<3>(x);
     else
@@ -314,6 +343,8 @@ class DifferentiatorBank {
   SmallMatrix F_, Q_;
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K_;  // Kalman gain
   bool gain_settled_ = false;
+  SmallMatrix S_;  // Kalman noise gain (noiseGain())
+  bool noise_settled_ = false;
   Eigen::VectorXd times_;
   Eigen::MatrixXd values_;  // window x channels
   Eigen::MatrixXd coeff_;   // 3 x window

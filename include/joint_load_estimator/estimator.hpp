@@ -42,6 +42,26 @@ struct WrenchInputConfig {
   /// prediction before it is passed on, so the joints proximal to the sensor carry the
   /// measured wrench (the sensor knows about unmodelled payloads and contacts).
   std::string sensor_joint;
+  /// Standard deviation of each sample's components, for the covariance of the loads
+  /// (UncertaintyConfig): force [N] and moment [N m], per component, white.
+  double force_noise = 0.0;
+  double moment_noise = 0.0;
+};
+
+/// The uncertainty of the inputs, propagated to the covariance of every computed joint
+/// wrench (Estimator::covariance; docs/uncertainty.md). All standard deviations are
+/// 1 sigma; the errors are taken as independent, zero-mean and (for the sensors) white.
+struct UncertaintyConfig {
+  bool enabled = false;
+  bool diagonal_only = false;  ///< only the 6 variances per joint (off-diagonal terms left 0)
+  /// [rad or m] noise of each joint position sample (an encoder of step D: D / sqrt(12)).
+  double position_noise = 0.0;
+  double mass_fraction = 0.0;     ///< relative, per link
+  double com_offset = 0.0;        ///< [m] per axis, per link
+  double inertia_fraction = 0.0;  ///< relative (the whole tensor scaled), per link
+  /// Include the (linearised) dependence on q and q-dot; false: only the q-ddot, wrench
+  /// and inertial-parameter parts, which are exact and cheaper.
+  bool linearize_state = true;
 };
 
 /// Arithmetic of the dynamics (the filters always run in double).
@@ -80,6 +100,7 @@ struct EstimatorConfig {
   std::vector<WrenchInputConfig> wrenches;
   /// Loads are computed for every n-th joint sample (the filters see every sample).
   int decimation = 1;
+  UncertaintyConfig uncertainty;
 };
 
 /// What became of a joint sample.
@@ -157,6 +178,15 @@ class Estimator {
   bool inputNeeded(int k) const { return inputs_[k].needed; }
   /// Whether coordinate i enters the computed loads.
   bool coordinateNeeded(int i) const { return coordinate_needed_[i] != 0; }
+  /// Covariance of data().force/moment[segment] of the last published sample: child
+  /// frame, (fx fy fz mx my mz), moment about the joint origin [N^2, N^2 m, N^2 m^2].
+  /// Valid after kPublished when config().uncertainty.enabled, for the segments of
+  /// dynamicsSegments(); with diagonal_only its off-diagonal terms are zero.
+  const Eigen::Matrix<double, 6, 6>& covariance(int segment) const {
+    return covariance_[static_cast<std::size_t>(segment)];
+  }
+  /// Variance of data().effort[segment] [N^2 m^2 or N^2] (0 for a joint that does not move).
+  double effortVariance(int segment) const;
   /// How the last published sample was obtained (for the benchmarks).
   bool lastWasReused() const { return reused_; }
   bool lastWasStatic() const { return static_; }
@@ -181,6 +211,11 @@ class Estimator {
   template <typename Scalar>
   void atSensor(Data<Scalar>& data, const Model<Scalar>& model, int segment);
   void compute(const BaseState<double>& base_state);
+  // Covariance of the loads just computed (src/core/covariance.cpp).
+  void setUpCovariance();
+  void computeCovariance(const BaseState<double>& base_state);
+  void loadsPass(Data<double>& data, const VectorX<double>& q, const VectorX<double>& qd,
+                 const BaseState<double>& base_state);
   // Value of input k at time t (linear between samples, held past the newest).
   Eigen::Matrix<double, 6, 1> sampleInput(Input& input, double t);
 
@@ -211,6 +246,22 @@ class Estimator {
   bool have_last_ = false;
   long sample_count_ = 0;
   double stamp_ = 0.0;
+
+  // Covariance workspace, sized in setUpCovariance() (src/core/covariance.cpp).
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  std::vector<Matrix6> covariance_;     // per segment: the result
+  std::vector<Matrix6> composite_;      // per segment: composite inertia of its subtree
+  std::vector<Matrix6> local_;          // per segment: covariance of its own terms
+  std::vector<Eigen::Matrix<double, 6, 3>> jacobian_;  // per segment: d y / d(q, qd, qdd)_j
+  std::vector<Vector6> motion_;         // per segment: the rigid acceleration of one qdd
+  std::vector<int> subtree_end_;        // per segment: its subtree is [i, subtree_end_[i])
+  std::vector<char> in_dynamics_;       // per segment
+  std::vector<std::vector<int>> coordinate_segments_;  // per coordinate: segments it drives
+  std::vector<std::vector<int>> affected_;             // per coordinate: dynamics segments it moves
+  Data<double> cov_nominal_;  // the loads in double (Precision::kFloat)
+  Data<double> cov_data_;     // a perturbed pass
+  VectorX<double> q_pert_, qd_pert_;
 };
 
 }  // namespace jle

@@ -57,7 +57,9 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
             model.nq + (model.floating_base ? 7 : 0) + 6 * static_cast<int>(config.wrenches.size())),
       q_(VectorX<double>::Zero(model.nq)),
       qd_(VectorX<double>::Zero(model.nq)),
-      qdd_(VectorX<double>::Zero(model.nq)) {
+      qdd_(VectorX<double>::Zero(model.nq)),
+      cov_nominal_(model_),
+      cov_data_(model_) {
   if (config_.decimation < 1) throw std::invalid_argument("decimation must be at least 1");
   if (!config_.gravity_world.allFinite()) throw std::invalid_argument("gravity is not finite");
   base_channel_ = model_.nq;
@@ -125,6 +127,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   }
   prune_ = static_cast<int>(dynamics_segments_.size()) < n;
   for (Input& input : inputs_) input.needed = dyn[model_.frames[input.frame].segment] != 0;
+  setUpCovariance();
 }
 
 void Estimator::reset() {
@@ -345,6 +348,7 @@ void Estimator::compute(const BaseState<double>& base_state) {
   } else {
     inverseDynamics(model_, data_, dynamics_segments_);
   }
+  if (config_.uncertainty.enabled) computeCovariance(base_state);
 }
 
 template <typename Scalar>

@@ -421,6 +421,23 @@ void EstimatorNode::publish(const ros::Time& received) {
       wrench_pubs_[i].publish(wrench_msg_);
     }
   }
+  if (settings_.estimator.uncertainty.enabled) {
+    // Sized on first use, then reused (no allocation per message).
+    const bool diagonal = settings_.estimator.uncertainty.diagonal_only;
+    const std::size_t per_joint = diagonal ? 6 : 36;
+    loads_msg_.covariance.resize(per_joint * published_segments_.size());
+    loads_msg_.effort_stddev.resize(published_segments_.size());
+    for (std::size_t i = 0; i < published_segments_.size(); ++i) {
+      const Eigen::Matrix<double, 6, 6>& C = estimator_->covariance(published_segments_[i]);
+      double* out = &loads_msg_.covariance[per_joint * i];
+      for (int r = 0; r < 6; ++r)
+        if (diagonal)
+          out[r] = C(r, r);
+        else
+          for (int c = 0; c < 6; ++c) out[6 * r + c] = C(r, c);
+      loads_msg_.effort_stddev[i] = std::sqrt(estimator_->effortVariance(published_segments_[i]));
+    }
+  }
   loads_pub_.publish(loads_msg_);
   if (residual_pub_ && residual_pub_.getNumSubscribers() > 0) {
     wrench_msg_.header.stamp = stamp;

@@ -177,6 +177,11 @@ WrenchTopicSettings parseWrench(const XmlRpcValue& value, const std::string& pre
   w.input.stale_policy = choose<StalePolicy>(
       s.name("stale_policy"), policy,
       {{"hold", StalePolicy::kHold}, {"zero", StalePolicy::kZero}, {"stop", StalePolicy::kStop}});
+  s.read("force_noise", w.input.force_noise);
+  s.read("moment_noise", w.input.moment_noise);
+  if (!(w.input.force_noise >= 0.0) || !(w.input.moment_noise >= 0.0))
+    throw SettingsError("parameters '" + s.name("force_noise") + "' and '" + s.name("moment_noise") +
+                        "' must not be negative");
   s.finish();
   w.input.name = w.topic;
   return w;
@@ -274,6 +279,25 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
       throw SettingsError("parameters 'savings/static_velocity' and 'savings/static_acceleration' "
                           "must not be negative");
     sv.finish();
+  }
+  if (s.has("uncertainty")) {
+    Section su(s.get("uncertainty"), "uncertainty");
+    UncertaintyConfig& u = n.estimator.uncertainty;
+    su.read("enabled", u.enabled);
+    su.read("diagonal_only", u.diagonal_only);
+    su.read("position_noise", u.position_noise);
+    su.read("mass_fraction", u.mass_fraction);
+    su.read("com_offset", u.com_offset);
+    su.read("inertia_fraction", u.inertia_fraction);
+    su.read("linearize_state", u.linearize_state);
+    const std::pair<const char*, double> values[] = {{"position_noise", u.position_noise},
+                                                      {"mass_fraction", u.mass_fraction},
+                                                      {"com_offset", u.com_offset},
+                                                      {"inertia_fraction", u.inertia_fraction}};
+    for (const auto& kv : values)
+      if (!(kv.second >= 0.0))
+        throw SettingsError("parameter '" + su.name(kv.first) + "' must not be negative");
+    su.finish();
   }
   if (s.has("differentiator"))
     n.estimator.differentiator = parseDifferentiator(s.get("differentiator"), "differentiator");

@@ -57,7 +57,8 @@ publishes when the bag is played to it, without the timing of a live system.
   --csv PATH           write the loads as CSV instead: t, then for every published
                        joint JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort (the columns of
                        joint_loads; wrenches in the child link frame, moment about the
-                       joint origin), %.17g
+                       joint origin), %.17g; with uncertainty enabled, then
+                       JOINT.effort_stddev for every joint
   --sto PATH           also (or only) write them as an OpenSim storage file: the
                        same numbers, tab-separated, under OpenSim's column names
                        (time, JOINT_moment or JOINT_force, and
@@ -159,7 +160,7 @@ class BagProcessor {
         joints_(model, segments_),
         effort_ring_(kEffortHistory, std::vector<double>(segments_.size())),
         effort_time_(kEffortHistory, std::numeric_limits<double>::quiet_NaN()),
-        row_(1 + 7 * segments_.size()) {
+        row_(1 + (settings.estimator.uncertainty.enabled ? 8 : 7) * segments_.size()) {
     joint_topic_ = globalName(settings.joint_states_topic);
     for (const jle::WrenchTopicSettings& w : settings.wrenches) {
       WrenchTopic topic;
@@ -310,7 +311,10 @@ class BagProcessor {
         names.push_back(joint + c);
     if (!options_.csv.empty()) {
       csv_ = std::make_unique<jle::CsvWriter>(options_.csv);
-      csv_->writeHeader(names);
+      std::vector<std::string> csv_names = names;
+      if (settings_.estimator.uncertainty.enabled)
+        for (const std::string& joint : loads_.name) csv_names.push_back(joint + ".effort_stddev");
+      csv_->writeHeader(csv_names);
     }
     if (!options_.sto.empty()) {
       sto_ = std::make_unique<jle::StoWriter>(options_.sto);
@@ -475,6 +479,22 @@ class BagProcessor {
       loads_.effort[i] = *row++ = data.effort[s];
       loads_.measured_effort[i] =
           measured ? (*measured)[i] : std::numeric_limits<double>::quiet_NaN();
+    }
+    const jle::UncertaintyConfig& u = settings_.estimator.uncertainty;
+    if (u.enabled) {  // the node's covariance fields (estimator_node.cpp publish())
+      const std::size_t per_joint = u.diagonal_only ? 6 : 36;
+      loads_.covariance.resize(per_joint * segments_.size());
+      loads_.effort_stddev.resize(segments_.size());
+      for (std::size_t i = 0; i < segments_.size(); ++i) {
+        const Eigen::Matrix<double, 6, 6>& C = estimator_.covariance(segments_[i]);
+        double* out = &loads_.covariance[per_joint * i];
+        for (int r = 0; r < 6; ++r)
+          if (u.diagonal_only)
+            out[r] = C(r, r);
+          else
+            for (int c = 0; c < 6; ++c) out[6 * r + c] = C(r, c);
+        loads_.effort_stddev[i] = *row++ = std::sqrt(estimator_.effortVariance(segments_[i]));
+      }
     }
     if (csv_) csv_->writeRow(row_.data(), row_.size());
     if (sto_) sto_->writeRow(row_.data(), row_.size());

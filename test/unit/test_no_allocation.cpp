@@ -80,4 +80,37 @@ TEST(NoAllocation, EstimatorWithEachDifferentiator) {
   }
 }
 
+// The covariance of the loads (every source, the state linearised) allocates nothing
+// per sample either.
+TEST(NoAllocation, EstimatorWithCovariance) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/panda.urdf");
+  for (bool linearize : {true, false}) {
+    jle::EstimatorConfig config;
+    jle::WrenchInputConfig ft;
+    ft.name = ft.link = "panda_hand";
+    ft.force_noise = 0.5;
+    ft.moment_noise = 0.05;
+    config.wrenches.push_back(ft);
+    config.uncertainty.enabled = true;
+    config.uncertainty.position_noise = 1e-4;
+    config.uncertainty.mass_fraction = 0.05;
+    config.uncertainty.com_offset = 0.005;
+    config.uncertainty.inertia_fraction = 0.05;
+    config.uncertainty.linearize_state = linearize;
+    config.precision = linearize ? jle::Precision::kDouble : jle::Precision::kFloat;
+    jle::Estimator estimator(model, config);
+    std::vector<double> q(static_cast<std::size_t>(model.nq), 0.0);
+    long before = 0;
+    for (int k = 0; k < 500; ++k) {
+      if (k == 100) before = g_allocations;
+      const double t = 1e-3 * k + 2e-4 * std::sin(k);
+      for (std::size_t i = 0; i < q.size(); ++i) q[i] = 0.5 * std::sin(t + i);
+      estimator.addWrench(0, t, Eigen::Vector3d(1, 0, -5), Eigen::Vector3d(0, 0.1, 0));
+      estimator.addJointSample(t, q.data());
+    }
+    EXPECT_EQ(g_allocations - before, 0) << "linearize_state " << linearize;
+    EXPECT_GT(estimator.covariance(model.moving_segments[0])(5, 5), 0.0);
+  }
+}
+
 }  // namespace

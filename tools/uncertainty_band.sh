@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The README's uncertainty band: the demo bag (make_example_bag, as tools/demo.sh makes
+# it) through process_bag with config/demo.yaml plus the uncertainty of
+# config/demo_uncertainty.yaml, then one joint's effort with +-2 sigma plotted into
+# docs/uncertainty_band.png (bench/plot_uncertainty.py). Needs the package built
+# (tools/build.sh process_bag make_example_bag).
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
+bin=$ws/devel/lib/joint_load_estimator
+demo=$ws/demo
+mkdir -p "$demo"
+bag=$demo/panda_example.bag
+[ -s "$bag" ] || "$bin/make_example_bag" --urdf "$repo/test/data/urdf/panda_demo.urdf" --output "$bag" --effort
+config=$demo/demo_uncertainty.yaml
+# The wrist sensor's noise goes into its wrench entry (0.5 N, 0.02 N m per component).
+sed 's/^    stale_policy: hold$/&\n    force_noise: 0.5\n    moment_noise: 0.02/' "$repo/config/demo.yaml" |
+  cat - "$repo/config/demo_uncertainty.yaml" >"$config"
+grep -q force_noise "$config" || { echo "uncertainty_band: no wrench entry in config/demo.yaml" >&2; exit 1; }
+"$bin/process_bag" --bag "$bag" --urdf "$repo/test/data/urdf/panda_demo.urdf" --config "$config" \
+  --csv "$demo/uncertainty.csv"
+/usr/bin/python3 "$repo/bench/plot_uncertainty.py" "$demo/uncertainty.csv" "${1:-panda_joint2}" \
+  "$repo/docs/uncertainty_band.png"
