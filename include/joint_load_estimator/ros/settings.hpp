@@ -26,6 +26,14 @@ struct WrenchTopicSettings {
   std::string frame;  ///< expressed-in frame; empty: the message's header.frame_id
 };
 
+/// One force plate as configured (force_plates[i]).
+struct PlateTopicSettings {
+  PlateInputConfig input;  ///< input.plate.name, .link, surface_height, contact_threshold, pose
+  std::string topic;
+  std::string frame;           ///< tf2 frame of the plate; empty: the message's header.frame_id
+  bool pose_configured = false;  ///< position/orientation given: no tf2 look-up
+};
+
 struct NodeSettings {
   std::string robot_description = "robot_description";  ///< parameter holding the URDF
   std::string joint_states_topic = "joint_states";
@@ -38,6 +46,9 @@ struct NodeSettings {
   std::vector<WrenchTopicSettings> wrenches;
   std::vector<std::string> keep_fixed_joints;
   EstimatorConfig estimator;
+  std::vector<PlateTopicSettings> force_plates;  ///< also in estimator.plates
+  /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
+  double body_mass = 0.0;
 };
 
 /// The node's differentiator when the parameters name none (see docs/accuracy.md).
