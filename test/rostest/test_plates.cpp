@@ -75,8 +75,12 @@ struct PaperFoot {
     return base0 + base_v * s(t) + 0.5 * base_a * s(t) * s(t);
   }
   // The force on the foot at P [N], world: linear in time (a rising stance).
-  Vector2d F_P(const ros::Time& t) const { return Vector2d(40.0 + 200.0 * s(t), 650.0 + 500.0 * s(t)); }
-  Eigen::Matrix2d Q(const ros::Time& t) const { return Eigen::Rotation2Dd(theta(t)).toRotationMatrix(); }
+  Vector2d F_P(const ros::Time& t) const {
+    return Vector2d(40.0 + 200.0 * s(t), 650.0 + 500.0 * s(t));
+  }
+  Eigen::Matrix2d Q(const ros::Time& t) const {
+    return Eigen::Rotation2Dd(theta(t)).toRotationMatrix();
+  }
   Vector2d P_world(const ros::Time& t) const {
     return base(t) + ankle_shank + Q(t) * (G_foot + Vector2d(b, -d));
   }
@@ -373,7 +377,8 @@ TEST(Plates, SignsByHand) {
   }
   // The COPs: one per published sample in contact, none below the threshold. The last
   // stamp's COP came after all the others (one connection keeps the order).
-  ASSERT_TRUE(waitFor([&] { return !cop.msgs().empty() && cop.msgs().back()->header.stamp == stamp(n - 1); }));
+  ASSERT_TRUE(waitFor(
+      [&] { return !cop.msgs().empty() && cop.msgs().back()->header.stamp == stamp(n - 1); }));
   int in_contact = 0;
   for (const auto& c : cop.msgs()) {
     if (c->header.stamp < stamp(first)) continue;

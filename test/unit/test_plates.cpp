@@ -126,20 +126,23 @@ jle::EstimatorConfig plateConfig(const jle::DifferentiatorConfig& differentiator
 // Without the contact gate, the filtered plate channels would still carry hundreds of
 // newtons for several samples after lift-off (Savitzky-Golay: the window's stance
 // samples; Kalman: its decaying state) and the swing loads would be off by as much.
-template <typename Settled>
-void runStanceSwingStance(const jle::DifferentiatorConfig& differentiator, Settled settled) {
+// `stance(j)`: the fraction of the stance wrench that the filter returns at stamp j
+// (1 once it has seen nothing else), negative where not checked.
+template <typename Stance>
+void runStanceSwingStance(const jle::DifferentiatorConfig& differentiator, Stance stance) {
   const jle::Model<double> model = jle::modelFromUrdfString(kFoot);
   jle::Estimator estimator(model, plateConfig(differentiator));
   const int s = model.segmentOfJoint("ankle");
   auto contact = [](int k) { return k < 60 || k >= 120; };
   const double q = 0.0;
-  int swing_checked = 0, first_swing_checked = -1;
+  int swing_checked = 0, first_swing_checked = -1, stance_checked = 0;
   for (int k = 0; k < 200; ++k) {
     const double t = 3.0 + 1e-3 * k;
     if (contact(k))
       ASSERT_TRUE(estimator.addPlateSample(0, t, kF, kM));
     else
-      ASSERT_TRUE(estimator.addPlateSample(0, t, Vector3d(1.0, 0.0, -15.0), Vector3d(0.3, -0.2, 0.0)));
+      ASSERT_TRUE(
+          estimator.addPlateSample(0, t, Vector3d(1.0, 0.0, -15.0), Vector3d(0.3, -0.2, 0.0)));
     if (estimator.addJointSample(t, &q) != jle::SampleStatus::kPublished) continue;
     const int j = static_cast<int>(std::lround((estimator.stamp() - 3.0) * 1000.0));
     const jle::PlateReading& r = estimator.plateReading(0);
@@ -155,12 +158,16 @@ void runStanceSwingStance(const jle::DifferentiatorConfig& differentiator, Settl
       ++swing_checked;
     } else {
       EXPECT_TRUE(r.contact) << "stamp sample " << j;
-      // Where the filter has seen only stance samples: the hand-worked stance loads. A
-      // filter of a constant returns it up to rounding of its weights: 1e-9 of 700 N
-      // (the Savitzky-Golay weights sum to 1 within 1e-15 each).
-      if (settled(j)) {
-        EXPECT_NEAR((F - kStanceForce).norm(), 0.0, 1e-9 * 700.0) << "stamp sample " << j;
-        EXPECT_NEAR((M - kStanceMoment).norm(), 0.0, 1e-9 * 700.0) << "stamp sample " << j;
+      // The filtered plate wrench is the fraction c of the stance wrench (the samples
+      // out of contact entered the filter as zero): the foot gets c times the stance
+      // reaction, at the same COP. Rounding of the filter's weights: 1e-9 of 700 N.
+      const double c = stance(j);
+      if (c >= 0.0) {
+        const Vector3d F_expected = kSwingForce + c * (kStanceForce - kSwingForce);
+        const Vector3d M_expected = kSwingMoment + c * (kStanceMoment - kSwingMoment);
+        EXPECT_NEAR((F - F_expected).norm(), 0.0, 1e-9 * 700.0) << "stamp sample " << j;
+        EXPECT_NEAR((M - M_expected).norm(), 0.0, 1e-9 * 700.0) << "stamp sample " << j;
+        ++stance_checked;
         EXPECT_NEAR(r.cop_plate.x(), -0.15, 1e-12);
         EXPECT_NEAR(r.cop_plate.y(), -0.19, 1e-12);
       }
@@ -168,6 +175,11 @@ void runStanceSwingStance(const jle::DifferentiatorConfig& differentiator, Settl
   }
   EXPECT_EQ(first_swing_checked, 60);  // from the very first stamp after lift-off
   EXPECT_GE(swing_checked, 55);
+  // Every published stance stamp was checked: Kalman (4 samples of warm-up, stamp = the
+  // newest) 3..59; Savitzky-Golay (9 samples, stamp 4 behind) 4..59 and 120..195.
+  EXPECT_EQ(stance_checked, differentiator.type == jle::DifferentiatorType::kKalman
+                                ? 57
+                                : 56 + 76);
 }
 
 TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootSavitzkyGolayCentred) {
@@ -176,8 +188,21 @@ TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootSavitzkyGolayCentred) {
   d.window = 9;
   d.order = 2;
   d.delay = 4;  // centred: the window reaches 4 samples past the stamp
-  // The window [j - 4, j + 4] holds only stance samples for j <= 55 and j >= 124.
-  runStanceSwingStance(d, [](int j) { return j <= 55 || j >= 124; });
+  // The value weights of the centred quadratic fit over 9 equally spaced samples (the
+  // textbook Savitzky-Golay smoothing coefficients) are (-21, 14, 39, 54, 59, 54, 39,
+  // 14, -21) / 231; the stance fraction at j sums those of the window [j - 4, j + 4]'s
+  // stance samples: 1 inside a stance, e.g. (59 + 54 + 39 + 14 - 21) / 231 = 145 / 231 at
+  // heel strike (j = 120). Had the 15 N of noise entered the filter, the foot would get
+  // ~15 N x (-21 + 14 + 39 + 54) / 231 = 5.6 N more there.
+  runStanceSwingStance(d, [](int j) {
+    const double w[9] = {-21, 14, 39, 54, 59, 54, 39, 14, -21};
+    double sum = 0.0;
+    for (int i = 0; i < 9; ++i) {
+      const int sample = j - 4 + i;
+      if (sample < 60 || sample >= 120) sum += w[i];
+    }
+    return sum / 231.0;
+  });
 }
 
 TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootKalman) {
@@ -189,7 +214,7 @@ TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootKalman) {
   // The filter starts at rest at its first sample: the first stance is exact (a
   // constant). After heel strike it converges in ~30 ms per e-fold: the second stance is
   // not checked (that lag is the filter's, as for the kinematics).
-  runStanceSwingStance(d, [](int j) { return j < 60; });
+  runStanceSwingStance(d, [](int j) { return j < 60 ? 1.0 : -1.0; });
 }
 
 // A plate that goes silent: under the default policy (zero) it is out of contact once

@@ -108,7 +108,8 @@ TEST_F(PlatesOffline, SettingsErrorsNameTheKey) {
   expectError("force_plates: [{name: a, topic: t}]", "'force_plates[0]/link'");
   expectError("force_plates: [{name: a, topic: t, link: foot}, {name: a, topic: u, link: foot}]",
               "'force_plates[1]/name'");
-  expectError("force_plates: [{name: a, topic: t, link: foot, sign: -1}]", "'force_plates[0]/sign'");
+  expectError("force_plates: [{name: a, topic: t, link: foot, sign: -1}]",
+              "'force_plates[0]/sign'");
   expectError("force_plates: [{name: a, topic: t, link: foot, contact_threshold: -1}]",
               "'force_plates[0]/contact_threshold'");
   expectError("force_plates: [{name: a, topic: t, link: foot, timeout: 0}]",
@@ -167,7 +168,8 @@ TEST_F(PlatesOffline, ProcessBagAppliesThePlateWithItsConfiguredPose) {
     ASSERT_TRUE(loads);
     ASSERT_EQ(loads->effort.size(), 1u);
     ASSERT_EQ(loads->effort_per_kg.size(), 1u);
-    const int k = static_cast<int>(std::lround((loads->header.stamp - ros::Time(100, 0)).toSec() * 1000));
+    const double s = (loads->header.stamp - ros::Time(100, 0)).toSec();
+    const int k = static_cast<int>(std::lround(s * 1000.0));
     // Constant inputs, q = 0: rounding only, 1e-12 of 30 N m.
     const double expected = k < 20 ? 30.5096675 : -0.4903325;
     EXPECT_NEAR(loads->effort[0], expected, 1e-10) << k;
