@@ -6,6 +6,7 @@
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>
@@ -64,6 +65,20 @@ struct UncertaintyConfig {
   bool linearize_state = true;
 };
 
+/// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
+/// frame, moment about the plate origin; its reaction acts on `plate.link`.
+/// The plate's six components are resampled and filtered at the joint stamps like a
+/// wrench input's. The contact threshold acts on each raw sample before filtering (a
+/// sample below it enters the filter as zero) and again on the raw signal at the
+/// estimate's stamp: the reaction is applied only when the plate is in contact at that
+/// stamp, so the filters' memory of a stance never loads a swinging foot. The applied
+/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot.
+struct PlateInputConfig {
+  ForcePlateConfig plate;
+  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
+  StalePolicy stale_policy = StalePolicy::kZero;
+};
+
 /// Arithmetic of the dynamics (the filters always run in double).
 enum class Precision : std::uint8_t { kDouble, kFloat };
 
@@ -101,6 +116,8 @@ struct EstimatorConfig {
   /// Loads are computed for every n-th joint sample (the filters see every sample).
   int decimation = 1;
   UncertaintyConfig uncertainty;
+  /// Force plates (after the wrench inputs in the filter bank).
+  std::vector<PlateInputConfig> plates;
 };
 
 /// What became of a joint sample.
@@ -142,6 +159,24 @@ class Estimator {
 
   /// Forgets all history (a backward jump of time).
   void reset();
+
+  /// A sample of force plate k at time t [s] as the plate measures it: the force [N]
+  /// and moment [N m] the foot applies to the plate, plate frame, moment about the plate
+  /// origin. A sample below the contact threshold is taken as zero. Samples not newer
+  /// than the newest held, or non-finite, are dropped (false).
+  bool addPlateSample(int k, double t, const Eigen::Vector3d& force_plate,
+                      const Eigen::Vector3d& moment_plate);
+  /// Sets the pose of plate k's frame in the world [m] (the root frame for a fixed base);
+  /// the configured pose until then.
+  void setPlatePose(int k, const Eigen::Matrix3d& R_world_plate, const Eigen::Vector3d& p_world_plate);
+  const PlateInputConfig& plateConfig(int k) const { return plates_[k].config; }
+  /// Plate k as applied at the last published sample: contact, COP (plate frame), free
+  /// moment, reaction on the foot. No contact: nothing was applied.
+  const PlateReading& plateReading(int k) const { return plates_[k].reading; }
+  /// Whether plate k was stale at the last joint sample.
+  bool plateStale(int k) const { return plates_[k].input.stale; }
+  /// Whether plate k's foot is on a segment whose loads are computed.
+  bool plateNeeded(int k) const { return plates_[k].input.needed; }
 
   /// Time the last published loads describe [s] (the newest joint sample minus the
   /// filter's delay).
@@ -216,6 +251,16 @@ class Estimator {
   void computeCovariance(const BaseState<double>& base_state);
   void loadsPass(Data<double>& data, const VectorX<double>& q, const VectorX<double>& qd,
                  const BaseState<double>& base_state);
+  struct Plate {
+    PlateInputConfig config;
+    ForcePlateConfig filtered;  // config.plate with a zero threshold (for the filtered wrench)
+    Input input;                // samples (zero below the threshold); input.frame: the foot
+    bool contact = false;       // raw signal in contact at the estimate's stamp
+    PlateReading reading;
+  };
+  // Contact of every plate at the estimate's stamp (raw signal); true if any changed.
+  bool updatePlateContacts();
+  void applyPlates();
   // Value of input k at time t (linear between samples, held past the newest).
   Eigen::Matrix<double, 6, 1> sampleInput(Input& input, double t);
 
@@ -240,6 +285,8 @@ class Estimator {
   std::vector<double> channels_;  // q (nq), base (7), wrenches (6 per input)
   int base_channel_ = 0;
   int wrench_channel_ = 0;
+  std::vector<Plate> plates_;
+  int plate_channel_ = 0;
   VectorX<double> q_, qd_, qdd_;
   Eigen::Quaterniond last_orientation_ = Eigen::Quaterniond::Identity();
   double last_t_ = 0.0;

@@ -54,7 +54,8 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
       qd_f_(VectorX<float>::Zero(model.nq)),
       qdd_f_(VectorX<float>::Zero(model.nq)),
       bank_(config.differentiator,
-            model.nq + (model.floating_base ? 7 : 0) + 6 * static_cast<int>(config.wrenches.size())),
+            model.nq + (model.floating_base ? 7 : 0) + 6 * static_cast<int>(config.wrenches.size()) +
+                6 * static_cast<int>(config.plates.size())),
       q_(VectorX<double>::Zero(model.nq)),
       qd_(VectorX<double>::Zero(model.nq)),
       qdd_(VectorX<double>::Zero(model.nq)),
@@ -97,6 +98,32 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
     input.values.assign(kWrenchHistory, Eigen::Matrix<double, 6, 1>::Zero());
     inputs_.push_back(input);
   }
+  plate_channel_ = wrench_channel_ + 6 * static_cast<int>(inputs_.size());
+  for (const PlateInputConfig& c : config_.plates) {
+    Plate plate;
+    plate.config = c;
+    plate.filtered = c.plate;
+    plate.filtered.contact_threshold = 0.0;
+    const std::string what = "force plate '" + c.plate.name + "'";
+    try {
+      plate.input.frame = model_.frameIndex(c.plate.link);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(what + ": " + e.what());
+    }
+    if (!(c.timeout > 0.0)) throw std::invalid_argument(what + ": timeout must be positive");
+    if (!(c.plate.contact_threshold >= 0.0) || !std::isfinite(c.plate.contact_threshold))
+      throw std::invalid_argument(what + ": contact_threshold must be finite and >= 0");
+    if (!std::isfinite(c.plate.surface_height))
+      throw std::invalid_argument(what + ": surface_height is not finite");
+    plate.input.config.name = c.plate.name;
+    plate.input.config.link = c.plate.link;
+    plate.input.config.timeout = c.timeout;
+    plate.input.config.stale_policy = c.stale_policy;
+    plate.input.times.assign(kWrenchHistory, 0.0);
+    plate.input.values.assign(kWrenchHistory, Eigen::Matrix<double, 6, 1>::Zero());
+    plates_.push_back(plate);
+    setPlatePose(static_cast<int>(plates_.size()) - 1, c.plate.R_world_plate, c.plate.p_world_plate);
+  }
   channels_.assign(static_cast<std::size_t>(bank_.channels()), 0.0);
   last_inputs_.assign(channels_.size() * 3, 0.0);
 
@@ -128,6 +155,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   prune_ = static_cast<int>(dynamics_segments_.size()) < n;
   for (Input& input : inputs_) input.needed = dyn[model_.frames[input.frame].segment] != 0;
   setUpCovariance();
+  for (Plate& p : plates_) p.input.needed = dyn[model_.frames[p.input.frame].segment] != 0;
 }
 
 void Estimator::reset() {
@@ -137,9 +165,100 @@ void Estimator::reset() {
     input.head = 0;
     input.stale = true;
   }
+  for (Plate& p : plates_) {
+    p.input.count = 0;
+    p.input.head = 0;
+    p.input.stale = true;
+    p.contact = false;
+    p.reading = PlateReading();
+  }
   have_last_ = false;
   have_result_ = false;
   sample_count_ = 0;
+}
+
+bool Estimator::addPlateSample(int k, double t, const Eigen::Vector3d& force_plate,
+                               const Eigen::Vector3d& moment_plate) {
+  Plate& plate = plates_.at(static_cast<std::size_t>(k));
+  Input& input = plate.input;
+  if (!std::isfinite(t) || !force_plate.allFinite() || !moment_plate.allFinite()) return false;
+  if (input.count > 0) {
+    const double newest = input.times[(input.head + kWrenchHistory - 1) % kWrenchHistory];
+    if (!(t > newest)) return false;
+  }
+  // Below the threshold (noise, a foot above the plate): zero, so that the filters hold
+  // no phantom load between contacts.
+  const bool contact = readForcePlate(plate.config.plate, force_plate, moment_plate).contact;
+  input.times[input.head] = t;
+  if (contact)
+    input.values[input.head] << force_plate, moment_plate;
+  else
+    input.values[input.head].setZero();
+  input.head = (input.head + 1) % kWrenchHistory;
+  if (input.count < kWrenchHistory) ++input.count;
+  return true;
+}
+
+void Estimator::setPlatePose(int k, const Eigen::Matrix3d& R_world_plate,
+                             const Eigen::Vector3d& p_world_plate) {
+  Plate& plate = plates_.at(static_cast<std::size_t>(k));
+  if (!R_world_plate.allFinite() || !p_world_plate.allFinite() ||
+      !(std::abs(R_world_plate.determinant() - 1.0) < 1e-6) ||
+      !R_world_plate.isUnitary(1e-6))
+    throw std::invalid_argument("force plate '" + plate.config.plate.name +
+                                "': the pose is not a finite rotation and position");
+  plate.config.plate.R_world_plate = R_world_plate;
+  plate.config.plate.p_world_plate = p_world_plate;
+  plate.filtered.R_world_plate = R_world_plate;
+  plate.filtered.p_world_plate = p_world_plate;
+}
+
+bool Estimator::updatePlateContacts() {
+  bool changed = false;
+  for (Plate& p : plates_) {
+    bool contact = false;
+    if (p.input.needed) {
+      // The raw signal at the estimate's stamp (sampleInput's staleness belongs to the
+      // newest joint sample: kept).
+      const bool stale = p.input.stale;
+      const Eigen::Matrix<double, 6, 1> raw = sampleInput(p.input, stamp_);
+      p.input.stale = stale;
+      const double normal = -raw[2];
+      contact = normal >= p.config.plate.contact_threshold && normal > 0.0;
+    }
+    changed = changed || contact != p.contact;
+    p.contact = contact;
+  }
+  return changed;
+}
+
+void Estimator::applyPlates() {
+  for (std::size_t k = 0; k < plates_.size(); ++k) {
+    Plate& p = plates_[k];
+    p.reading = PlateReading();
+    if (!p.input.needed || !p.contact) continue;
+    const int c = plate_channel_ + 6 * static_cast<int>(k);
+    const Eigen::Vector3d f(bank_.value(c), bank_.value(c + 1), bank_.value(c + 2));
+    const Eigen::Vector3d m(bank_.value(c + 3), bank_.value(c + 4), bank_.value(c + 5));
+    // In contact at the stamp; the filtered wrench still pressing into the plate.
+    p.reading = readForcePlate(p.filtered, f, m);
+    if (!p.reading.contact) continue;
+    const Frame<double>& frame = model_.frames[static_cast<std::size_t>(p.input.frame)];
+    const int s = frame.segment;
+    Eigen::Vector3d foot_world;
+    if (config_.precision == Precision::kFloat)
+      foot_world = (data_f_.p_world[s] + data_f_.R_world[s] * frame.p_segment_frame.cast<float>())
+                       .cast<double>();
+    else
+      foot_world = data_.p_world[s] + data_.R_world[s] * frame.p_segment_frame;
+    Eigen::Vector3d force_world, moment_world;
+    plateReactionInWorld(p.filtered, p.reading, foot_world, force_world, moment_world);
+    if (config_.precision == Precision::kFloat)
+      addExternalWrench(model_f_, data_f_, p.input.frame, Eigen::Vector3f(force_world.cast<float>()),
+                        Eigen::Vector3f(moment_world.cast<float>()), WrenchFrame::kWorld);
+    else
+      addExternalWrench(model_, data_, p.input.frame, force_world, moment_world, WrenchFrame::kWorld);
+  }
 }
 
 bool Estimator::addWrench(int k, double t, const Eigen::Vector3d& force,
@@ -222,6 +341,16 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
     for (int j = 0; j < 6; ++j)
       channels_[static_cast<std::size_t>(wrench_channel_) + 6 * k + static_cast<std::size_t>(j)] = w[j];
   }
+  for (std::size_t k = 0; k < plates_.size(); ++k) {
+    Input& input = plates_[k].input;
+    if (!input.needed) {
+      input.stale = false;
+      continue;
+    }
+    const Eigen::Matrix<double, 6, 1> w = sampleInput(input, t);
+    for (int j = 0; j < 6; ++j)
+      channels_[static_cast<std::size_t>(plate_channel_) + 6 * k + static_cast<std::size_t>(j)] = w[j];
+  }
   // A gap restarts the bank inside update(); the decimation phase restarts with it.
   const bool ready = bank_.update(t, channels_.data());
   if (!ready) {
@@ -231,6 +360,8 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
   if (sample_count_++ % config_.decimation != 0) return SampleStatus::kDecimated;
   for (const Input& input : inputs_)
     if (input.stale && input.config.stale_policy == StalePolicy::kStop) return SampleStatus::kStale;
+  for (const Plate& p : plates_)
+    if (p.input.stale && p.config.stale_policy == StalePolicy::kStop) return SampleStatus::kStale;
 
   stamp_ = bank_.stamp();
   for (int i = 0; i < model_.nq; ++i) {
@@ -262,10 +393,11 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
         Eigen::Quaterniond(quat[0], quat[1], quat[2], quat[3]).toRotationMatrix();
   }
 
+  const bool contacts_changed = updatePlateContacts();
   // Same filtered inputs as the last computation: same loads (exact by construction).
   reused_ = false;
   if (config_.savings.reuse_unchanged) {
-    bool same = have_result_;
+    bool same = have_result_ && !contacts_changed;
     const std::size_t c = channels_.size();
     for (std::size_t i = 0; i < c && same; ++i)
       same = bank_.value(static_cast<int>(i)) == last_inputs_[i] &&
@@ -328,6 +460,7 @@ void Estimator::compute(const BaseState<double>& base_state) {
     else
       addExternalWrench(model_, data_, inputs_[k].frame, f, m, WrenchFrame::kLocal);
   }
+  applyPlates();
   if (config_.precision == Precision::kFloat) {
     if (have_sensors_)
       inverseDynamics(model_f_, data_f_, dynamics_segments_,

@@ -106,6 +106,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     wrench_topics_.push_back(std::move(topic));
   }
+  setUpPlates();
   joint_sub_ = nh_.subscribe(settings_.joint_states_topic, 100, &EstimatorNode::onJointState,
                              this, ros::TransportHints().tcpNoDelay());
 
@@ -290,6 +291,10 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
           if (estimator_->stale(static_cast<int>(k)))
             ROS_WARN_THROTTLE(kThrottle, "wrench input '%s' is stale: not publishing",
                               wrench_topics_[k]->settings.topic.c_str());
+        for (std::size_t k = 0; k < plate_topics_.size(); ++k)
+          if (estimator_->plateStale(static_cast<int>(k)))
+            ROS_WARN_THROTTLE(kThrottle, "force plate '%s' is stale: not publishing",
+                              plate_topics_[k]->settings.topic.c_str());
         break;
       default: break;
     }
@@ -438,6 +443,9 @@ void EstimatorNode::publish(const ros::Time& received) {
       loads_msg_.effort_stddev[i] = std::sqrt(estimator_->effortVariance(published_segments_[i]));
     }
   }
+  for (std::size_t i = 0; i < loads_msg_.effort_per_kg.size(); ++i)
+    loads_msg_.effort_per_kg[i] = loads_msg_.effort[i] / body_mass_;
+  publishPlates(stamp);
   loads_pub_.publish(loads_msg_);
   if (residual_pub_ && residual_pub_.getNumSubscribers() > 0) {
     wrench_msg_.header.stamp = stamp;
@@ -467,6 +475,9 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   for (std::size_t k = 0; k < wrench_topics_.size(); ++k)
     if (estimator_->stale(static_cast<int>(k)))
       stale += (stale.empty() ? "" : ", ") + wrench_topics_[k]->settings.topic;
+  for (std::size_t k = 0; k < plate_topics_.size(); ++k)
+    if (estimator_->plateStale(static_cast<int>(k)))
+      stale += (stale.empty() ? "" : ", ") + plate_topics_[k]->settings.topic;
   if (counters_.published == 0)
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no loads published yet");
   else if (!stale.empty())
@@ -486,10 +497,125 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("messages with unknown joints", counters_.unknown_joints);
   status.add("not published: stale input", counters_.stale);
   status.add("time jumps back", counters_.resets);
+  status.add("force plate samples received", counters_.plate_samples);
   status.add("stale inputs", stale);
   latency_sum_ = 0.0;
   latency_max_ = 0.0;
   latency_count_ = 0;
+}
+
+// ---------------------------------------------------------------------------------
+// Force plates and the mass-normalised efforts.
+
+void EstimatorNode::setUpPlates() {
+  const Model<double>& model = estimator_->model();
+  if (settings_.body_mass != 0.0) {
+    body_mass_ = settings_.body_mass > 0.0 ? settings_.body_mass : model.totalMass();
+    if (!(body_mass_ > 0.0))
+      throw SettingsError("parameter 'body_mass' is -1 but the URDF's total mass is " +
+                          std::to_string(body_mass_) + " kg");
+    loads_msg_.effort_per_kg.resize(loads_msg_.effort.size());
+  }
+  for (std::size_t k = 0; k < settings_.force_plates.size(); ++k) {
+    auto plate = std::make_unique<PlateTopic>();
+    plate->settings = settings_.force_plates[k];
+    const std::string& name = plate->settings.input.plate.name;
+    plate->cop_pub = private_nh_.advertise<geometry_msgs::PointStamped>("cop/" + name, 10);
+    if (!estimator_->plateNeeded(static_cast<int>(k))) {
+      ROS_INFO("force plate '%s' under link '%s' affects none of the published joints: not "
+               "subscribed", name.c_str(), plate->settings.input.plate.link.c_str());
+      plate_topics_.push_back(std::move(plate));
+      continue;
+    }
+    plate->subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
+        plate->settings.topic, 100,
+        [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onPlate(k, msg); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    plate_topics_.push_back(std::move(plate));
+  }
+}
+
+bool EstimatorNode::resolvePlatePose(PlateTopic& plate, const std::string& frame) {
+  if (plate.pose_known && frame == plate.frame) return true;
+  if (plate.settings.pose_configured) {  // the estimator holds the configured pose
+    plate.frame = frame;
+    plate.pose_known = true;
+    return true;
+  }
+  // A lab plate is fixed in the world: looked up until found, then kept. The estimator's
+  // world is world_frame for a floating base, the URDF root link for a fixed one.
+  const Model<double>& model = estimator_->model();
+  const std::string& world = model.floating_base ? settings_.world_frame : model.link_name[0];
+  try {
+    const geometry_msgs::TransformStamped tf =
+        tf_buffer_.lookupTransform(world, frame, ros::Time(0));
+    const Eigen::Isometry3d X = tf2::transformToEigen(tf);
+    for (std::size_t k = 0; k < plate_topics_.size(); ++k)
+      if (plate_topics_[k].get() == &plate)
+        estimator_->setPlatePose(static_cast<int>(k), X.rotation(), X.translation());
+    plate.frame = frame;
+    plate.pose_known = true;
+    return true;
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_THROTTLE(kThrottle, "force plate '%s': no pose of frame '%s' in '%s' from tf2 (and "
+                      "no position/orientation configured): %s",
+                      plate.settings.input.plate.name.c_str(), frame.c_str(), world.c_str(),
+                      e.what());
+    return false;
+  }
+}
+
+void EstimatorNode::onPlate(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+  ++counters_.plate_samples;
+  try {
+    PlateTopic& plate = *plate_topics_[k];
+    const std::string& name = plate.settings.input.plate.name;
+    Eigen::Vector3d f, m;
+    tf2::fromMsg(msg->wrench.force, f);
+    tf2::fromMsg(msg->wrench.torque, m);
+    if (!f.allFinite() || !m.allFinite()) {
+      ROS_ERROR_THROTTLE(kThrottle, "force plate '%s': non-finite force or torque: dropped",
+                         name.c_str());
+      ++counters_.dropped_invalid;
+      return;
+    }
+    const std::string& frame =
+        plate.settings.frame.empty() ? msg->header.frame_id : plate.settings.frame;
+    if (frame.empty() && !plate.settings.pose_configured) {
+      ROS_ERROR_THROTTLE(kThrottle, "force plate '%s': empty header.frame_id and no 'frame' "
+                         "configured: dropped", name.c_str());
+      ++counters_.dropped_frame;
+      return;
+    }
+    const ros::Time stamp = msg->header.stamp.isZero() ? ros::Time::now() : msg->header.stamp;
+    checkTimeJump(stamp);  // as for wrenches: a looping bag
+    if (!resolvePlatePose(plate, frame)) {
+      ++counters_.dropped_frame;
+      return;
+    }
+    if (!estimator_->addPlateSample(static_cast<int>(k), relative(stamp), f, m)) {
+      ++counters_.dropped_order;
+      ROS_WARN_THROTTLE(kThrottle, "force plate '%s': stamp %.9f not newer than the last: dropped",
+                        name.c_str(), stamp.toSec());
+    }
+  } catch (const std::exception& e) {
+    ++counters_.dropped_invalid;
+    ROS_ERROR_THROTTLE(kThrottle, "force plate input %zu: %s", k, e.what());
+  }
+}
+
+void EstimatorNode::publishPlates(const ros::Time& stamp) {
+  for (std::size_t k = 0; k < plate_topics_.size(); ++k) {
+    const PlateReading& r = estimator_->plateReading(static_cast<int>(k));
+    if (!r.contact) continue;
+    const PlateTopic& plate = *plate_topics_[k];
+    cop_msg_.header.stamp = stamp;
+    cop_msg_.header.frame_id = plate.frame;
+    cop_msg_.point.x = r.cop_plate.x();
+    cop_msg_.point.y = r.cop_plate.y();
+    cop_msg_.point.z = r.cop_plate.z();
+    plate.cop_pub.publish(cop_msg_);
+  }
 }
 
 }  // namespace jle

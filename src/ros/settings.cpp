@@ -187,6 +187,65 @@ WrenchTopicSettings parseWrench(const XmlRpcValue& value, const std::string& pre
   return w;
 }
 
+// A list of `n` numbers (key e.g. "force_plates[0]/position").
+void readNumbers(const XmlRpcValue& v, const std::string& key, int n, double* out) {
+  if (v.getType() != XmlRpcValue::TypeArray || v.size() != n)
+    throw SettingsError("parameter '" + key + "' must be a list of " + std::to_string(n) +
+                        " numbers");
+  for (int i = 0; i < n; ++i) {
+    const XmlRpcValue& e = v[i];
+    if (e.getType() == XmlRpcValue::TypeDouble)
+      out[i] = static_cast<double>(const_cast<XmlRpcValue&>(e));
+    else if (e.getType() == XmlRpcValue::TypeInt)
+      out[i] = static_cast<int>(const_cast<XmlRpcValue&>(e));
+    else
+      wrongType(key + "[" + std::to_string(i) + "]", e, "a number");
+    if (!std::isfinite(out[i])) throw SettingsError("parameter '" + key + "' is not finite");
+  }
+}
+
+PlateTopicSettings parsePlate(const XmlRpcValue& value, const std::string& prefix) {
+  PlateTopicSettings p;
+  ForcePlateConfig& plate = p.input.plate;
+  Section s(value, prefix);
+  if (value.getType() != XmlRpcValue::TypeStruct) wrongType(prefix, value, "a map");
+  for (const char* key : {"name", "topic", "link"})
+    if (!s.has(key)) throw SettingsError("parameter '" + s.name(key) + "' is required");
+  s.read("name", plate.name);
+  if (plate.name.empty()) throw SettingsError("parameter '" + s.name("name") + "' is empty");
+  s.read("topic", p.topic);
+  s.read("frame", p.frame);
+  s.read("link", plate.link);
+  s.read("surface_height", plate.surface_height);
+  s.read("contact_threshold", plate.contact_threshold);
+  if (plate.contact_threshold < 0.0)
+    throw SettingsError("parameter '" + s.name("contact_threshold") + "' must not be negative");
+  s.read("timeout", p.input.timeout);
+  if (!(p.input.timeout > 0.0))
+    throw SettingsError("parameter '" + s.name("timeout") + "' must be positive");
+  std::string policy = "zero";
+  s.read("stale_policy", policy);
+  p.input.stale_policy = choose<StalePolicy>(
+      s.name("stale_policy"), policy,
+      {{"hold", StalePolicy::kHold}, {"zero", StalePolicy::kZero}, {"stop", StalePolicy::kStop}});
+  if (s.has("position")) {
+    readNumbers(s.get("position"), s.name("position"), 3, plate.p_world_plate.data());
+    p.pose_configured = true;
+  }
+  if (s.has("orientation")) {
+    double xyzw[4];
+    readNumbers(s.get("orientation"), s.name("orientation"), 4, xyzw);
+    const Eigen::Quaterniond o(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+    if (!(o.norm() > 1e-6))
+      throw SettingsError("parameter '" + s.name("orientation") +
+                          "' must be a quaternion [x, y, z, w] of non-zero norm");
+    plate.R_world_plate = o.normalized().toRotationMatrix();
+    p.pose_configured = true;
+  }
+  s.finish();
+  return p;
+}
+
 XmlRpcValue fromYaml(const YAML::Node& node) {
   XmlRpcValue out;
   switch (node.Type()) {
@@ -309,6 +368,23 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
       n.estimator.wrenches.push_back(n.wrenches.back().input);
     }
   }
+  if (s.has("force_plates")) {
+    const XmlRpcValue& list = s.get("force_plates");
+    if (list.getType() != XmlRpcValue::TypeArray) wrongType("force_plates", list, "a list of maps");
+    std::set<std::string> names;
+    for (int i = 0; i < list.size(); ++i) {
+      const std::string key = "force_plates[" + std::to_string(i) + "]";
+      n.force_plates.push_back(parsePlate(list[i], key));
+      if (!names.insert(n.force_plates.back().input.plate.name).second)
+        throw SettingsError("parameter '" + key + "/name': '" +
+                            n.force_plates.back().input.plate.name + "' names another plate too");
+      n.estimator.plates.push_back(n.force_plates.back().input);
+    }
+  }
+  s.read("body_mass", n.body_mass);
+  if (!(n.body_mass >= 0.0 || n.body_mass == -1.0))
+    throw SettingsError("parameter 'body_mass' must be a mass > 0 [kg], 0 (off) or -1 (the "
+                        "URDF's total mass)");
   if (n.time_jump_threshold <= 0.0)
     throw SettingsError("parameter 'time_jump_threshold' must be positive");
   s.read("base_residual_threshold", n.base_residual_threshold);

@@ -70,7 +70,9 @@ publishes when the bag is played to it, without the timing of a live system.
 
 Not supported offline: a floating base (its pose comes from tf2), and wrenches
 expressed in a frame that moves relative to their link (the node asks tf2): a wrench's
-frame must be a URDF link rigid to the configured link; any other is an error.
+frame must be a URDF link rigid to the configured link; any other is an error. Force
+plates (force_plates) need their pose in the config (position, orientation): there
+is no tf2 to look it up.
 
 Progress goes to standard error about once a second when it is a terminal; a summary
 line at the end gives the samples per second of the estimator alone (compute) and of
@@ -168,6 +170,14 @@ class BagProcessor {
       topic.topic = globalName(w.topic);
       wrench_topics_.push_back(topic);
     }
+    for (const jle::PlateTopicSettings& p : settings.force_plates) plate_topics_.push_back(globalName(p.topic));
+    if (settings.body_mass != 0.0) {
+      body_mass_ = settings.body_mass > 0.0 ? settings.body_mass : model.totalMass();
+      if (!(body_mass_ > 0.0))
+        throw jle::SettingsError("parameter 'body_mass' is -1 but the URDF's total mass is " +
+                                 std::to_string(body_mass_) + " kg");
+      loads_.effort_per_kg.resize(segments_.size());
+    }
     const std::size_t n = segments_.size();
     loads_.name.resize(n);
     loads_.wrench.resize(n);
@@ -195,6 +205,7 @@ class BagProcessor {
     }
     std::vector<std::string> topics{joint_topic_};
     for (const WrenchTopic& w : wrench_topics_) topics.push_back(w.topic);
+    for (const std::string& p : plate_topics_) topics.push_back(p);
     rosbag::View view(in, rosbag::TopicQuery(topics));
     checkTopics(in, view);
     openOutputs();
@@ -215,6 +226,11 @@ class BagProcessor {
           if (topic == wrench_topics_[k].topic) {
             deserialize(m, buffer_, wrench_msg_);
             onWrench(k, m.getTime());
+          }
+        for (std::size_t k = 0; k < plate_topics_.size(); ++k)
+          if (topic == plate_topics_[k]) {
+            deserialize(m, buffer_, wrench_msg_);
+            onPlate(k, m.getTime());
           }
       }
       if (progress && (++count & 1023) == 0 && Clock::now() >= next_progress) {
@@ -259,6 +275,7 @@ class BagProcessor {
     const std::map<std::string, std::string> expected = [&] {
       std::map<std::string, std::string> e{{joint_topic_, "sensor_msgs/JointState"}};
       for (const WrenchTopic& w : wrench_topics_) e[w.topic] = "geometry_msgs/WrenchStamped";
+      for (const std::string& p : plate_topics_) e[p] = "geometry_msgs/WrenchStamped";
       return e;
     }();
     std::map<std::string, bool> present;
@@ -289,6 +306,12 @@ class BagProcessor {
                      "process_bag: warning: no messages on wrench topic '%s' in %s: the loads "
                      "are computed without it\n",
                      w.topic.c_str(), options_.bag.c_str());
+    for (const std::string& p : plate_topics_)
+      if (!present.count(p))
+        std::fprintf(stderr,
+                     "process_bag: warning: no messages on force plate topic '%s' in %s: the "
+                     "loads are computed without it\n",
+                     p.c_str(), options_.bag.c_str());
   }
 
   void openOutputs() {
@@ -450,6 +473,25 @@ class BagProcessor {
     if (!taken) ++counters_.dropped_order;
   }
 
+  // A force plate sample: as the node, with the configured plate pose.
+  void onPlate(std::size_t k, const ros::Time& bag_time) {
+    ++counters_.wrenches;
+    const geometry_msgs::WrenchStamped& msg = wrench_msg_;
+    const Eigen::Vector3d f(msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z);
+    const Eigen::Vector3d m(msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z);
+    if (!f.allFinite() || !m.allFinite()) {
+      ++counters_.dropped_invalid;
+      if (!said_wrench_invalid_)
+        warnOnce(said_wrench_invalid_, plate_topics_[k] + ": non-finite force or torque: dropped");
+      return;
+    }
+    const ros::Time stamp = msg.header.stamp.isZero() ? bag_time : msg.header.stamp;
+    const Clock::time_point c0 = Clock::now();
+    const bool taken = estimator_.addPlateSample(static_cast<int>(k), relative(stamp), f, m);
+    compute_ += Clock::now() - c0;
+    if (!taken) ++counters_.dropped_order;
+  }
+
   void write() {
     ++counters_.published;
     if (!out_bag_ && !csv_ && !sto_) return;
@@ -496,6 +538,8 @@ class BagProcessor {
         loads_.effort_stddev[i] = *row++ = std::sqrt(estimator_.effortVariance(segments_[i]));
       }
     }
+    for (std::size_t i = 0; i < loads_.effort_per_kg.size(); ++i)
+      loads_.effort_per_kg[i] = loads_.effort[i] / body_mass_;
     if (csv_) csv_->writeRow(row_.data(), row_.size());
     if (sto_) sto_->writeRow(row_.data(), row_.size());
     if (out_bag_) {
@@ -542,6 +586,8 @@ class BagProcessor {
   jle::JointStateMap joints_;
   std::string joint_topic_;
   std::vector<WrenchTopic> wrench_topics_;
+  std::vector<std::string> plate_topics_;  // settings.force_plates order
+  double body_mass_ = 0.0;                 // [kg] effort_per_kg divisor; 0: none
   ReuseBuffer buffer_;
   sensor_msgs::JointState joint_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
@@ -574,6 +620,12 @@ void run(const Options& options) {
     throw std::runtime_error(options.config +
                              ": floating_base is not supported by process_bag "
                              "(the base pose comes from tf2); use the node");
+  for (std::size_t k = 0; k < settings.force_plates.size(); ++k)
+    if (!settings.force_plates[k].pose_configured)
+      throw std::runtime_error(options.config + ": force_plates[" + std::to_string(k) + "] '" +
+                               settings.force_plates[k].input.plate.name +
+                               "' has no position/orientation: process_bag has no tf2 to look "
+                               "up the plate's pose");
   const jle::Model<double> model =
       jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));
   jle::completeSensorLinks(model, settings);

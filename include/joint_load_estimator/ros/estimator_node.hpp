@@ -7,6 +7,7 @@
 #include <joint_load_estimator/ros/settings.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
@@ -36,6 +37,8 @@ struct NodeCounters {
   long unknown_joints = 0;     ///< messages naming joints the model does not have
   long stale = 0;              ///< samples not published because an input was stale
   long resets = 0;             ///< backward time jumps
+  long plate_samples = 0;      ///< force plate WrenchStamped messages received (plates also
+                               ///< count in dropped_* like wrenches)
 };
 
 class EstimatorNode {
@@ -83,7 +86,19 @@ class EstimatorNode {
     std::vector<Eigen::Matrix<double, 6, 1>> mean, m2;
   };
 
+  struct PlateTopic {
+    PlateTopicSettings settings;
+    ros::Subscriber subscriber;
+    ros::Publisher cop_pub;
+    std::string frame;  // the plate frame whose pose the estimator holds (COP frame_id)
+    bool pose_known = false;
+  };
+
   void onJointState(const sensor_msgs::JointState::ConstPtr& msg);
+  void onPlate(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
+  bool resolvePlatePose(PlateTopic& plate, const std::string& frame);
+  void setUpPlates();
+  void publishPlates(const ros::Time& stamp);
   void onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
   bool resolveFrame(WrenchTopic& topic, const std::string& frame, const ros::Time& stamp,
                     Eigen::Matrix3d& R, Eigen::Vector3d& p);
@@ -118,6 +133,9 @@ class EstimatorNode {
   std::vector<ros::Publisher> wrench_pubs_;
   joint_load_estimator::JointLoads loads_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
+  std::vector<std::unique_ptr<PlateTopic>> plate_topics_;
+  geometry_msgs::PointStamped cop_msg_;
+  double body_mass_ = 0.0;  // [kg] the divisor of effort_per_kg; 0: not published
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   diagnostic_updater::Updater updater_;

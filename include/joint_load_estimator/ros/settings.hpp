@@ -30,6 +30,14 @@ struct WrenchTopicSettings {
   double moment_threshold = 0.5;  ///< [N m]
 };
 
+/// One force plate as configured (force_plates[i]).
+struct PlateTopicSettings {
+  PlateInputConfig input;  ///< input.plate.name, .link, surface_height, contact_threshold, pose
+  std::string topic;
+  std::string frame;           ///< tf2 frame of the plate; empty: the message's header.frame_id
+  bool pose_configured = false;  ///< position/orientation given: no tf2 look-up
+};
+
 struct NodeSettings {
   std::string robot_description = "robot_description";  ///< parameter holding the URDF
   std::string joint_states_topic = "joint_states";
@@ -50,6 +58,9 @@ struct NodeSettings {
   /// ~calibrate_bias. Empty: not loaded, and calibrate_bias writes none.
   std::string bias_file;
   EstimatorConfig estimator;
+  std::vector<PlateTopicSettings> force_plates;  ///< also in estimator.plates
+  /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
+  double body_mass = 0.0;
 };
 
 /// The node's differentiator when the parameters name none (see docs/accuracy.md).
