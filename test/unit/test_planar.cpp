@@ -1,6 +1,7 @@
 // The planar 3x3 path (planar.hpp, savings.planar) against the 6x6 path and the
 // closed form of the paper's planar foot: random planar chains and trees, detection,
-// forced mode, the per-sample fallback for out-of-plane wrenches, no allocation.
+// forced mode, the per-sample fallback for out-of-plane wrenches (no allocation per
+// sample: test_no_allocation.cpp).
 //
 // Tolerance: the two paths evaluate the same physics along different sums (world-plane
 // 2-D sums against sums in each segment frame), so they agree to a few units of double
@@ -20,29 +21,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
-#include <new>
 #include <string>
 #include <vector>
-
-// Counts heap allocations (the per-sample path must make none; as test_no_allocation).
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -534,29 +517,6 @@ TEST(Planar, ForcedModeDropsWhatDetectionRefused) {
   jle::ModelOptions floating;
   floating.floating_base = true;
   EXPECT_THROW(jle::Estimator(jle::modelFromUrdfString(twoLinks("0 0 1"), floating), on), std::invalid_argument);
-}
-
-TEST(Planar, NoAllocationPerSample) {
-  const jle::Model<double> arm = jle::modelFromUrdfFile(kData + "/urdf/planar_arm.urdf");
-  jle::EstimatorConfig c;
-  c.gravity_world = Vec3(0, -kG, 0);
-  jle::WrenchInputConfig w;
-  w.name = w.link = "tool";
-  c.wrenches.push_back(w);
-  jle::Estimator estimator(arm, c);
-  ASSERT_TRUE(estimator.planar());
-  std::vector<double> q(static_cast<std::size_t>(arm.nq), 0.0);
-  long before = 0, planar = 0;
-  for (int k = 0; k < 2000; ++k) {
-    if (k == 100) before = g_allocations;
-    const double t = 1e-3 * k;
-    for (std::size_t i = 0; i < q.size(); ++i) q[i] = 0.5 * std::sin(t + i);
-    // Out of the plane now and then: the fallback must not allocate either.
-    estimator.addWrench(0, t, Vec3(1, 0, k >= 1900 && k < 1910 ? 1.0 : 0.0), Vec3(0, 0, 0.1));
-    if (estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished) planar += estimator.lastWasPlanar();
-  }
-  EXPECT_EQ(g_allocations - before, 0);
-  EXPECT_GT(planar, 1700);
 }
 
 }  // namespace
