@@ -212,11 +212,18 @@ void scaling(benchmark::State& state, bool tree) {
 }
 
 // One saving switched relative to the defaults (all exact savings on).
-jle::EstimatorConfig savingsVariant(const std::string& variant) {
+// A "_gy" suffix: gravity along -y (a vertical planar arm turning about z: planar).
+jle::EstimatorConfig savingsVariant(std::string variant) {
   jle::EstimatorConfig c;
+  const std::string gy = "_gy";
+  if (variant.size() > gy.size() && variant.compare(variant.size() - gy.size(), gy.size(), gy) == 0) {
+    c.gravity_world = Eigen::Vector3d(0.0, -9.80665, 0.0);
+    variant.resize(variant.size() - gy.size());
+  }
   if (variant == "none") {
     c.savings.prune = c.savings.massless_chains = c.savings.gyroscopic = false;
     c.savings.reuse_unchanged = false;
+    c.savings.planar = jle::PlanarMode::kOff;
   } else if (variant == "prune_off") {
     c.savings.prune = false;
   } else if (variant == "massless_off") {
@@ -241,6 +248,8 @@ jle::EstimatorConfig savingsVariant(const std::string& variant) {
     c.uncertainty.inertia_fraction = 0.1;
     c.uncertainty.linearize_state = variant.find("full") != std::string::npos;
     c.uncertainty.diagonal_only = variant.find("diag") != std::string::npos;
+  } else if (variant == "planar_off") {
+    c.savings.planar = jle::PlanarMode::kOff;
   }
   return c;
 }
@@ -265,6 +274,7 @@ void estimatorStep(benchmark::State& state, const std::string& file, const std::
     k = (k + 1) % n;
   }
   state.counters["computed_segments"] = static_cast<double>(estimator.dynamicsSegments().size());
+  state.counters["planar"] = estimator.lastWasPlanar();
 }
 
 }  // namespace
@@ -301,6 +311,16 @@ JLE_SAVING(talos_all_still, "/urdf/talos_reduced.urdf", "", true);
 JLE_SAVING(planar_arm_moving, "/urdf/planar_arm.urdf", "", false);
 JLE_SAVING(panda_chain_moving, "/urdf/chains/panda_chain.urdf", "", false);
 JLE_SAVING(panda_chain_still, "/urdf/chains/panda_chain.urdf", "", true);
+// savings.planar: planar scenes (the planar arm and a 12-link planar chain, gravity in
+// their plane) with the 3x3 path (auto detects it) and without; a spatial arm, where
+// detection refuses at construction, with auto and off (what detection costs per
+// sample: nothing).
+BENCHMARK_CAPTURE(estimatorStep, planar_arm_vertical_planar_auto, "/urdf/planar_arm.urdf", "", false, "defaults_gy");
+BENCHMARK_CAPTURE(estimatorStep, planar_arm_vertical_planar_off, "/urdf/planar_arm.urdf", "", false, "planar_off_gy");
+BENCHMARK_CAPTURE(estimatorStep, planar_chain_vertical_planar_auto, "/urdf/planar_chain.urdf", "", false, "defaults_gy");
+BENCHMARK_CAPTURE(estimatorStep, planar_chain_vertical_planar_off, "/urdf/planar_chain.urdf", "", false, "planar_off_gy");
+BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_auto, "/urdf/chains/panda_chain.urdf", "", false, "defaults");
+BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/panda_chain.urdf", "", false, "planar_off");
 
 BENCHMARK_CAPTURE(coreDouble, panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",

@@ -8,6 +8,7 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/planar.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -82,6 +83,13 @@ struct PlateInputConfig {
 /// Arithmetic of the dynamics (the filters always run in double).
 enum class Precision : std::uint8_t { kDouble, kFloat };
 
+/// savings.planar: whether to solve the planar 3x3 system (planar.hpp).
+enum class PlanarMode : std::uint8_t {
+  kAuto,  ///< when the model is detected planar (exact: within 1e-12 relative of 6x6)
+  kOn,    ///< always: the user asserts planarity, out-of-plane parts are dropped
+  kOff,   ///< never
+};
+
 /// Work the estimator skips when a scene does not need it. Each switch exists for
 /// measurement; the exact ones are on by default.
 struct Savings {
@@ -102,6 +110,14 @@ struct Savings {
   /// With reuse_unchanged: publish the reused result with the new stamp (true) or
   /// publish nothing for an unchanged sample (false; the node's choice, not the estimator's).
   bool republish_unchanged = true;
+  /// Solve the planar 3x3 system of the paper's section 6 instead of the 6x6 one when
+  /// every computed joint turns about one normal n, slides across it, gravity and the
+  /// inertias agree (planar.hpp states the exact conditions). The published 6-D
+  /// wrenches are unchanged (within 1e-12 relative). kAuto: detected at construction,
+  /// and a sample whose filtered wrench input leaves the plane takes the 6x6 path.
+  /// kOn: also where detection refuses (not exact there). Precision::kFloat always
+  /// keeps the 6x6 path.
+  PlanarMode planar = PlanarMode::kAuto;
 };
 
 struct EstimatorConfig {
@@ -182,6 +198,8 @@ class Estimator {
   /// filter's delay).
   double stamp() const { return stamp_; }
   /// Kinematics and loads of the last published sample (dynamics.hpp conventions).
+  /// After a planar sample (lastWasPlanar()) only the loads (force, moment, effort) are
+  /// updated: the planar pass has no 3-D kinematics to store.
   const Data<double>& data() const { return data_; }
   /// The estimated coordinates of the last published sample.
   const VectorX<double>& q() const { return q_; }
@@ -225,6 +243,11 @@ class Estimator {
   /// How the last published sample was obtained (for the benchmarks).
   bool lastWasReused() const { return reused_; }
   bool lastWasStatic() const { return static_; }
+  /// Whether the planar 3x3 path is in use (savings.planar), why not if it is not, and
+  /// whether the last published sample took it.
+  bool planar() const { return planar_; }
+  const std::string& planarReason() const { return planar_reason_; }
+  bool lastWasPlanar() const { return last_planar_; }
 
  private:
   struct Input {
@@ -261,6 +284,8 @@ class Estimator {
   // Contact of every plate at the estimate's stamp (raw signal); true if any changed.
   bool updatePlateContacts();
   void applyPlates();
+  // The planar path for this sample; false (nothing done) when a wrench leaves the plane.
+  bool computePlanar();
   // Value of input k at time t (linear between samples, held past the newest).
   Eigen::Matrix<double, 6, 1> sampleInput(Input& input, double t);
 
@@ -309,6 +334,12 @@ class Estimator {
   Data<double> cov_nominal_;  // the loads in double (Precision::kFloat)
   Data<double> cov_data_;     // a perturbed pass
   VectorX<double> q_pert_, qd_pert_;
+  // savings.planar (planar.hpp).
+  bool planar_ = false;
+  bool last_planar_ = false;
+  std::string planar_reason_;
+  PlanarModel<double> planar_model_;
+  PlanarData<double> planar_data_;
 };
 
 }  // namespace jle

@@ -156,6 +156,34 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   for (Input& input : inputs_) input.needed = dyn[model_.frames[input.frame].segment] != 0;
   setUpCovariance();
   for (Plate& p : plates_) p.input.needed = dyn[model_.frames[p.input.frame].segment] != 0;
+
+  // savings.planar: detected over the segments computed (a joint pruned away does not
+  // matter); gravity is in the root frame, which is the world for a fixed base.
+  if (config_.savings.planar == PlanarMode::kOff) {
+    planar_reason_ = "savings.planar is off";
+  } else if (config_.precision == Precision::kFloat) {
+    planar_reason_ = "precision float keeps the 6x6 path";
+  } else if (config_.uncertainty.enabled) {
+    // The covariance reads the 3-D kinematics, which the planar path does not compute.
+    planar_reason_ = "the covariance needs the 6x6 path";
+  } else if (have_sensors_) {
+    planar_reason_ = "a force/torque sensor at a joint needs the 6x6 path";
+  } else if (!plates_.empty()) {
+    planar_reason_ = "force plates need the 6x6 path (the feet's 3-D positions)";
+  } else {
+    const PlanarCheck<double> check = detectPlanar(model_, config_.gravity_world, kinematics_segments_);
+    planar_ = check.planar;
+    planar_reason_ = check.reason;
+    if (!planar_ && config_.savings.planar == PlanarMode::kOn) {
+      if (model_.floating_base || check.normal.isZero())
+        throw std::invalid_argument("savings.planar is on but " + check.reason);
+      planar_ = true;  // the user's assertion: out-of-plane parts are dropped
+    }
+    if (planar_) {
+      planar_model_ = planarModel(model_, check.normal);
+      planar_data_ = PlanarData<double>(n);
+    }
+  }
 }
 
 void Estimator::reset() {
@@ -431,6 +459,8 @@ void Estimator::compute(const BaseState<double>& base_state) {
       qdd_.setZero();
     }
   }
+  last_planar_ = planar_ && computePlanar();
+  if (last_planar_) return;
   if (config_.precision == Precision::kFloat) {
     q_f_ = q_.cast<float>();
     qd_f_ = qd_.cast<float>();
@@ -511,6 +541,30 @@ Wrench<double> Estimator::sensorResidual(int k) const {
   r.force = data_.force[s] - input.predicted.force;
   r.moment = data_.moment[s] - input.predicted.moment;
   return r;
+}
+
+bool Estimator::computePlanar() {
+  // kAuto: a filtered wrench with out-of-plane components sends this sample to the
+  // 6x6 path (checked before any work); kOn drops those components.
+  const bool check = config_.savings.planar == PlanarMode::kAuto;
+  for (std::size_t k = 0; k < inputs_.size() && check; ++k) {
+    if (!inputs_[k].needed) continue;
+    const int c = wrench_channel_ + 6 * static_cast<int>(k);
+    const Eigen::Vector3d f(bank_.value(c), bank_.value(c + 1), bank_.value(c + 2));
+    const Eigen::Vector3d m(bank_.value(c + 3), bank_.value(c + 4), bank_.value(c + 5));
+    if (!planarWrenchInPlane(planar_model_, inputs_[k].frame, f, m)) return false;
+  }
+  planarKinematics(model_, planar_model_, planar_data_, q_, qd_, qdd_, config_.gravity_world,
+                   kinematics_segments_);
+  for (std::size_t k = 0; k < inputs_.size(); ++k) {
+    if (!inputs_[k].needed) continue;
+    const int c = wrench_channel_ + 6 * static_cast<int>(k);
+    const Eigen::Vector3d f(bank_.value(c), bank_.value(c + 1), bank_.value(c + 2));
+    const Eigen::Vector3d m(bank_.value(c + 3), bank_.value(c + 4), bank_.value(c + 5));
+    planarAddExternalWrench(model_, planar_model_, planar_data_, inputs_[k].frame, f, m);
+  }
+  planarInverseDynamics(model_, planar_model_, planar_data_, data_, dynamics_segments_);
+  return true;
 }
 
 Wrench<double> Estimator::appliedWrench(int k) const {

@@ -334,6 +334,17 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
     sv.read("republish_unchanged", v.republish_unchanged);
     sv.read("static_velocity", v.static_velocity);
     sv.read("static_acceleration", v.static_acceleration);
+    // rosparam reads YAML 1.1, where a bare on/off is a boolean: take it as meant.
+    if (sv.has("planar") && sv.get("planar").getType() == XmlRpcValue::TypeBoolean) {
+      bool planar = false;
+      sv.read("planar", planar);
+      v.planar = planar ? PlanarMode::kOn : PlanarMode::kOff;
+    } else {
+      std::string planar = "auto";
+      sv.read("planar", planar);
+      v.planar = choose<PlanarMode>(sv.name("planar"), planar,
+                                    {{"auto", PlanarMode::kAuto}, {"on", PlanarMode::kOn}, {"off", PlanarMode::kOff}});
+    }
     if (v.static_velocity < 0.0 || v.static_acceleration < 0.0)
       throw SettingsError("parameters 'savings/static_velocity' and 'savings/static_acceleration' "
                           "must not be negative");

@@ -113,4 +113,28 @@ TEST(NoAllocation, EstimatorWithCovariance) {
   }
 }
 
+// savings.planar: the planar 3x3 path and its per-sample fallback to 6x6.
+TEST(NoAllocation, EstimatorOnThePlanarPath) {
+  const jle::Model<double> arm = jle::modelFromUrdfFile(kData + "/urdf/planar_arm.urdf");
+  jle::EstimatorConfig c;
+  c.gravity_world = Eigen::Vector3d(0, -9.80665, 0);
+  jle::WrenchInputConfig w;
+  w.name = w.link = "tool";
+  c.wrenches.push_back(w);
+  jle::Estimator estimator(arm, c);
+  ASSERT_TRUE(estimator.planar());
+  std::vector<double> q(static_cast<std::size_t>(arm.nq), 0.0);
+  long before = 0, planar = 0;
+  for (int k = 0; k < 2000; ++k) {
+    if (k == 100) before = g_allocations;
+    const double t = 1e-3 * k;
+    for (std::size_t i = 0; i < q.size(); ++i) q[i] = 0.5 * std::sin(t + i);
+    // Out of the plane for 10 samples: the fallback must not allocate either.
+    estimator.addWrench(0, t, Eigen::Vector3d(1, 0, k >= 1900 && k < 1910 ? 1.0 : 0.0), Eigen::Vector3d(0, 0, 0.1));
+    if (estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished) planar += estimator.lastWasPlanar();
+  }
+  EXPECT_EQ(g_allocations - before, 0);
+  EXPECT_GT(planar, 1700);
+}
+
 }  // namespace

@@ -55,6 +55,7 @@ jle::EstimatorConfig noSavings() {
   c.savings.massless_chains = false;
   c.savings.gyroscopic = false;
   c.savings.reuse_unchanged = false;
+  c.savings.planar = jle::PlanarMode::kOff;  // test_planar.cpp covers it
   return c;
 }
 
