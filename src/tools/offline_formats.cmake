@@ -2,7 +2,6 @@
 # process_bag, joint_loads' floating base and force plates. Included at the end of
 # CMakeLists.txt, after the targets exist.
 
-target_sources(joint_load_estimator_core PRIVATE ${CMAKE_CURRENT_LIST_DIR}/../core/sto.cpp)
 
 if(CATKIN_ENABLE_TESTING)
   jle_add_unit_test(test_offline_formats test/unit/test_offline_formats.cpp)

@@ -1,7 +1,6 @@
 # Predicted against measured (issue 8): the node's sensor and base residuals, the bias
 # calibration service, and the core's sensor substitution. Included at the end of
 # CMakeLists.txt.
-target_sources(joint_load_estimator_ros PRIVATE src/ros/consistency.cpp)
 
 if(CATKIN_ENABLE_TESTING)
   jle_add_unit_test(test_sensor_joint test/unit/test_sensor_joint.cpp)
