@@ -63,7 +63,7 @@ samples of an instant before its joint state).
 
 The trial (gait time g = t + 0.33 s, stride T = 1.1 s, w = 2 pi / T; the right heel
 strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
-  pelvis  x = 1.2 g - 0.016 sin(2w (g - 0.3T)), y = -0.02 cos(w (g - 0.3T)),
+  pelvis  x = 1.2 g - 0.016 sin(2w (g - 0.3T)), y = -0.03 cos(w (g - 0.3T)),
           z = z0 + 0.02 cos(2w (g - 0.3T)), yaw = 0.07 cos(w g), roll = -0.05 sin(w g)
           (z0 = the standing height of the pelvis minus 0.05 m)
   feet    heel rocker (0 - 10 %: the foot turns down about the heel from 15 deg toe
@@ -72,7 +72,8 @@ strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
           toe off to the next heel strike; heel lifted by 0.05 m * 64 s^3 (1 - s)^3);
           every motion a quintic smooth step S(s) = 10 s^3 - 15 s^4 + 6 s^5, so that
           the feet are at rest at heel strike and toe off; footprints 0.66 m apart,
-          the heel 0.2 m ahead of the hip at heel strike, 5 deg toe-out
+          the heel 0.2 m ahead of the hip at heel strike, 5 deg toe-out, the
+          heels at 0.6 times their standing distance from the midline
   joints  the leg's 5 angles that put heel_s and toe_s where the foot is (inverse
           kinematics to 1e-12 m on a 1 kHz grid); velocities and accelerations by
           5-point central differences on that grid
@@ -116,7 +117,9 @@ constexpr double kToeOut = 5.0 * kPi / 180.0;
 constexpr double kClearance = 0.05;      // [m] heel lift in mid-swing
 constexpr double kPelvisDrop = 0.05;     // [m] mean pelvis height below standing
 constexpr double kHeelAhead = 0.20;      // [m] heel ahead of the hip at heel strike
-constexpr double kSwayX = 0.016;         // [m] forward speed modulation (amplitude of x)
+constexpr double kSwayX = 0.016;
+constexpr double kSwayY = 0.03;          // [m] lateral sway (amplitude of y)
+constexpr double kStepWidthRatio = 0.6;  // footprint y / standing heel y         // [m] forward speed modulation (amplitude of x)
 constexpr double kJointRate = 200.0;     // [Hz]
 constexpr int kPlateDivisor = 5;         // plate samples per joint sample (1 kHz)
 constexpr int kDisplayDivisor = 10;      // plate samples per display sample (100 Hz)
@@ -183,10 +186,10 @@ struct Pelvis {
     const double c = g - kStartPhase * kStride;
     jle::BaseState<double> b;
     b.p_world_base = Vector3d(x_offset + kSpeed * g - kSwayX * std::sin(w2 * c),
-                              -0.02 * std::cos(w * c), z0 + 0.02 * std::cos(w2 * c));
-    b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c), 0.02 * w * std::sin(w * c),
+                              -kSwayY * std::cos(w * c), z0 + 0.02 * std::cos(w2 * c));
+    b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c), kSwayY * w * std::sin(w * c),
                          -0.02 * w2 * std::sin(w2 * c));
-    b.a_world = Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c), 0.02 * w * w * std::cos(w * c),
+    b.a_world = Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c), kSwayY * w * w * std::cos(w * c),
                          -0.02 * w2 * w2 * std::cos(w2 * c));
     const double yaw = 0.07 * std::cos(w * g), yaw_d = -0.07 * w * std::sin(w * g),
                  yaw_dd = -0.07 * w * w * std::cos(w * g);
@@ -416,7 +419,7 @@ void run(const Options& options) {
     const Vector3d heel = framePosition(model, data, leg.heel);
     const Vector3d toe = framePosition(model, data, leg.toe);
     leg.foot_length = (toe - heel).norm();
-    leg.y_footprint = heel.y();
+    leg.y_footprint = kStepWidthRatio * heel.y();
     sole = std::min({sole, heel.z(), toe.z()});
     if (!(leg.foot_length > 0.05))
       throw std::runtime_error(options.urdf + ": heel_" + std::string(1, leg.side) + " and toe_" +
