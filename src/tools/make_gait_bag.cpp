@@ -89,6 +89,11 @@ strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
   --urdf PATH    the body (root link pelvis, the joints and links above, heel_s and
                  toe_s on the sole), e.g. test/data/urdf/body_75kg_175cm.urdf
   --output PATH  the bag; written beside PATH and renamed onto it on success only
+  --csv PATH     also the same trial at 200 Hz as joint_loads' input (docs/joint_loads.md):
+                 t, J.q, J.qd, J.qdd of every joint, base.x .. base.qw, base.vx .. base.wz,
+                 base.ax .. base.alz (exact), plate@plate1.fx .. .mz, plate@plate2.fx ..
+                 .mz (plate 1 under foot_r, plate 2 under foot_l; the plates' poses
+                 are printed as joint_loads --plate options)
   --strides N    gait cycles covered, 1 .. 100 (default 3)
   --noise SIGMA  plate noise [N], >= 0 (default 0)
   --seed N       0 .. 4294967295 (default 1)
@@ -127,6 +132,7 @@ constexpr double kLaneWidth = 0.4;       // [m] each plate's width (y)
 
 struct Options {
   std::string urdf, output;
+  std::string csv;  // the same trial for joint_loads; empty: none
   int strides = 3;
   double noise = 0.0;
   std::uint32_t seed = 1;
@@ -152,12 +158,13 @@ unsigned long long parseInteger(const std::string& key, const std::string& text,
 
 Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = jle::cli::optionValues(
-      argc, argv, {"--urdf", "--output", "--strides", "--noise", "--seed"});
+      argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
   Options options;
   if (!v.count("--urdf")) throw UsageError("--urdf BODY.urdf is required");
   if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
   options.urdf = v["--urdf"];
   options.output = v["--output"];
+  if (v.count("--csv")) options.csv = v["--csv"];
   if (v.count("--strides")) {
     options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 100));
     if (options.strides < 1) throw UsageError("--strides: must be >= 1");
@@ -467,7 +474,7 @@ void run(const Options& options) {
       x_max = std::max({x_max, foot.heel.x(), foot.toe.x()});
     }
   const double plate_length = std::ceil((x_max - x_min + 0.4) * 10.0) / 10.0;
-  const double x_centre = 0.5 * (x_min + x_max);
+  const double x_centre = std::round(500.0 * (x_min + x_max)) / 1000.0;  // to the mm
   const std::array<Vector3d, 2> p_world_plate = {Vector3d(x_centre, -0.5 * kLaneWidth, 0.0),
                                                  Vector3d(x_centre, 0.5 * kLaneWidth, 0.0)};
 
@@ -489,6 +496,7 @@ void run(const Options& options) {
     plate_msg[i].header.frame_id = plate_frame[i];
     reaction_msg[i].header.frame_id = cop_frame[i];
   }
+  std::array<Eigen::Matrix<double, 6, 1>, 2> plate_row;  // the plates' samples for the CSV
   std::array<Vector3d, 2> last_cop = {p_world_plate[0], p_world_plate[1]};
 
   jle::Uniform uniform(options.seed);
@@ -504,7 +512,22 @@ void run(const Options& options) {
       q_max(static_cast<std::size_t>(model.nq), -1e9);
 
   const std::string temporary = options.output + ".partial";
+  const std::string csv_temporary = options.csv + ".partial";
+  FILE* csv = nullptr;
   try {
+    if (!options.csv.empty()) {
+      csv = std::fopen(csv_temporary.c_str(), "w");
+      if (!csv) throw std::runtime_error(options.csv + ": cannot write " + csv_temporary);
+      std::fprintf(csv, "t");
+      for (const std::string& n : model.coordinate_names)
+        std::fprintf(csv, ",%s.q,%s.qd,%s.qdd", n.c_str(), n.c_str(), n.c_str());
+      for (const char* c : {"x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz", "wx", "wy",
+                            "wz", "ax", "ay", "az", "alx", "aly", "alz"})
+        std::fprintf(csv, ",base.%s", c);
+      for (const char* p : {"plate1", "plate2"})
+        for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(csv, ",plate@%s.%s", p, c);
+      std::fprintf(csv, "\n");
+    }
     rosbag::Bag bag(temporary, rosbag::bagmode::Write);
     {  // The plates' poses, latched.
       const ros::Time stamp = stampOf(kEpochNs);
@@ -595,6 +618,7 @@ void run(const Options& options) {
         setWrench(plate_msg[i], f_plate, m_plate);
         bag.write(plate_topic[i], early, plate_msg[i]);
         if (share[i].contact) last_cop[i] = share[i].cop;
+        plate_row[i] << f_plate, m_plate;
       }
       if (k % kDisplayDivisor == 0) {
         for (std::size_t i = 0; i < 2; ++i) {
@@ -613,13 +637,37 @@ void run(const Options& options) {
         for (int j = 0; j < model.nq; ++j)
           joints.position[static_cast<std::size_t>(j)] = grid[c][j];
         bag.write("/joint_states", stamp, joints);
+        if (csv) {
+          std::fprintf(csv, "%.17g", static_cast<double>(ns - kEpochNs) * 1e-9);
+          for (int j = 0; j < model.nq; ++j)
+            std::fprintf(csv, ",%.17g,%.17g,%.17g", grid[c][j], qd[j], qdd[j]);
+          const Eigen::Quaterniond o(base.R_world_base);
+          const double pose[7] = {base.p_world_base.x(), base.p_world_base.y(),
+                                  base.p_world_base.z(), o.x(), o.y(), o.z(), o.w()};
+          for (double x : pose) std::fprintf(csv, ",%.17g", x);
+          for (const Vector3d* v : {&base.v_world, &base.omega_world, &base.a_world, &base.alpha_world})
+            std::fprintf(csv, ",%.17g,%.17g,%.17g", v->x(), v->y(), v->z());
+          for (const auto& row : plate_row)
+            for (int j = 0; j < 6; ++j) std::fprintf(csv, ",%.17g", row[j]);
+          std::fprintf(csv, "\n");
+        }
       }
     }
     bag.close();
+    if (csv) {
+      const bool ok = std::fflush(csv) == 0 && !std::ferror(csv);
+      std::fclose(csv);
+      csv = nullptr;
+      if (!ok) throw std::runtime_error(options.csv + ": write error");
+      if (std::rename(csv_temporary.c_str(), options.csv.c_str()) != 0)
+        throw std::runtime_error(options.csv + ": cannot rename " + csv_temporary + " onto it");
+    }
     if (std::rename(temporary.c_str(), options.output.c_str()) != 0)
       throw std::runtime_error(options.output + ": cannot rename " + temporary + " onto it");
   } catch (...) {
+    if (csv) std::fclose(csv);
     std::remove(temporary.c_str());
+    if (!options.csv.empty()) std::remove(csv_temporary.c_str());
     throw;
   }
 
@@ -630,6 +678,8 @@ void run(const Options& options) {
   std::printf("  body %.2f kg (weight %.1f N); plates %.1f m x %.1f m, centres x %.3f m, "
               "y -/+%.2f m\n",
               mass, weight, plate_length, kLaneWidth, x_centre, 0.5 * kLaneWidth);
+  std::printf("  joint_loads: --plate plate1=foot_r,%.3f,%.3f,0 --plate plate2=foot_l,%.3f,%.3f,0\n",
+              x_centre, -0.5 * kLaneWidth, x_centre, 0.5 * kLaneWidth);
   std::printf("  vertical ground reaction: peak %.2f BW (both feet), %.2f BW (one foot)\n",
               peak_fz / weight, peak_fz_foot / weight);
   std::printf("  single support: centre of pressure from %.2f to %.2f of heel->toe, up to "
