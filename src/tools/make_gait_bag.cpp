@@ -534,7 +534,11 @@ void run(const Options& options) {
       for (int i = 0; i < 2; ++i)
         static_msg.transforms.push_back(
             transform(plate_frame[i], stamp, p_world_plate[i], Matrix3d::Identity()));
+      // A connection header of our own (for "latching") must also name the type.
       auto header = boost::make_shared<ros::M_string>();
+      (*header)["type"] = ros::message_traits::datatype(static_msg);
+      (*header)["md5sum"] = ros::message_traits::md5sum(static_msg);
+      (*header)["message_definition"] = ros::message_traits::definition(static_msg);
       (*header)["callerid"] = "/make_gait_bag";
       (*header)["latching"] = "1";
       bag.write("/tf_static", stamp - ros::Duration(0, 3000000), static_msg, header);
