@@ -14,4 +14,11 @@ if(CATKIN_ENABLE_TESTING)
   target_compile_definitions(test_node_gait PRIVATE
     JLE_MAKE_GAIT_BAG="$<TARGET_FILE:make_gait_bag>")
   add_dependencies(test_node_gait make_gait_bag)
+
+  # The same trial as a CSV file through joint_loads (the offline path for a trial of
+  # one's own).
+  jle_add_unit_test(test_gait_csv test/unit/test_gait_csv.cpp)
+  target_compile_definitions(test_gait_csv PRIVATE
+    JLE_MAKE_GAIT_BAG="$<TARGET_FILE:make_gait_bag>")
+  add_dependencies(test_gait_csv make_gait_bag joint_loads)
 endif()
