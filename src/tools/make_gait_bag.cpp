@@ -1,0 +1,707 @@
+// make_gait_bag: a deterministic, gait-like walking trial of a human body model over
+// two force plates, as a bag, for the gait demo (docs/gait_demo.md) and its test. The
+// plate signals are computed from the model's own inverse dynamics, so that the
+// floating-base residual of the estimate is filter error only. The formulas are in
+// kUsage and docs/gait_demo.md.
+#include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <geometry_msgs/WrenchStamped.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+using jle::cli::UsageError;
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+const char* const kUsage =
+    R"(usage: make_gait_bag --urdf BODY.urdf --output OUT.bag [--strides 3] [--noise 0]
+                     [--seed 1]
+
+Writes a bag of a body walking at 1.2 m/s over two force plates (lanes side by side:
+plate 1 under the right foot, plate 2 under the left; each foot lands on its own plate
+at every step), for the gait demo (docs/gait_demo.md):
+  /joint_states         sensor_msgs/JointState, 200 Hz, positions of every coordinate
+                        of the URDF (the mocap's joint angles; legs: hip_flexion_s,
+                        hip_adduction_s, hip_rotation_s, knee_flexion_s,
+                        ankle_flexion_s, s = r, l; any other coordinate stays 0)
+  /tf                   world -> pelvis (the mocap's pelvis pose), 200 Hz; world ->
+                        force_plate_N_cop (where the ground reaction acts), 100 Hz
+  /tf_static            world -> force_plate_1, world -> force_plate_2 (latched)
+  /force_plate_N/wrench geometry_msgs/WrenchStamped, 1 kHz, frame force_plate_N: what
+                        the foot applies TO the plate, moment about the plate origin
+                        (the plate frame: origin at the centre of the surface, z up)
+  /force_plate_N/reaction  geometry_msgs/WrenchStamped, 100 Hz, frame
+                        force_plate_N_cop: the ground reaction on the foot at its centre
+                        of pressure (world axes) and the free moment, for display
+stamped t0 + i / rate (t0 = 1000 s); bag time = stamp for the joint states, stamp - 2
+ms for the poses and the plates (a reader in time order has the pose and the plate
+samples of an instant before its joint state).
+
+The trial (gait time g = t + 0.33 s, stride T = 1.1 s, w = 2 pi / T; the right heel
+strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
+  pelvis  x = 1.2 g - 0.016 sin(2w (g - 0.3T)), y = -0.03 cos(w (g - 0.3T)),
+          z = z0 + 0.02 cos(2w (g - 0.3T)), yaw = 0.07 cos(w g), roll = -0.05 sin(w g)
+          (z0 = the standing height of the pelvis minus 0.05 m)
+  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 15 deg toe
+          up), foot flat (10 - 35 %), toe rocker (35 - 60 %: the heel rises, the foot
+          turns about the toe to 50 deg), swing (heel position and foot pitch from
+          toe off to the next heel strike; heel lifted by 0.05 m * 64 s^3 (1 - s)^3);
+          every motion a quintic smooth step S(s) = 10 s^3 - 15 s^4 + 6 s^5, so that
+          the feet are at rest at heel strike and toe off; footprints 0.66 m apart,
+          the heel 0.2 m ahead of the hip at heel strike, 5 deg toe-out, the
+          heels at 0.6 times their standing distance from the midline
+  joints  the leg's 5 angles that put heel_s and toe_s where the foot is (inverse
+          kinematics to 1e-12 m on a 1 kHz grid); velocities and accelerations by
+          5-point central differences on that grid
+  plates  the wrench the world must apply to the pelvis for that motion (the model's
+          floating-base inverse dynamics, gravity 0 0 -9.80665), on the stance foot; in
+          double support split by a quintic smooth step of the force from the trailing
+          to the leading foot, each foot's centre of pressure the nominal point (toe of
+          the trailing foot, heel of the leading) shifted by the same vector, so that
+          the two sum to the whole wrench; free moment split like the force
+  noise   with --noise SIGMA: Gaussian noise (Box-Muller on jle::Uniform(seed)) of SIGMA
+          N on each force component, 0.01 SIGMA N m on each moment component
+
+  --urdf PATH    the body (root link pelvis, the joints and links above, heel_s and
+                 toe_s on the sole), e.g. test/data/urdf/body_75kg_175cm.urdf
+  --output PATH  the bag; written beside PATH and renamed onto it on success only
+  --csv PATH     also the same trial at 200 Hz as joint_loads' input (docs/joint_loads.md):
+                 t, J.q, J.qd, J.qdd of every joint, base.x .. base.qw, base.vx .. base.wz,
+                 base.ax .. base.alz (exact), plate@plate1.fx .. .mz, plate@plate2.fx ..
+                 .mz (plate 1 under foot_r, plate 2 under foot_l; the plates' poses
+                 are printed as joint_loads --plate options)
+  --strides N    gait cycles covered, 1 .. 100 (default 3)
+  --noise SIGMA  plate noise [N], >= 0 (default 0)
+  --seed N       0 .. 4294967295 (default 1)
+  --help         this text
+
+Prints the trial's figures (duration, mass, peak vertical ground reaction, centre of
+pressure along the foot, inverse-kinematics error, toe clearance, joint ranges).
+Exit status: 0 success; 1 a data error (unreadable URDF, a body the trial does not fit,
+unwritable bag); 2 a usage error.
+)";
+
+constexpr double kPi = 3.141592653589793;
+constexpr std::int64_t kEpochNs = 1000000000000LL;  // t0 = 1000 s
+constexpr double kGravity = 9.80665;
+
+// The trial's parameters (kUsage).
+constexpr double kSpeed = 1.2;           // [m/s]
+constexpr double kStride = 1.1;          // [s]
+constexpr double kStartPhase = 0.3;      // the trial starts at 30 % of the right cycle
+constexpr double kHeelRocker = 0.10;     // end of the heel rocker, fraction of T
+constexpr double kHeelOff = 0.35;        // start of the toe rocker
+constexpr double kToeOff = 0.60;         // end of stance
+constexpr double kHeelStrikePitch = 15.0 * kPi / 180.0;  // toe up at heel strike
+constexpr double kToeOffPitch = -50.0 * kPi / 180.0;     // heel up at toe off
+constexpr double kToeOut = 5.0 * kPi / 180.0;
+constexpr double kClearance = 0.05;      // [m] heel lift in mid-swing
+constexpr double kPelvisDrop = 0.05;     // [m] mean pelvis height below standing
+constexpr double kHeelAhead = 0.20;      // [m] heel ahead of the hip at heel strike
+constexpr double kSwayX = 0.016;
+constexpr double kSwayY = 0.03;          // [m] lateral sway (amplitude of y)
+constexpr double kStepWidthRatio = 0.6;  // footprint y / standing heel y         // [m] forward speed modulation (amplitude of x)
+constexpr double kJointRate = 200.0;     // [Hz]
+constexpr int kPlateDivisor = 5;         // plate samples per joint sample (1 kHz)
+constexpr int kDisplayDivisor = 10;      // plate samples per display sample (100 Hz)
+constexpr double kLaneWidth = 0.4;       // [m] each plate's width (y)
+
+struct Options {
+  std::string urdf, output;
+  std::string csv;  // the same trial for joint_loads; empty: none
+  int strides = 3;
+  double noise = 0.0;
+  std::uint32_t seed = 1;
+};
+
+double parseNumber(const std::string& key, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
+    throw UsageError(key + ": '" + text + "' is not a finite number");
+  return v;
+}
+
+unsigned long long parseInteger(const std::string& key, const std::string& text,
+                                unsigned long long max) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || v > max)
+    throw UsageError(key + ": '" + text + "' is not an integer in 0 .. " + std::to_string(max));
+  return v;
+}
+
+Options parseOptions(int argc, char** argv) {
+  std::map<std::string, std::string> v = jle::cli::optionValues(
+      argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
+  Options options;
+  if (!v.count("--urdf")) throw UsageError("--urdf BODY.urdf is required");
+  if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
+  options.urdf = v["--urdf"];
+  options.output = v["--output"];
+  if (v.count("--csv")) options.csv = v["--csv"];
+  if (v.count("--strides")) {
+    options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 100));
+    if (options.strides < 1) throw UsageError("--strides: must be >= 1");
+  }
+  if (v.count("--noise")) {
+    options.noise = parseNumber("--noise", v["--noise"]);
+    if (options.noise < 0.0) throw UsageError("--noise: must be >= 0");
+  }
+  if (v.count("--seed"))
+    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 4294967295ULL));
+  return options;
+}
+
+// Quintic smooth step: 0 at 0, 1 at 1, first and second derivatives 0 at both ends.
+double smoothStep(double s) {
+  s = std::min(1.0, std::max(0.0, s));
+  return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+}
+
+// Pelvis pose, twist and acceleration at gait time g (kUsage), world frame.
+struct Pelvis {
+  double z0 = 0.0;
+  double x_offset = 0.0;
+  jle::BaseState<double> at(double g) const {
+    const double w = 2.0 * kPi / kStride, w2 = 2.0 * w;
+    const double c = g - kStartPhase * kStride;
+    jle::BaseState<double> b;
+    b.p_world_base = Vector3d(x_offset + kSpeed * g - kSwayX * std::sin(w2 * c),
+                              -kSwayY * std::cos(w * c), z0 + 0.02 * std::cos(w2 * c));
+    b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c), kSwayY * w * std::sin(w * c),
+                         -0.02 * w2 * std::sin(w2 * c));
+    b.a_world = Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c), kSwayY * w * w * std::cos(w * c),
+                         -0.02 * w2 * w2 * std::cos(w2 * c));
+    const double yaw = 0.07 * std::cos(w * g), yaw_d = -0.07 * w * std::sin(w * g),
+                 yaw_dd = -0.07 * w * w * std::cos(w * g);
+    const double roll = -0.05 * std::sin(w * g), roll_d = -0.05 * w * std::cos(w * g),
+                 roll_dd = 0.05 * w * w * std::sin(w * g);
+    const Matrix3d Rz = Eigen::AngleAxisd(yaw, Vector3d::UnitZ()).toRotationMatrix();
+    b.R_world_base = Rz * Eigen::AngleAxisd(roll, Vector3d::UnitX()).toRotationMatrix();
+    // R = Rz(yaw) Rx(roll): omega = yaw' z + roll' Rz x.
+    const Vector3d x_rot = Rz * Vector3d::UnitX();
+    b.omega_world = yaw_d * Vector3d::UnitZ() + roll_d * x_rot;
+    b.alpha_world = yaw_dd * Vector3d::UnitZ() + roll_dd * x_rot +
+                    (yaw_d * Vector3d::UnitZ()).cross(roll_d * x_rot);
+    return b;
+  }
+};
+
+// A leg's coordinates and sole frames.
+struct Leg {
+  char side = 'r';
+  double y_sign = -1.0;            // -1 right, +1 left
+  double strike_offset = 0.0;      // gait time of its first heel strike in the cycle [s]
+  std::array<int, 5> coordinate{};
+  int heel = 0, toe = 0;           // frame indices
+  double y_footprint = 0.0;        // [m] heel's y at standing (footprints' lateral place)
+  double foot_length = 0.0;        // [m] heel to toe
+};
+
+// Heel and toe points of a leg at gait time g, and whether it is in stance; also the
+// time since its last heel strike [s].
+struct FootState {
+  Vector3d heel, toe;
+  bool stance = false;
+  double since_strike = 0.0;
+};
+
+struct Gait {
+  double hip_x = 0.0;  // hip joint's x at standing, relative to the pelvis origin
+  double x_offset = 0.0;
+
+  Vector3d direction(const Leg& leg, double pitch) const {
+    const double yaw = leg.y_sign * kToeOut;
+    return Vector3d(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                    std::sin(pitch));
+  }
+  Vector3d directionRate(const Leg& leg, double pitch) const {  // d/dpitch
+    const double yaw = leg.y_sign * kToeOut;
+    return Vector3d(-std::sin(pitch) * std::cos(yaw), -std::sin(pitch) * std::sin(yaw),
+                    std::cos(pitch));
+  }
+  // Heel at heel strike number n (gait time n T + offset).
+  Vector3d footprint(const Leg& leg, double strike_time) const {
+    return Vector3d(x_offset + kSpeed * strike_time + hip_x + kHeelAhead, leg.y_footprint, 0.0);
+  }
+
+  FootState at(const Leg& leg, double g) const {
+    const double T = kStride;
+    const double n = std::floor((g - leg.strike_offset) / T);
+    const double strike = n * T + leg.strike_offset;
+    const double tau = g - strike;
+    const Vector3d H = footprint(leg, strike);
+    const double l = leg.foot_length;
+    FootState f;
+    f.since_strike = tau;
+    const double t1 = kHeelRocker * T, t2 = kHeelOff * T, t3 = kToeOff * T;
+    if (tau < t1) {  // heel rocker: pitch = p_hs (1 - S(s)) about the heel
+      f.heel = H;
+      f.toe = H + l * direction(leg, kHeelStrikePitch * (1.0 - smoothStep(tau / t1)));
+      f.stance = true;
+    } else if (tau < t2) {
+      f.heel = H;
+      f.toe = H + l * direction(leg, 0.0);
+      f.stance = true;
+    } else if (tau < t3) {  // toe rocker: pitch = p_to S(s) about the toe
+      f.toe = H + l * direction(leg, 0.0);
+      f.heel = f.toe - l * direction(leg, kToeOffPitch * smoothStep((tau - t2) / (t3 - t2)));
+      f.stance = true;
+    } else {  // swing: quintic from toe off to the next heel strike
+      // Both ends at rest (the smooth steps of the rockers): quintic smooth steps.
+      const double d = T - t3;
+      const Vector3d toe = H + l * direction(leg, 0.0);
+      const Vector3d h0 = toe - l * direction(leg, kToeOffPitch);
+      const Vector3d h1 = footprint(leg, strike + T);
+      const double s = (tau - t3) / d;
+      const double pitch = kToeOffPitch + (kHeelStrikePitch - kToeOffPitch) * smoothStep(s);
+      f.heel = h0 + (h1 - h0) * smoothStep(s);
+      f.heel.z() += kClearance * 64.0 * std::pow(s * (1.0 - s), 3);
+      f.toe = f.heel + l * direction(leg, pitch);
+    }
+    return f;
+  }
+};
+
+Vector3d framePosition(const jle::Model<double>& model, const jle::Data<double>& data, int frame) {
+  const jle::Frame<double>& f = model.frames[static_cast<std::size_t>(frame)];
+  const std::size_t s = static_cast<std::size_t>(f.segment);
+  return data.p_world[s] + data.R_world[s] * f.p_segment_frame;
+}
+
+// Puts the leg's heel and toe frames on the targets (Gauss-Newton, numerical Jacobian,
+// damped); q holds the start and receives the solution. Returns the remaining error [m].
+double solveLeg(const jle::Model<double>& model, jle::Data<double>& data, const Leg& leg,
+                const jle::BaseState<double>& base, const Vector3d& heel, const Vector3d& toe,
+                jle::VectorX<double>& q) {
+  const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
+  const Vector3d gravity(0.0, 0.0, -kGravity);
+  auto error = [&](const jle::VectorX<double>& qq) {
+    jle::forwardKinematics(model, data, qq, zero, zero, gravity, base);
+    Eigen::Matrix<double, 6, 1> e;
+    e << framePosition(model, data, leg.heel) - heel, framePosition(model, data, leg.toe) - toe;
+    return e;
+  };
+  double norm = 0.0;
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    const Eigen::Matrix<double, 6, 1> e = error(q);
+    norm = e.norm();
+    if (norm < 1e-13) break;
+    Eigen::Matrix<double, 6, 5> J;
+    for (int j = 0; j < 5; ++j) {
+      jle::VectorX<double> qq = q;
+      const double h = 1e-7;
+      qq[leg.coordinate[static_cast<std::size_t>(j)]] += h;
+      J.col(j) = (error(qq) - e) / h;
+    }
+    const Eigen::Matrix<double, 5, 5> A =
+        J.transpose() * J + 1e-12 * Eigen::Matrix<double, 5, 5>::Identity();
+    Eigen::Matrix<double, 5, 1> step = A.ldlt().solve(-J.transpose() * e);
+    // A trust region: far from the solution, small steps keep the knee on its branch.
+    if (step.norm() > 0.1) step *= 0.1 / step.norm();
+    for (int j = 0; j < 5; ++j) q[leg.coordinate[static_cast<std::size_t>(j)]] += step[j];
+    // The knee bends one way only (flexion positive): never onto the mirrored branch.
+    double& knee = q[leg.coordinate[3]];
+    knee = std::max(knee, 0.0);
+    if (step.norm() < 1e-15) break;
+  }
+  return norm;
+}
+
+int coordinateIndex(const jle::Model<double>& model, const std::string& name,
+                    const std::string& urdf) {
+  for (std::size_t i = 0; i < model.coordinate_names.size(); ++i)
+    if (model.coordinate_names[i] == name) return static_cast<int>(i);
+  throw std::runtime_error(urdf + ": no joint '" + name +
+                           "' (make_gait_bag needs the body model of docs/gait_demo.md)");
+}
+
+int frameIndex(const jle::Model<double>& model, const std::string& name, const std::string& urdf) {
+  for (std::size_t i = 0; i < model.frames.size(); ++i)
+    if (model.frames[i].name == name) return static_cast<int>(i);
+  throw std::runtime_error(urdf + ": no link '" + name +
+                           "' (make_gait_bag needs the body model of docs/gait_demo.md)");
+}
+
+ros::Time stampOf(std::int64_t ns) {
+  return ros::Time(static_cast<std::uint32_t>(ns / 1000000000),
+                   static_cast<std::uint32_t>(ns % 1000000000));
+}
+
+geometry_msgs::TransformStamped transform(const std::string& child, const ros::Time& stamp,
+                                          const Vector3d& p, const Matrix3d& R) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = "world";
+  t.child_frame_id = child;
+  t.transform.translation.x = p.x();
+  t.transform.translation.y = p.y();
+  t.transform.translation.z = p.z();
+  const Eigen::Quaterniond o(R);
+  t.transform.rotation.x = o.x();
+  t.transform.rotation.y = o.y();
+  t.transform.rotation.z = o.z();
+  t.transform.rotation.w = o.w();
+  return t;
+}
+
+void setWrench(geometry_msgs::WrenchStamped& msg, const Vector3d& f, const Vector3d& m) {
+  msg.wrench.force.x = f.x();
+  msg.wrench.force.y = f.y();
+  msg.wrench.force.z = f.z();
+  msg.wrench.torque.x = m.x();
+  msg.wrench.torque.y = m.y();
+  msg.wrench.torque.z = m.z();
+}
+
+// One foot's share of the ground reaction: force [N] at the centre of pressure [m] on
+// the ground (z = 0), free moment [N m] about z.
+struct Share {
+  bool contact = false;
+  Vector3d force = Vector3d::Zero();
+  Vector3d cop = Vector3d::Zero();
+  double free_moment = 0.0;
+};
+
+void run(const Options& options) {
+  jle::ModelOptions model_options;
+  model_options.floating_base = true;
+  const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
+  if (model.link_name[0] != "pelvis")
+    throw std::runtime_error(options.urdf + ": the root link is '" + model.link_name[0] +
+                             "', make_gait_bag needs 'pelvis'");
+  const double mass = model.totalMass();
+  const double weight = mass * kGravity;
+
+  std::array<Leg, 2> legs;
+  const char* names[5] = {"hip_flexion_", "hip_adduction_", "hip_rotation_", "knee_flexion_",
+                          "ankle_flexion_"};
+  for (int k = 0; k < 2; ++k) {
+    Leg& leg = legs[static_cast<std::size_t>(k)];
+    leg.side = k == 0 ? 'r' : 'l';
+    leg.y_sign = k == 0 ? -1.0 : 1.0;
+    leg.strike_offset = k == 0 ? 0.0 : 0.5 * kStride;
+    const std::string s(1, leg.side);
+    for (int j = 0; j < 5; ++j)
+      leg.coordinate[static_cast<std::size_t>(j)] =
+          coordinateIndex(model, names[j] + s, options.urdf);
+    leg.heel = frameIndex(model, "heel_" + s, options.urdf);
+    leg.toe = frameIndex(model, "toe_" + s, options.urdf);
+  }
+
+  // The standing body (q = 0, pelvis at the origin): sole height, foot geometry.
+  jle::Data<double> data(model);
+  jle::VectorX<double> q = jle::VectorX<double>::Zero(model.nq);
+  const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
+  const Vector3d gravity(0.0, 0.0, -kGravity);
+  jle::forwardKinematics(model, data, zero, zero, zero, gravity);
+  double sole = 0.0;
+  for (Leg& leg : legs) {
+    const Vector3d heel = framePosition(model, data, leg.heel);
+    const Vector3d toe = framePosition(model, data, leg.toe);
+    leg.foot_length = (toe - heel).norm();
+    leg.y_footprint = kStepWidthRatio * heel.y();
+    sole = std::min({sole, heel.z(), toe.z()});
+    if (!(leg.foot_length > 0.05))
+      throw std::runtime_error(options.urdf + ": heel_" + std::string(1, leg.side) + " and toe_" +
+                               std::string(1, leg.side) + " are less than 5 cm apart");
+  }
+  const int hip_segment = model.segmentOfJoint("hip_flexion_r");
+  Gait gait;
+  gait.hip_x = data.p_world[static_cast<std::size_t>(hip_segment)].x();
+  Pelvis pelvis;
+  pelvis.z0 = -sole - kPelvisDrop;
+  gait.x_offset = pelvis.x_offset = 0.0;
+
+  // The 1 kHz grid, with two points either side for the 5-point differences.
+  const double h = 1.0 / (kJointRate * kPlateDivisor);
+  const long long n_plate = std::llround(options.strides * kStride / h);
+  const double g0 = kStartPhase * kStride;
+  std::vector<jle::VectorX<double>> grid;
+  grid.reserve(static_cast<std::size_t>(n_plate + 4));
+  double ik_error = 0.0;
+  // Knees slightly bent: the inverse kinematics stays on the bent-knee branch.
+  for (const Leg& leg : legs) q[leg.coordinate[3]] = 0.3;
+  double min_toe = 1e9;
+  for (long long k = -2; k < n_plate + 2; ++k) {
+    const double g = g0 + static_cast<double>(k) * h;
+    const jle::BaseState<double> base = pelvis.at(g);
+    for (const Leg& leg : legs) {
+      const FootState foot = gait.at(leg, g);
+      ik_error = std::max(ik_error, solveLeg(model, data, leg, base, foot.heel, foot.toe, q));
+      const double swing = foot.since_strike / kStride - kToeOff;  // fraction of T into swing
+      if (swing > 0.1 && swing < 0.3) min_toe = std::min(min_toe, foot.toe.z());
+    }
+    grid.push_back(q);
+  }
+  if (ik_error > 1e-6)
+    throw std::runtime_error(options.urdf + ": the legs cannot follow the trial (the inverse "
+                             "kinematics misses the feet by " + std::to_string(ik_error) + " m)");
+
+  // Plates: two lanes along x, covering every footprint.
+  double x_min = 1e9, x_max = -1e9;
+  for (long long k = 0; k < n_plate; ++k)
+    for (const Leg& leg : legs) {
+      const FootState foot = gait.at(leg, g0 + static_cast<double>(k) * h);
+      if (!foot.stance) continue;
+      x_min = std::min({x_min, foot.heel.x(), foot.toe.x()});
+      x_max = std::max({x_max, foot.heel.x(), foot.toe.x()});
+    }
+  const double plate_length = std::ceil((x_max - x_min + 0.4) * 10.0) / 10.0;
+  const double x_centre = std::round(500.0 * (x_min + x_max)) / 1000.0;  // to the mm
+  const std::array<Vector3d, 2> p_world_plate = {Vector3d(x_centre, -0.5 * kLaneWidth, 0.0),
+                                                 Vector3d(x_centre, 0.5 * kLaneWidth, 0.0)};
+
+  // Messages, allocated once.
+  sensor_msgs::JointState joints;
+  joints.name = model.coordinate_names;
+  joints.position.resize(joints.name.size());
+  tf2_msgs::TFMessage pose_msg, cop_msg, static_msg;
+  pose_msg.transforms.resize(1);
+  cop_msg.transforms.resize(2);
+  std::array<geometry_msgs::WrenchStamped, 2> plate_msg, reaction_msg;
+  std::array<std::string, 2> plate_topic, reaction_topic, plate_frame, cop_frame;
+  for (int i = 0; i < 2; ++i) {
+    const std::string n = std::to_string(i + 1);
+    plate_topic[i] = "/force_plate_" + n + "/wrench";
+    reaction_topic[i] = "/force_plate_" + n + "/reaction";
+    plate_frame[i] = "force_plate_" + n;
+    cop_frame[i] = "force_plate_" + n + "_cop";
+    plate_msg[i].header.frame_id = plate_frame[i];
+    reaction_msg[i].header.frame_id = cop_frame[i];
+  }
+  std::array<Eigen::Matrix<double, 6, 1>, 2> plate_row;  // the plates' samples for the CSV
+  std::array<Vector3d, 2> last_cop = {p_world_plate[0], p_world_plate[1]};
+
+  jle::Uniform uniform(options.seed);
+  auto gaussian = [&uniform]() {  // Box-Muller, one of the pair
+    const double u1 = 1.0 - uniform(), u2 = uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+  };
+
+  // Figures for the report.
+  double peak_fz = 0.0, peak_fz_foot = 0.0, max_residual_split = 0.0;
+  double cop_min = 1e9, cop_max = -1e9, cop_side = 0.0;
+  std::vector<double> q_min(static_cast<std::size_t>(model.nq), 1e9),
+      q_max(static_cast<std::size_t>(model.nq), -1e9);
+
+  const std::string temporary = options.output + ".partial";
+  const std::string csv_temporary = options.csv + ".partial";
+  FILE* csv = nullptr;
+  try {
+    if (!options.csv.empty()) {
+      csv = std::fopen(csv_temporary.c_str(), "w");
+      if (!csv) throw std::runtime_error(options.csv + ": cannot write " + csv_temporary);
+      std::fprintf(csv, "t");
+      for (const std::string& n : model.coordinate_names)
+        std::fprintf(csv, ",%s.q,%s.qd,%s.qdd", n.c_str(), n.c_str(), n.c_str());
+      for (const char* c : {"x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz", "wx", "wy",
+                            "wz", "ax", "ay", "az", "alx", "aly", "alz"})
+        std::fprintf(csv, ",base.%s", c);
+      for (const char* p : {"plate1", "plate2"})
+        for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(csv, ",plate@%s.%s", p, c);
+      std::fprintf(csv, "\n");
+    }
+    rosbag::Bag bag(temporary, rosbag::bagmode::Write);
+    {  // The plates' poses, latched.
+      const ros::Time stamp = stampOf(kEpochNs);
+      for (int i = 0; i < 2; ++i)
+        static_msg.transforms.push_back(
+            transform(plate_frame[i], stamp, p_world_plate[i], Matrix3d::Identity()));
+      // A connection header of our own (for "latching") must also name the type.
+      auto header = boost::make_shared<ros::M_string>();
+      (*header)["type"] = ros::message_traits::datatype(static_msg);
+      (*header)["md5sum"] = ros::message_traits::md5sum(static_msg);
+      (*header)["message_definition"] = ros::message_traits::definition(static_msg);
+      (*header)["callerid"] = "/make_gait_bag";
+      (*header)["latching"] = "1";
+      bag.write("/tf_static", stamp - ros::Duration(0, 3000000), static_msg, header);
+    }
+    jle::VectorX<double> qd(model.nq), qdd(model.nq);
+    for (long long k = 0; k < n_plate; ++k) {
+      const std::size_t c = static_cast<std::size_t>(k + 2);
+      for (int j = 0; j < model.nq; ++j) {
+        const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j],
+                     p2 = grid[c + 2][j], z = grid[c][j];
+        qd[j] = (m2 - 8.0 * m1 + 8.0 * p1 - p2) / (12.0 * h);
+        qdd[j] = (-m2 + 16.0 * m1 - 30.0 * z + 16.0 * p1 - p2) / (12.0 * h * h);
+        q_min[static_cast<std::size_t>(j)] = std::min(q_min[static_cast<std::size_t>(j)], z);
+        q_max[static_cast<std::size_t>(j)] = std::max(q_max[static_cast<std::size_t>(j)], z);
+      }
+      const double g = g0 + static_cast<double>(k) * h;
+      const jle::BaseState<double> base = pelvis.at(g);
+      jle::forwardKinematics(model, data, grid[c], qd, qdd, gravity, base);
+      jle::inverseDynamics(model, data);
+      // What the world must apply to the pelvis: world axes, about the world origin.
+      const Vector3d F = base.R_world_base * data.force[0];
+      const Vector3d M = base.R_world_base * data.moment[0] + base.p_world_base.cross(F);
+      if (!(F.z() > 0.0))
+        throw std::runtime_error("the trial needs the body pulled down (vertical ground "
+                                 "reaction " + std::to_string(F.z()) + " N)");
+      // Whole-body centre of pressure on z = 0 and free moment.
+      const Vector3d cop(-M.y() / F.z(), M.x() / F.z(), 0.0);
+      const double free_moment = M.z() - (cop.x() * F.y() - cop.y() * F.x());
+
+      std::array<FootState, 2> feet = {gait.at(legs[0], g), gait.at(legs[1], g)};
+      std::array<Share, 2> share;
+      if (feet[0].stance && feet[1].stance) {
+        const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
+        const int trail = 1 - lead;
+        const double w_lead = smoothStep(feet[lead].since_strike / ((kToeOff - 0.5) * kStride));
+        const Vector3d a(feet[trail].toe.x(), feet[trail].toe.y(), 0.0);
+        const Vector3d b(feet[lead].heel.x(), feet[lead].heel.y(), 0.0);
+        const Vector3d e = cop - ((1.0 - w_lead) * a + w_lead * b);
+        share[static_cast<std::size_t>(trail)] = {true, (1.0 - w_lead) * F, a + e,
+                                                  (1.0 - w_lead) * free_moment};
+        share[static_cast<std::size_t>(lead)] = {true, w_lead * F, b + e, w_lead * free_moment};
+      } else {
+        const int stance = feet[0].stance ? 0 : 1;
+        if (!feet[static_cast<std::size_t>(stance)].stance)
+          throw std::runtime_error("internal: no foot on the ground");
+        share[static_cast<std::size_t>(stance)] = {true, F, cop, free_moment};
+        // Where the centre of pressure lies along the foot, heel 0 .. toe 1.
+        const FootState& f = feet[static_cast<std::size_t>(stance)];
+        const Vector3d along = f.toe - f.heel;
+        const double u = (cop - f.heel).dot(along) / along.squaredNorm();
+        cop_min = std::min(cop_min, u);
+        cop_max = std::max(cop_max, u);
+        const Vector3d lateral = Vector3d::UnitZ().cross(along).normalized();
+        cop_side = std::max(cop_side, std::abs((cop - f.heel).dot(lateral)));
+      }
+      // Check of the split: the two shares make the whole wrench.
+      Vector3d F_sum = Vector3d::Zero(), M_sum = Vector3d::Zero();
+      for (const Share& s : share) {
+        F_sum += s.force;
+        M_sum += s.cop.cross(s.force) + Vector3d(0, 0, s.free_moment);
+      }
+      max_residual_split =
+          std::max({max_residual_split, (F_sum - F).norm(), (M_sum - M).norm() / 1.0});
+      peak_fz = std::max(peak_fz, F.z());
+
+      const std::int64_t ns = kEpochNs + k * 1000000LL;
+      const ros::Time stamp = stampOf(ns);
+      const ros::Time early = stamp - ros::Duration(0, 2000000);
+      for (std::size_t i = 0; i < 2; ++i) {
+        peak_fz_foot = std::max(peak_fz_foot, share[i].force.z());
+        // What the foot applies to the plate (the reaction reversed), plate frame
+        // (axes of the world), moment about the plate origin.
+        const Vector3d r = share[i].cop - p_world_plate[i];
+        Vector3d f_plate = -share[i].force;
+        Vector3d m_plate = -(r.cross(share[i].force) + Vector3d(0, 0, share[i].free_moment));
+        if (options.noise > 0.0) {
+          for (int j = 0; j < 3; ++j) f_plate[j] += options.noise * gaussian();
+          for (int j = 0; j < 3; ++j) m_plate[j] += 0.01 * options.noise * gaussian();
+        }
+        plate_msg[i].header.stamp = stamp;
+        setWrench(plate_msg[i], f_plate, m_plate);
+        bag.write(plate_topic[i], early, plate_msg[i]);
+        if (share[i].contact) last_cop[i] = share[i].cop;
+        plate_row[i] << f_plate, m_plate;
+      }
+      if (k % kDisplayDivisor == 0) {
+        for (std::size_t i = 0; i < 2; ++i) {
+          cop_msg.transforms[i] = transform(cop_frame[i], stamp, last_cop[i], Matrix3d::Identity());
+          reaction_msg[i].header.stamp = stamp;
+          setWrench(reaction_msg[i], share[i].force, Vector3d(0, 0, share[i].free_moment));
+        }
+        bag.write("/tf", early, cop_msg);
+        for (std::size_t i = 0; i < 2; ++i) bag.write(reaction_topic[i], stamp, reaction_msg[i]);
+      }
+      if (k % kPlateDivisor == 0) {
+        pose_msg.transforms[0] = transform("pelvis", stamp, base.p_world_base, base.R_world_base);
+        bag.write("/tf", early, pose_msg);
+        joints.header.stamp = stamp;
+        joints.header.seq = static_cast<std::uint32_t>(k / kPlateDivisor);
+        for (int j = 0; j < model.nq; ++j)
+          joints.position[static_cast<std::size_t>(j)] = grid[c][j];
+        bag.write("/joint_states", stamp, joints);
+        if (csv) {
+          std::fprintf(csv, "%.17g", static_cast<double>(ns - kEpochNs) * 1e-9);
+          for (int j = 0; j < model.nq; ++j)
+            std::fprintf(csv, ",%.17g,%.17g,%.17g", grid[c][j], qd[j], qdd[j]);
+          const Eigen::Quaterniond o(base.R_world_base);
+          const double pose[7] = {base.p_world_base.x(), base.p_world_base.y(),
+                                  base.p_world_base.z(), o.x(), o.y(), o.z(), o.w()};
+          for (double x : pose) std::fprintf(csv, ",%.17g", x);
+          for (const Vector3d* v : {&base.v_world, &base.omega_world, &base.a_world, &base.alpha_world})
+            std::fprintf(csv, ",%.17g,%.17g,%.17g", v->x(), v->y(), v->z());
+          for (const auto& row : plate_row)
+            for (int j = 0; j < 6; ++j) std::fprintf(csv, ",%.17g", row[j]);
+          std::fprintf(csv, "\n");
+        }
+      }
+    }
+    bag.close();
+    if (csv) {
+      const bool ok = std::fflush(csv) == 0 && !std::ferror(csv);
+      std::fclose(csv);
+      csv = nullptr;
+      if (!ok) throw std::runtime_error(options.csv + ": write error");
+      if (std::rename(csv_temporary.c_str(), options.csv.c_str()) != 0)
+        throw std::runtime_error(options.csv + ": cannot rename " + csv_temporary + " onto it");
+    }
+    if (std::rename(temporary.c_str(), options.output.c_str()) != 0)
+      throw std::runtime_error(options.output + ": cannot rename " + temporary + " onto it");
+  } catch (...) {
+    if (csv) std::fclose(csv);
+    std::remove(temporary.c_str());
+    if (!options.csv.empty()) std::remove(csv_temporary.c_str());
+    throw;
+  }
+
+  std::printf("make_gait_bag: %d strides, %.3f s, %lld joint states (200 Hz), %lld plate "
+              "samples per plate (1 kHz) -> %s\n",
+              options.strides, static_cast<double>(n_plate) * h, (n_plate + 4) / 5, n_plate,
+              options.output.c_str());
+  std::printf("  body %.2f kg (weight %.1f N); plates %.1f m x %.1f m, centres x %.3f m, "
+              "y -/+%.2f m\n",
+              mass, weight, plate_length, kLaneWidth, x_centre, 0.5 * kLaneWidth);
+  std::printf("  joint_loads: --plate plate1=foot_r,%.3f,%.3f,0 --plate plate2=foot_l,%.3f,%.3f,0\n",
+              x_centre, -0.5 * kLaneWidth, x_centre, 0.5 * kLaneWidth);
+  std::printf("  vertical ground reaction: peak %.2f BW (both feet), %.2f BW (one foot)\n",
+              peak_fz / weight, peak_fz_foot / weight);
+  std::printf("  single support: centre of pressure from %.2f to %.2f of heel->toe, up to "
+              "%.3f m beside that line\n",
+              cop_min, cop_max, cop_side);
+  std::printf("  inverse kinematics error %.1e m, split error %.1e, lowest toe in mid-swing "
+              "%.3f m\n",
+              ik_error, max_residual_split, min_toe);
+  for (const Leg& leg : legs)
+    for (int j : leg.coordinate)
+      std::printf("  %-18s %7.1f .. %6.1f deg\n", model.coordinate_names[static_cast<std::size_t>(j)].c_str(),
+                  q_min[static_cast<std::size_t>(j)] * 180.0 / kPi,
+                  q_max[static_cast<std::size_t>(j)] * 180.0 / kPi);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return jle::cli::runTool(argc, argv, "make_gait_bag", kUsage, parseOptions, run);
+}
+
