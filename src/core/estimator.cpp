@@ -159,6 +159,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
 
 void Estimator::reset() {
   bank_.reset();
+  cov_count_ = 0;
   for (Input& input : inputs_) {
     input.count = 0;
     input.head = 0;
