@@ -442,6 +442,61 @@ TEST(CovarianceReference, Talos) {
   expectMatchesReference({"talos_reduced.urdf", "left_sole_link"}, false);
 }
 
+// uncertainty.decimation: the covariance is computed for every n-th published sample and
+// held in between. The held values must be exactly those of the sample they were
+// computed at; the error of holding (how much each effort sigma moves over n samples)
+// is measured and printed for docs/uncertainty.md.
+TEST(CovarianceDecimation, HoldsAndMeasuresTheError) {
+  for (const std::string urdf : {"panda.urdf", "talos_reduced.urdf"}) {
+    const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/" + urdf);
+    const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31), {});
+    jle::EstimatorConfig config;
+    config.savings.reuse_unchanged = false;
+    config.uncertainty.enabled = true;
+    config.uncertainty.position_noise = 1e-4;
+    config.uncertainty.mass_fraction = 0.05;
+    config.uncertainty.com_offset = 0.005;
+    config.uncertainty.inertia_fraction = 0.1;
+    jle::Estimator every(model, config);
+    config.uncertainty.decimation = 10;
+    jle::Estimator held(model, config);
+    const int samples = 2000;  // 2 s at 1 kHz
+    std::vector<std::vector<double>> sigma;  // per published sample, per moving joint
+    Eigen::VectorXd q, qd, qdd;
+    int published = 0;
+    for (int k = 0; k < samples; ++k) {
+      const double t = k * 1e-3;
+      truth.coordinates(t, q, qd, qdd);
+      const jle::SampleStatus s = every.addJointSample(t, q.data());
+      ASSERT_EQ(held.addJointSample(t, q.data()), s);
+      if (s != jle::SampleStatus::kPublished) continue;
+      std::vector<double> row;
+      for (int i : model.moving_segments) row.push_back(std::sqrt(every.effortVariance(i)));
+      sigma.push_back(row);
+      // Held: exactly the value of the last computed sample (same code, same inputs).
+      const std::size_t computed = static_cast<std::size_t>(published - published % 10);
+      for (std::size_t j = 0; j < row.size(); ++j)
+        EXPECT_EQ(std::sqrt(held.effortVariance(model.moving_segments[j])), sigma[computed][j]);
+      ++published;
+    }
+    for (int n : {2, 5, 10, 20, 50}) {
+      double worst = 0.0, mean = 0.0;
+      long count = 0;
+      for (std::size_t a = 0; a < sigma.size(); a += static_cast<std::size_t>(n))
+        for (std::size_t b = a + 1; b < std::min(sigma.size(), a + n); ++b)
+          for (std::size_t j = 0; j < sigma[a].size(); ++j) {
+            if (sigma[a][j] <= 0.0) continue;
+            const double e = std::abs(sigma[b][j] / sigma[a][j] - 1.0);
+            worst = std::max(worst, e);
+            mean += e;
+            ++count;
+          }
+      std::printf("%s, decimation %2d: held sigma of the efforts off by at most %.4f (mean %.5f)\n",
+                  urdf.c_str(), n, worst, count ? mean / count : 0.0);
+    }
+  }
+}
+
 // Inertial parameters: the propagated covariance against the loads of 10 000 models
 // whose masses, centres of mass and inertias are drawn from the stated uncertainty,
 // at the state the estimator held (the core's own passes on each perturbed model).
