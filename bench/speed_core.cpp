@@ -240,7 +240,7 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
   } else if (variant.rfind("cov_", 0) == 0) {
     // Covariance of the loads (docs/uncertainty.md): cov_full = every source, the state
     // linearised; cov_qdd = its cheap path (q-ddot, wrench and inertial parts only);
-    // _diag = only the variances.
+    // _diag = only the variances; _dec16 = computed every 16th sample, held in between.
     c.uncertainty.enabled = true;
     c.uncertainty.position_noise = 1e-4;
     c.uncertainty.mass_fraction = 0.05;
@@ -248,6 +248,7 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
     c.uncertainty.inertia_fraction = 0.1;
     c.uncertainty.linearize_state = variant.find("full") != std::string::npos;
     c.uncertainty.diagonal_only = variant.find("diag") != std::string::npos;
+    if (variant.find("dec16") != std::string::npos) c.uncertainty.decimation = 16;
   } else if (variant == "planar_off") {
     c.savings.planar = jle::PlanarMode::kOff;
   }
@@ -301,7 +302,8 @@ BENCHMARK_CAPTURE(scaling, tree, true)
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full, file, "", false, "cov_full");         \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag, file, "", false, "cov_full_diag"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd, file, "", false, "cov_qdd");           \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag")
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag");  \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec16, file, "", false, "cov_full_dec16")
 JLE_COVARIANCE(panda, "/urdf/panda.urdf");
 JLE_COVARIANCE(talos, "/urdf/talos_reduced.urdf");
 

@@ -64,6 +64,9 @@ struct UncertaintyConfig {
   /// Include the (linearised) dependence on q and q-dot; false: only the q-ddot, wrench
   /// and inertial-parameter parts, which are exact and cheaper.
   bool linearize_state = true;
+  /// The covariance is computed for every n-th published sample and held in between
+  /// (it changes slowly; docs/uncertainty.md measures the error of holding it).
+  int decimation = 1;
 };
 
 /// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
@@ -274,6 +277,8 @@ class Estimator {
   void computeCovariance(const BaseState<double>& base_state);
   void loadsPass(Data<double>& data, const VectorX<double>& q, const VectorX<double>& qd,
                  const BaseState<double>& base_state);
+  template <bool kState>
+  void sweepCoordinate(int j, const Data<double>& nom, const Eigen::Matrix<double, 3, kState ? 3 : 1>& F);
   struct Plate {
     PlateInputConfig config;
     ForcePlateConfig filtered;  // config.plate with a zero threshold (for the filtered wrench)
@@ -323,17 +328,20 @@ class Estimator {
   using Matrix6 = Eigen::Matrix<double, 6, 6>;
   using Vector6 = Eigen::Matrix<double, 6, 1>;
   std::vector<Matrix6> covariance_;     // per segment: the result
-  std::vector<Matrix6> composite_;      // per segment: composite inertia of its subtree
-  std::vector<Matrix6> local_;          // per segment: covariance of its own terms
-  std::vector<Eigen::Matrix<double, 6, 3>> jacobian_;  // per segment: d y / d(q, qd, qdd)_j
-  std::vector<Vector6> motion_;         // per segment: the rigid acceleration of one qdd
+  std::vector<Matrix6> local_;          // per segment: covariance of its own terms, then subtree
+  // Per segment: tangents of one coordinate's sweep (columns: the noise directions):
+  // omega, alpha, origin acceleration, then force and moment (segment frame).
+  std::vector<Eigen::Matrix3d> t_w_, t_al_, t_acc_, t_f_, t_n_;
+  std::vector<Eigen::Matrix<double, 6, 3>> jacobian_;  // per segment: ancestors of a mimic's sweep
   std::vector<int> subtree_end_;        // per segment: its subtree is [i, subtree_end_[i])
   std::vector<char> in_dynamics_;       // per segment
-  std::vector<std::vector<int>> coordinate_segments_;  // per coordinate: segments it drives
-  std::vector<std::vector<int>> affected_;             // per coordinate: dynamics segments it moves
+  std::vector<char> in_kinematics_;     // per segment
+  std::vector<int> sweep_mark_;         // per segment: the coordinate being swept + 1, or 0
+  std::vector<std::vector<int>> sweep_;            // per coordinate: subtrees of its segments
+  std::vector<std::vector<int>> sweep_ancestors_;  // per coordinate, several roots: their ancestors
+  std::vector<char> single_root_;                  // per coordinate
   Data<double> cov_nominal_;  // the loads in double (Precision::kFloat)
-  Data<double> cov_data_;     // a perturbed pass
-  VectorX<double> q_pert_, qd_pert_;
+  long cov_count_ = 0;        // published samples since the last covariance (decimation)
   // savings.planar (planar.hpp).
   bool planar_ = false;
   bool last_planar_ = false;

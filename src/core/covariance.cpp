@@ -3,18 +3,31 @@
 // The wrench y_i of segment i (force, moment: child frame, about the joint origin)
 // depends on
 //  - each coordinate's estimate e_j = (q, qd, qdd)_j, whose noise has the covariance
-//    sigma^2 G (G the filter's noise gain), independent between coordinates;
+//    Sigma = sigma^2 G (G the filter's noise gain), independent between coordinates;
 //  - the filtered wrench inputs (noise sigma^2 G_00 per component, independent);
 //  - the inertial parameters of each segment (independent between segments).
 // These are independent of each other, so
-//    Cov(y_i) = sum_j J_ij sigma^2 G J_ij^T + sum_{k in subtree(i)} X_ik C_k X_ik^T,
+//    Cov(y_i) = sum_j J_ij Sigma J_ij^T + sum_{k in subtree(i)} X_ik C_k X_ik^T,
 // with J_ij = d y_i / d e_j and C_k the covariance of segment k's own terms (its
 // inertial wrench and the inputs acting on it) carried to i by the force transform X_ik.
-// y is linear in qdd, in the inputs and in the mass and inertia: those parts are exact.
-// Its dependence on q and qd (and on the centre of mass) is linearised at the estimate.
+//
+// How J is obtained, in O(sum of subtree sizes) instead of O(nq n) passes:
+//  - coordinate j moves only the subtree of its joint s: one forward-mode (tangent)
+//    sweep of that subtree's kinematics and wrenches gives J_ij for every i in it,
+//    exactly (the derivative of the recursion, not a difference);
+//  - above s, e_j reaches y_i only through the joint wrench s hands to its parent:
+//    J_ij = X_{i p(s)} g_j with g_j (6 x 3) its derivative, so those terms are the rank-3
+//    covariance g_j Sigma g_j^T entering p(s), carried up with the C_k above (one
+//    congruence per segment for all coordinates together).
+// Sigma is factored once (Sigma = F F^T) and the sweep is seeded with the columns of F,
+// so each term is an outer product (J F)(J F)^T.
+// y is linear in qdd, in the inputs and in the mass and inertia: those parts are exact;
+// its dependence on q and qd (and on the centre of mass) is linearised at the estimate.
 #include <joint_load_estimator/estimator.hpp>
 
 #include <joint_load_estimator/kinematics.hpp>
+
+#include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -56,27 +69,6 @@ void addForceCongruence(const Eigen::Matrix3d& R, const Eigen::Vector3d& r, cons
   out.bottomRightCorner<3, 3>() += SB + SB.transpose() + Y.bottomRightCorner<3, 3>();
 }
 
-// The wrench (f, n about B's origin, B frame) in A about A's origin.
-Vector6 forceToParent(const Eigen::Matrix3d& R, const Eigen::Vector3d& r, const Vector6& w) {
-  Vector6 out;
-  out.head<3>().noalias() = R * w.head<3>();
-  out.tail<3>().noalias() = R * w.tail<3>();
-  out.tail<3>() += r.cross(out.head<3>());
-  return out;
-}
-
-// Spatial inertia of a segment about its origin, in its frame: the acceleration
-// (linear at the origin, angular) to the wrench (f, n about the origin).
-Matrix6 spatialInertia(double m, const Eigen::Vector3d& c, const Eigen::Matrix3d& I_com) {
-  const Eigen::Matrix3d C = skew(c);
-  Matrix6 I;
-  I.topLeftCorner<3, 3>() = m * Eigen::Matrix3d::Identity();
-  I.topRightCorner<3, 3>() = -m * C;
-  I.bottomLeftCorner<3, 3>() = m * C;
-  I.bottomRightCorner<3, 3>() = I_com - m * C * C;  // [c]^T [c] = -[c][c]
-  return I;
-}
-
 void checkNoise(double value, const std::string& name) {
   if (!(value >= 0.0) || !std::isfinite(value))
     throw std::invalid_argument(name + " must be finite and non-negative");
@@ -90,6 +82,7 @@ void Estimator::setUpCovariance() {
   checkNoise(u.mass_fraction, "uncertainty.mass_fraction");
   checkNoise(u.com_offset, "uncertainty.com_offset");
   checkNoise(u.inertia_fraction, "uncertainty.inertia_fraction");
+  if (u.decimation < 1) throw std::invalid_argument("uncertainty.decimation must be at least 1");
   for (const WrenchInputConfig& c : config_.wrenches) {
     checkNoise(c.force_noise, "wrench input '" + c.name + "': force_noise");
     checkNoise(c.moment_noise, "wrench input '" + c.name + "': moment_noise");
@@ -97,11 +90,11 @@ void Estimator::setUpCovariance() {
   const int n = model_.nsegments();
   const std::size_t ns = static_cast<std::size_t>(n);
   covariance_.assign(ns, Matrix6::Zero());
+  cov_count_ = 0;
   if (!u.enabled) return;
-  composite_.assign(ns, Matrix6::Zero());
   local_.assign(ns, Matrix6::Zero());
+  for (auto* t : {&t_w_, &t_al_, &t_acc_, &t_f_, &t_n_}) t->assign(ns, Eigen::Matrix3d::Zero());
   jacobian_.assign(ns, Eigen::Matrix<double, 6, 3>::Zero());
-  motion_.assign(ns, Vector6::Zero());
   // Segments are numbered depth first: each subtree is a range of indices.
   subtree_end_.resize(ns);
   for (int i = 0; i < n; ++i) subtree_end_[i] = i + 1;
@@ -113,23 +106,44 @@ void Estimator::setUpCovariance() {
         throw std::logic_error("covariance: segments are not numbered depth first");
   in_dynamics_.assign(ns, 0);
   for (int i : dynamics_segments_) in_dynamics_[i] = 1;
-  coordinate_segments_.assign(static_cast<std::size_t>(model_.nq), {});
-  for (int i : kinematics_segments_)
-    if (model_.coordinate[i] >= 0 && isMoving(model_.joint_type[i]))
-      coordinate_segments_[model_.coordinate[i]].push_back(i);
-  affected_.assign(static_cast<std::size_t>(model_.nq), {});
+  in_kinematics_.assign(ns, 0);
+  for (int i : kinematics_segments_) in_kinematics_[i] = 1;
+  sweep_mark_.assign(ns, 0);
+  // Per coordinate: the segments it moves (the subtrees of the joints it drives, which
+  // the loads need), and, when it drives several disjoint subtrees (mimic joints), the
+  // computed segments above them, which see the sum of their effects.
+  const std::size_t nq = static_cast<std::size_t>(model_.nq);
+  sweep_.assign(nq, {});
+  sweep_ancestors_.assign(nq, {});
+  single_root_.assign(nq, 1);
   std::vector<char> mark(ns);
   for (int j = 0; j < model_.nq; ++j) {
     mark.assign(ns, 0);
-    for (int s : coordinate_segments_[j]) {
-      for (int k = s; k < subtree_end_[s]; ++k) mark[k] = 1;
-      for (int p = model_.parent[s]; p >= 0; p = model_.parent[p]) mark[p] = 1;
+    bool needed = false;
+    for (int s : kinematics_segments_) {
+      if (model_.coordinate[s] != j || !isMoving(model_.joint_type[s])) continue;
+      for (int k = s; k < subtree_end_[s]; ++k) {
+        mark[k] = in_kinematics_[k];
+        needed = needed || in_dynamics_[k];
+      }
     }
-    for (int i : dynamics_segments_)
-      if (mark[i]) affected_[j].push_back(i);
+    if (!needed) continue;  // moves nothing whose loads are computed
+    int roots = 0;
+    for (int k = 0; k < n; ++k) {
+      if (!mark[k]) continue;
+      sweep_[j].push_back(k);
+      if (model_.parent[k] < 0 || !mark[model_.parent[k]]) ++roots;
+    }
+    single_root_[j] = roots == 1;
+    if (roots > 1) {
+      std::vector<char> above(ns, 0);
+      for (int k : sweep_[j])
+        if (model_.parent[k] >= 0 && !mark[model_.parent[k]])
+          for (int p = model_.parent[k]; p >= 0; p = model_.parent[p]) above[p] = 1;
+      for (int k = n - 1; k >= 0; --k)
+        if (above[k] && in_dynamics_[k]) sweep_ancestors_[j].push_back(k);
+    }
   }
-  q_pert_ = q_;
-  qd_pert_ = qd_;
 }
 
 void Estimator::loadsPass(Data<double>& data, const VectorX<double>& q, const VectorX<double>& qd,
@@ -146,8 +160,176 @@ void Estimator::loadsPass(Data<double>& data, const VectorX<double>& q, const Ve
   inverseDynamics(model_, data, dynamics_segments_);
 }
 
+// One coordinate's sweep: the derivatives of the kinematics and of the joint wrenches of
+// every segment it moves, along the NC noise directions of the columns of F (rows: q,
+// qd, qdd; kState false: the q-ddot direction only, one column). Each computed segment
+// of the sweep gets its outer product; the wrench handed out of the sweep goes to the
+// parent's local_ (one root) or is carried up explicitly (several roots: mimics).
+template <bool kState>
+#if defined(__GNUC__)
+// Inline every small fixed-size Eigen product (GCC leaves many out of line): 2x faster.
+__attribute__((flatten))
+#endif
+void Estimator::sweepCoordinate(int j, const Data<double>& nom,
+                                const Eigen::Matrix<double, 3, kState ? 3 : 1>& F) {
+  constexpr int NC = kState ? 3 : 1;
+  using M = Eigen::Matrix<double, 3, NC>;
+  using Row = Eigen::Matrix<double, 1, NC>;
+  using J6 = Eigen::Matrix<double, 6, NC>;
+  const bool diagonal = config_.uncertainty.diagonal_only;
+  const std::vector<int>& sweep = sweep_[j];
+  const int tag = j + 1;
+  for (int k : sweep) sweep_mark_[k] = tag;
+
+  // Forward: the tangent of omega, alpha and the origin acceleration, segment frame.
+  for (int k : sweep) {
+    const int p = model_.parent[k];
+    const Eigen::Matrix3d& R = nom.R_parent_child[k];
+    const Eigen::Vector3d& r = nom.p_parent_child[k];
+    const Eigen::Vector3d& u = model_.axis[k];
+    const double qd_k = nom.qd[k];
+    auto w = t_w_[k].leftCols<NC>();
+    auto al = t_al_[k].leftCols<NC>();
+    auto acc = t_acc_[k].leftCols<NC>();
+    if (p >= 0 && sweep_mark_[p] == tag) {
+      const auto w_p = t_w_[p].leftCols<NC>();
+      const auto al_p = t_al_[p].leftCols<NC>();
+      M a_point = t_acc_[p].leftCols<NC>();
+      a_point.noalias() -= skew(r) * al_p;  // al_p x r
+      if (kState) {
+        const Eigen::Vector3d& wn_p = nom.omega[p];
+        // d(w x (w x r)) = dw x (w x r) + w x (dw x r)
+        a_point.noalias() -= (skew(wn_p.cross(r)) + skew(wn_p) * skew(r)) * w_p;
+        w.noalias() = R.transpose() * w_p;
+      } else {
+        w.setZero();
+      }
+      al.noalias() = R.transpose() * al_p;
+      acc.noalias() = R.transpose() * a_point;
+    } else {
+      w.setZero();
+      al.setZero();
+      acc.setZero();
+    }
+    const bool driven = model_.coordinate[k] == j && isMoving(model_.joint_type[k]);
+    const double mu = model_.multiplier[k];
+    const Eigen::Vector3d& wn = nom.omega[k];
+    if (model_.joint_type[k] == JointType::kRevolute) {
+      if (driven) {
+        // The joint rotation R(theta) enters as R^T: d(R^T x)/d theta = -u x R^T x.
+        const Row a = mu * F.row(0), b = mu * F.row(1), c = mu * F.row(2);
+        if (kState) {
+          const Eigen::Vector3d Rt_wp = wn - u * qd_k;
+          w.noalias() += (-u.cross(Rt_wp)) * a + u * b;
+          const Eigen::Vector3d Rt_alp = nom.alpha[k] - u * nom.qdd[k] - wn.cross(u * qd_k);
+          al.noalias() += (-u.cross(Rt_alp)) * a + wn.cross(u) * b;
+          acc.noalias() += (-u.cross(nom.acc[k])) * a;
+        }
+        al.noalias() += u * c;
+      }
+      if (kState && qd_k != 0.0) al.noalias() -= skew(u * qd_k) * w;  // dw x u qd
+    } else if (model_.joint_type[k] == JointType::kPrismatic) {
+      if (driven) {
+        const Row a = mu * F.row(0), b = mu * F.row(1), c = mu * F.row(2);
+        if (kState) {
+          const Eigen::Vector3d& aln = nom.alpha[k];
+          acc.noalias() += (aln.cross(u) + wn.cross(wn.cross(u))) * a + (2.0 * wn.cross(u)) * b;
+        }
+        acc.noalias() += u * c;
+      }
+      if (kState && qd_k != 0.0) acc.noalias() -= skew(2.0 * qd_k * u) * w;  // 2 dw x u qd
+    }
+    t_f_[k].leftCols<NC>().setZero();
+    t_n_[k].leftCols<NC>().setZero();
+  }
+
+  // Backward: the tangent of each joint wrench, its outer product, handed to the parent.
+  const std::vector<int>& ancestors = sweep_ancestors_[j];
+  for (int a : ancestors) jacobian_[a].leftCols<NC>().setZero();
+  for (auto it = sweep.rbegin(); it != sweep.rend(); ++it) {
+    const int k = *it;
+    if (!in_dynamics_[k]) continue;
+    auto f = t_f_[k].leftCols<NC>();
+    auto nmo = t_n_[k].leftCols<NC>();
+    if (model_.has_inertia[k]) {
+      const double m = model_.mass[k];
+      const Eigen::Vector3d& c = model_.com[k];
+      const Eigen::Matrix3d& I = model_.inertia_com[k];
+      const Eigen::Matrix3d C = skew(c);
+      const auto al = t_al_[k].leftCols<NC>();
+      M dacom = t_acc_[k].leftCols<NC>();
+      dacom.noalias() -= C * al;
+      if (kState) {
+        const Eigen::Vector3d& wn = nom.omega[k];
+        const auto w = t_w_[k].leftCols<NC>();
+        dacom.noalias() -= (skew(wn.cross(c)) + skew(wn) * C) * w;
+        if (model_.gyroscopic[k]) nmo.noalias() += (skew(wn) * I - skew(I * wn)) * w;
+      }
+      const M df = m * dacom;
+      f += df;
+      nmo.noalias() += I * al;
+      nmo.noalias() += C * df;
+    }
+    J6 Jk;
+    Jk << f, nmo;
+    if (diagonal)
+      covariance_[k].diagonal() += Jk.cwiseAbs2().rowwise().sum();
+    else
+      covariance_[k].noalias() += Jk * Jk.transpose();
+    const int p = model_.parent[k];
+    if (p < 0 || !in_dynamics_[p]) continue;
+    // The wrench handed to the parent, X (f, n), and its change with the joint's own
+    // coordinate: d(R f)/d theta = R (u x f) (revolute); d(r x R f)/d d = R (u x f) (prismatic).
+    const Eigen::Matrix3d& R = nom.R_parent_child[k];
+    const Eigen::Vector3d& r = nom.p_parent_child[k];
+    M f_p = R * f;
+    M n_p = R * nmo;
+    if (kState && model_.coordinate[k] == j && isMoving(model_.joint_type[k])) {
+      const Row a = model_.multiplier[k] * F.row(0);
+      const Eigen::Vector3d& u = model_.axis[k];
+      if (model_.joint_type[k] == JointType::kRevolute) {
+        f_p.noalias() += (R * u.cross(nom.force[k])) * a;
+        n_p.noalias() += (R * u.cross(nom.moment[k])) * a;
+      } else {
+        n_p.noalias() += (R * u.cross(nom.force[k])) * a;
+      }
+    }
+    n_p.noalias() += skew(r) * f_p;
+    if (sweep_mark_[p] == tag) {
+      t_f_[p].leftCols<NC>() += f_p;
+      t_n_[p].leftCols<NC>() += n_p;
+    } else if (single_root_[j]) {
+      J6 g;
+      g << f_p, n_p;
+      local_[p].noalias() += g * g.transpose();
+    } else {
+      jacobian_[p].topLeftCorner<3, NC>() += f_p;
+      jacobian_[p].bottomLeftCorner<3, NC>() += n_p;
+    }
+  }
+  // Several roots (a mimic driving disjoint subtrees): their effects add before the
+  // outer product, so the segments above are done here.
+  for (int a : ancestors) {
+    const J6 Ja = jacobian_[a].leftCols<NC>();
+    if (diagonal)
+      covariance_[a].diagonal() += Ja.cwiseAbs2().rowwise().sum();
+    else
+      covariance_[a].noalias() += Ja * Ja.transpose();
+    const int p = model_.parent[a];
+    if (p < 0 || !in_dynamics_[p]) continue;
+    const Eigen::Matrix3d& R = nom.R_parent_child[a];
+    const M f_p = R * Ja.template topRows<3>();
+    jacobian_[p].topLeftCorner<3, NC>() += f_p;
+    jacobian_[p].bottomLeftCorner<3, NC>().noalias() += R * Ja.template bottomRows<3>();
+    jacobian_[p].bottomLeftCorner<3, NC>().noalias() += skew(nom.p_parent_child[a]) * f_p;
+  }
+  for (int k : sweep) sweep_mark_[k] = 0;
+}
+
 void Estimator::computeCovariance(const BaseState<double>& base_state) {
   const UncertaintyConfig& u = config_.uncertainty;
+  // Decimated: the covariance of the last computation is held.
+  if (cov_count_++ % u.decimation != 0) return;
   // The kinematics in double: data_ itself, or a double pass beside the float one.
   if (config_.precision == Precision::kFloat) loadsPass(cov_nominal_, q_, qd_, base_state);
   const Data<double>& nom = config_.precision == Precision::kFloat ? cov_nominal_ : data_;
@@ -156,95 +338,27 @@ void Estimator::computeCovariance(const BaseState<double>& base_state) {
     covariance_[i].setZero();
     local_[i].setZero();
   }
+  bool any_local = false;
 
   // The state part, coordinate by coordinate.
   const double var_q = u.position_noise * u.position_noise;
   if (var_q > 0.0) {
-    // Composite inertia of each subtree about its joint origin (the CRBA recursion):
-    // what a rigid acceleration of the subtree costs in joint wrench.
-    for (int i : dynamics_segments_)
-      composite_[i] = spatialInertia(model_.mass[i], model_.com[i], model_.inertia_com[i]);
-    for (auto it = dynamics_segments_.rbegin(); it != dynamics_segments_.rend(); ++it) {
-      const int i = *it, p = model_.parent[i];
-      if (p >= 0 && in_dynamics_[p])
-        addForceCongruence(nom.R_parent_child[i], nom.p_parent_child[i], composite_[i],
-                           composite_[p]);
-    }
-    const Eigen::Matrix3d Sigma = var_q * G;
-    const double var_qdd = var_q * G(2, 2);
-    for (int j = 0; j < model_.nq; ++j) {
-      if (coordinate_segments_[j].empty()) continue;
-      const std::vector<int>& affected = affected_[j];
-      for (int i : affected) jacobian_[i].setZero();
-      // d y / d qdd_j, exact: qdd_j accelerates each driven subtree rigidly (no velocity
-      // changes), which costs the composite inertia times that acceleration below the
-      // joint and is passed on unchanged (transformed) above it.
-      for (int s : coordinate_segments_[j]) {
-        Vector6 S = Vector6::Zero();
-        if (model_.joint_type[s] == JointType::kRevolute)
-          S.tail<3>() = model_.multiplier[s] * model_.axis[s];
-        else
-          S.head<3>() = model_.multiplier[s] * model_.axis[s];
-        motion_[s] = S;
-        for (int k = s + 1; k < subtree_end_[s]; ++k) {
-          const Vector6& mp = motion_[model_.parent[k]];
-          const Eigen::Matrix3d& R = nom.R_parent_child[k];
-          const Eigen::Vector3d& r = nom.p_parent_child[k];
-          motion_[k].tail<3>().noalias() = R.transpose() * mp.tail<3>();
-          motion_[k].head<3>().noalias() = R.transpose() * (mp.head<3>() + mp.tail<3>().cross(r));
-        }
-        for (int k = s; k < subtree_end_[s]; ++k)
-          if (in_dynamics_[k]) jacobian_[k].col(2).noalias() += composite_[k] * motion_[k];
-        if (in_dynamics_[s]) {
-          Vector6 w = composite_[s] * S;
-          for (int c = s, p = model_.parent[s]; p >= 0 && in_dynamics_[p];
-               c = p, p = model_.parent[p]) {
-            w = forceToParent(nom.R_parent_child[c], nom.p_parent_child[c], w);
-            jacobian_[p].col(2) += w;
-          }
-        }
-      }
-      if (u.linearize_state) {
-        // d y / d q_j and d y / d qd_j: forward differences of the loads. The step
-        // leaves a relative error of about h times the curvature over the slope (1e-6
-        // for angles of order 1) and a rounding error of eps |y| / h (1e-10 |y|).
-        constexpr double h = 1e-6;  // [rad or m, rad/s or m/s]
-        q_pert_ = q_;
-        q_pert_[j] += h;
-        loadsPass(cov_data_, q_pert_, qd_, base_state);
-        for (int i : affected) {
-          jacobian_[i].col(0).head<3>() = (cov_data_.force[i] - nom.force[i]) / h;
-          jacobian_[i].col(0).tail<3>() = (cov_data_.moment[i] - nom.moment[i]) / h;
-        }
-        qd_pert_ = qd_;
-        qd_pert_[j] += h;
-        loadsPass(cov_data_, q_, qd_pert_, base_state);
-        for (int i : affected) {
-          jacobian_[i].col(1).head<3>() = (cov_data_.force[i] - nom.force[i]) / h;
-          jacobian_[i].col(1).tail<3>() = (cov_data_.moment[i] - nom.moment[i]) / h;
-        }
-        for (int i : affected) {
-          const Eigen::Matrix<double, 6, 3>& J = jacobian_[i];
-          const Eigen::Matrix<double, 6, 3> JS = J * Sigma;
-          if (u.diagonal_only)
-            covariance_[i].diagonal() += JS.cwiseProduct(J).rowwise().sum();
-          else
-            covariance_[i].noalias() += JS * J.transpose();
-        }
-      } else {
-        for (int i : affected) {
-          const Vector6 d = jacobian_[i].col(2);
-          if (u.diagonal_only)
-            covariance_[i].diagonal() += var_qdd * d.cwiseAbs2();
-          else
-            covariance_[i].noalias() += var_qdd * d * d.transpose();
-        }
-      }
+    any_local = true;
+    if (u.linearize_state) {
+      // Sigma = var_q G = F F^T (G may be singular: the Kalman filter's first sample).
+      const Eigen::LDLT<Eigen::Matrix3d> ldlt(G);
+      Eigen::Matrix3d F = ldlt.transpositionsP().transpose() * Eigen::Matrix3d(ldlt.matrixL());
+      for (int c = 0; c < 3; ++c) F.col(c) *= std::sqrt(var_q * std::max(ldlt.vectorD()[c], 0.0));
+      for (int j = 0; j < model_.nq; ++j)
+        if (!sweep_[j].empty()) sweepCoordinate<true>(j, nom, F);
+    } else {
+      const Eigen::Vector3d F(0.0, 0.0, std::sqrt(var_q * G(2, 2)));
+      for (int j = 0; j < model_.nq; ++j)
+        if (!sweep_[j].empty()) sweepCoordinate<false>(j, nom, F);
     }
   }
 
   // Each segment's own terms: the wrench inputs acting on it and its inertial parameters.
-  bool any_local = false;
   const double g00 = G(0, 0);  // the inputs are filtered like the positions (value output)
   for (std::size_t k = 0; k < inputs_.size(); ++k) {
     const WrenchInputConfig& c = inputs_[k].config;

@@ -59,8 +59,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
       q_(VectorX<double>::Zero(model.nq)),
       qd_(VectorX<double>::Zero(model.nq)),
       qdd_(VectorX<double>::Zero(model.nq)),
-      cov_nominal_(model_),
-      cov_data_(model_) {
+      cov_nominal_(model_) {
   if (config_.decimation < 1) throw std::invalid_argument("decimation must be at least 1");
   if (!config_.gravity_world.allFinite()) throw std::invalid_argument("gravity is not finite");
   base_channel_ = model_.nq;
@@ -188,6 +187,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
 
 void Estimator::reset() {
   bank_.reset();
+  cov_count_ = 0;
   for (Input& input : inputs_) {
     input.count = 0;
     input.head = 0;

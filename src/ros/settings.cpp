@@ -360,6 +360,9 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
     su.read("com_offset", u.com_offset);
     su.read("inertia_fraction", u.inertia_fraction);
     su.read("linearize_state", u.linearize_state);
+    su.read("decimation", u.decimation);
+    if (u.decimation < 1)
+      throw SettingsError("parameter '" + su.name("decimation") + "' must be at least 1");
     const std::pair<const char*, double> values[] = {{"position_noise", u.position_noise},
                                                       {"mass_fraction", u.mass_fraction},
                                                       {"com_offset", u.com_offset},

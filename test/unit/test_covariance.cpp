@@ -326,6 +326,177 @@ TEST(CovarianceMonteCarlo, TalosLongWindow) {
   runMonteCarlo(s, kReplays);
 }
 
+// ---------------------------------------------------------------------------------------
+// The propagation of the coordinate noise against the previous implementation's method,
+// kept here as the reference: every column of d y / d(q, qd, qdd)_j by differences of
+// complete passes of the core (q-ddot: the loads are linear in it, a unit step is exact
+// to rounding; q, q-dot: central differences), Cov = sum_j J_j sigma^2 G J_j^T.
+
+struct ReferenceScene {
+  std::string urdf;
+  std::string wrench_link;  // an applied input (its wrench moves with its link)
+};
+
+void expectMatchesReference(const ReferenceScene& scene, bool linearize_state) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/" + scene.urdf);
+  const jle::WrenchMotion wrench = jle::randomWrench(scene.wrench_link, 17);
+  const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 23),
+                               {wrench});
+  jle::EstimatorConfig config;
+  config.savings.reuse_unchanged = false;
+  jle::WrenchInputConfig w;
+  w.name = w.link = scene.wrench_link;
+  config.wrenches.push_back(w);
+  config.uncertainty.enabled = true;
+  config.uncertainty.position_noise = 1e-3;
+  config.uncertainty.linearize_state = linearize_state;
+  jle::Estimator estimator(model, config);
+  jle::DifferentiatorBank bank(config.differentiator, 1);  // the same times: the same gain
+  Eigen::VectorXd q, qd, qdd;
+  const double h_t = 1e-3;
+  for (int k = 0; k < 30; ++k) {
+    const double t = 0.5 + k * h_t;
+    const Vector6 wr = wrench.at(t);
+    estimator.addWrench(0, t, wr.head<3>(), wr.tail<3>());
+    truth.coordinates(t, q, qd, qdd);
+    ASSERT_EQ(estimator.addJointSample(t, q.data()),
+              k < 8 ? jle::SampleStatus::kWarmingUp : jle::SampleStatus::kPublished);
+    const double x = 0.0;
+    bank.update(t, &x);
+  }
+  const Eigen::Matrix3d Sigma = 1e-6 * bank.noiseGain();
+  const jle::Wrench<double> applied = estimator.appliedWrench(0);
+  const int frame = model.frameIndex(scene.wrench_link);
+  jle::Data<double> data(model);
+  auto loads = [&](const Eigen::VectorXd& q_, const Eigen::VectorXd& qd_,
+                   const Eigen::VectorXd& qdd_, std::vector<Vector6>& y) {
+    jle::forwardKinematics(model, data, q_, qd_, qdd_, Eigen::Vector3d(0.0, 0.0, -9.80665));
+    jle::addExternalWrench(model, data, frame, applied.force, applied.moment,
+                           jle::WrenchFrame::kLocal);
+    jle::inverseDynamics(model, data);
+    y.resize(static_cast<std::size_t>(model.nsegments()));
+    for (int i = 0; i < model.nsegments(); ++i) y[i] << data.force[i], data.moment[i];
+  };
+  const Eigen::VectorXd q0 = estimator.q(), qd0 = estimator.qd(), qdd0 = estimator.qdd();
+  const int n = model.nsegments();
+  std::vector<Matrix6> reference(static_cast<std::size_t>(n), Matrix6::Zero());
+  std::vector<Vector6> y0, yp, ym;
+  loads(q0, qd0, qdd0, y0);
+  // Central differences: truncation h^2 / 6 times the third derivative (1e-10 for angles
+  // of order 1), rounding eps |y| / h (1e-11 |y|): far below the 1e-8 allowed below.
+  const double h = 1e-5;
+  for (int j = 0; j < model.nq; ++j) {
+    std::vector<Eigen::Matrix<double, 6, 3>> J(static_cast<std::size_t>(n),
+                                               Eigen::Matrix<double, 6, 3>::Zero());
+    Eigen::VectorXd a = qdd0;
+    a[j] += 1.0;
+    loads(q0, qd0, a, yp);
+    for (int i = 0; i < n; ++i) J[i].col(2) = yp[i] - y0[i];
+    if (linearize_state) {
+      Eigen::VectorXd b = q0, c = q0;
+      b[j] += h;
+      c[j] -= h;
+      loads(b, qd0, qdd0, yp);
+      loads(c, qd0, qdd0, ym);
+      for (int i = 0; i < n; ++i) J[i].col(0) = (yp[i] - ym[i]) / (2.0 * h);
+      b = qd0;
+      c = qd0;
+      b[j] += h;
+      c[j] -= h;
+      loads(q0, b, qdd0, yp);
+      loads(q0, c, qdd0, ym);
+      for (int i = 0; i < n; ++i) J[i].col(1) = (yp[i] - ym[i]) / (2.0 * h);
+      for (int i = 0; i < n; ++i) reference[i] += J[i] * Sigma * J[i].transpose();
+    } else {
+      for (int i = 0; i < n; ++i)
+        reference[i] += Sigma(2, 2) * J[i].col(2) * J[i].col(2).transpose();
+    }
+  }
+  // q-ddot only: both exact, the same sums in another order (1e-12). With q and q-dot:
+  // the reference's central differences (1e-8). Each entry relative to the standard
+  // deviations of its row and column.
+  const double tolerance = linearize_state ? 1e-8 : 1e-12;
+  double worst = 0.0;
+  for (int i : model.moving_segments) {
+    const Matrix6& P = estimator.covariance(i);
+    const Matrix6& R = reference[i];
+    for (int a = 0; a < 6; ++a)
+      for (int b = 0; b < 6; ++b) {
+        const double scale = std::sqrt(R(a, a) * R(b, b)) + 1e-300;
+        worst = std::max(worst, std::abs(P(a, b) - R(a, b)) / scale);
+        EXPECT_NEAR(P(a, b), R(a, b), tolerance * scale)
+            << scene.urdf << " " << model.joint_name[i] << " (" << a << "," << b << ")";
+      }
+  }
+  std::printf("%s, linearize_state %d: worst relative difference to the reference %.1e\n",
+              scene.urdf.c_str(), linearize_state ? 1 : 0, worst);
+}
+
+TEST(CovarianceReference, PandaWithMimicFingers) {
+  expectMatchesReference({"panda.urdf", "panda_hand"}, true);
+  expectMatchesReference({"panda.urdf", "panda_hand"}, false);
+}
+
+TEST(CovarianceReference, Talos) {
+  expectMatchesReference({"talos_reduced.urdf", "left_sole_link"}, true);
+  expectMatchesReference({"talos_reduced.urdf", "left_sole_link"}, false);
+}
+
+// uncertainty.decimation: the covariance is computed for every n-th published sample and
+// held in between. The held values must be exactly those of the sample they were
+// computed at; the error of holding (how much each effort sigma moves over n samples)
+// is measured and printed for docs/uncertainty.md.
+TEST(CovarianceDecimation, HoldsAndMeasuresTheError) {
+  for (const std::string urdf : {"panda.urdf", "talos_reduced.urdf"}) {
+    const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/" + urdf);
+    const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31), {});
+    jle::EstimatorConfig config;
+    config.savings.reuse_unchanged = false;
+    config.uncertainty.enabled = true;
+    config.uncertainty.position_noise = 1e-4;
+    config.uncertainty.mass_fraction = 0.05;
+    config.uncertainty.com_offset = 0.005;
+    config.uncertainty.inertia_fraction = 0.1;
+    jle::Estimator every(model, config);
+    config.uncertainty.decimation = 10;
+    jle::Estimator held(model, config);
+    const int samples = 2000;  // 2 s at 1 kHz
+    std::vector<std::vector<double>> sigma;  // per published sample, per moving joint
+    Eigen::VectorXd q, qd, qdd;
+    int published = 0;
+    for (int k = 0; k < samples; ++k) {
+      const double t = k * 1e-3;
+      truth.coordinates(t, q, qd, qdd);
+      const jle::SampleStatus s = every.addJointSample(t, q.data());
+      ASSERT_EQ(held.addJointSample(t, q.data()), s);
+      if (s != jle::SampleStatus::kPublished) continue;
+      std::vector<double> row;
+      for (int i : model.moving_segments) row.push_back(std::sqrt(every.effortVariance(i)));
+      sigma.push_back(row);
+      // Held: exactly the value of the last computed sample (same code, same inputs).
+      const std::size_t computed = static_cast<std::size_t>(published - published % 10);
+      for (std::size_t j = 0; j < row.size(); ++j)
+        EXPECT_EQ(std::sqrt(held.effortVariance(model.moving_segments[j])), sigma[computed][j]);
+      ++published;
+    }
+    for (int n : {2, 5, 10, 20, 50}) {
+      double worst = 0.0, mean = 0.0;
+      long count = 0;
+      for (std::size_t a = 0; a < sigma.size(); a += static_cast<std::size_t>(n))
+        for (std::size_t b = a + 1; b < std::min(sigma.size(), a + n); ++b)
+          for (std::size_t j = 0; j < sigma[a].size(); ++j) {
+            if (sigma[a][j] <= 0.0) continue;
+            const double e = std::abs(sigma[b][j] / sigma[a][j] - 1.0);
+            worst = std::max(worst, e);
+            mean += e;
+            ++count;
+          }
+      std::printf("%s, decimation %2d: held sigma of the efforts off by at most %.4f (mean %.5f)\n",
+                  urdf.c_str(), n, worst, count ? mean / count : 0.0);
+    }
+  }
+}
+
 // Inertial parameters: the propagated covariance against the loads of 10 000 models
 // whose masses, centres of mass and inertias are drawn from the stated uncertainty,
 // at the state the estimator held (the core's own passes on each perturbed model).
