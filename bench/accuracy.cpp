@@ -36,12 +36,16 @@ compares the loads with the exact ones at the estimate's stamp (a sample stamp).
   --quick       a tiny input (0.3 s per scene, a few configurations): checks that the
                 study still runs, in a second
   --repeat N    timed runs per configuration of the main scene and of the savings
-                sweep on TALOS (the fastest counts; default 5; other scenes 1)
+                sweeps on TALOS and the planar chain (the fastest counts; default 5;
+                other scenes 1)
   --scene NAME  only this scene (repeatable; default: all)
   --data DIR    the test data directory (default: the package's test/data)
 
 Exit status: 0 success; 1 a failed self-check (exact inputs not reproduced to 1e-9
-relative in double precision) or an error; 2 a usage error.
+relative in double precision; savings.planar not taking the 3x3 path on every
+estimate of planar_savings, or taking it where it is off; loads with "planar off"
+differing from the default's by 1e-12 of the largest load) or an error; 2 a usage
+error.
 )";
 
 constexpr double kTwoPi = 6.283185307179586;
@@ -158,7 +162,11 @@ std::vector<SavingsVariant> savingsVariants() {
   s.reuse_unchanged = false;
   out.push_back({"reuse_unchanged off", s, false});
   s = jle::Savings{};
+  s.planar = jle::PlanarMode::kOff;
+  out.push_back({"planar off", s, false});
+  s = jle::Savings{};
   s.prune = s.massless_chains = s.gyroscopic = s.reuse_unchanged = false;
+  s.planar = jle::PlanarMode::kOff;
   out.push_back({"all off", s, false});
   s = jle::Savings{};
   s.static_velocity = kStaticVelocity;
@@ -182,7 +190,11 @@ struct SceneSpec {
   double duration = 10.0;
   jle::SensorModel sensor;
   std::vector<std::string> wrench_links;
-  bool planar_wrench = false;    // forces in x-z, moment about y only
+  bool planar_wrench = false;    // forces across plane_normal, moment along it only
+  int plane_normal = 1;          // with planar_wrench: the plane's normal axis in the link frame
+  bool planar_sensor = false;    // the F/T reports only the in-plane components (3-axis)
+  Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.80665);  // [m/s^2], world
+  bool expect_planar = false;    // self-check: default savings take the planar path throughout
   bool constant_wrench = false;  // no sinusoidal part
   std::uint64_t seed = 1;
   bool both_precisions = false;  // float as well as double
@@ -231,6 +243,27 @@ jle::SensorModel realisticSensor() {
   s.wrench_offset = 2.5e-4;            // F/T clock out of phase with the joints
   s.force_noise = 0.1;                 // [N]
   s.moment_noise = 5e-3;               // [N m]
+  return s;
+}
+
+// The 12-link planar chain (joints about z, links stacked along z) with gravity along -y,
+// in its plane, and an in-plane tip load read by a 3-axis F/T: savings.planar applies
+// to every sample. Savings and precision swept, timed.
+SceneSpec planarSavings(const std::string& data, SceneSpec s) {
+  s.name = "planar_savings";
+  s.description = "12-link planar chain, gravity in the plane (-y), stop-and-go, in-plane tip "
+                  "load read by a 3-axis F/T (fx, fy, mz), sensors otherwise as panda; "
+                  "savings and precision swept, timed";
+  s.urdf = readFile(data + "/urdf/planar_chain.urdf");
+  s.motion = jle::MotionKind::kStopAndGo;
+  s.wrench_links = {"tool"};
+  s.planar_wrench = s.planar_sensor = s.expect_planar = true;
+  s.plane_normal = 2;
+  s.gravity = Eigen::Vector3d(0.0, -9.80665, 0.0);
+  s.seed = 8;
+  s.both_precisions = s.savings_sweep = s.timed = true;
+  s.only = {"FD3 causal", "SG w9 o2 causal", "SG w25 o3 centred", "KF-CA q=1e+00",
+            "KF-CJ q=1e+04 r=1e-04"};
   return s;
 }
 
@@ -350,6 +383,9 @@ std::vector<SceneSpec> sceneSpecs(const std::string& data, bool quick) {
     s.planar_wrench = true;
     s.seed = 7;
     specs.push_back(s);
+    // Where savings.planar applies (the scene above does not: its 6-axis F/T reports
+    // noise out of the plane, which sends every sample to the 6x6 path).
+    specs.push_back(planarSavings(data, s));
   } else {
     SceneSpec s = main;
     s.both_precisions = s.savings_sweep = s.timed = false;
@@ -363,6 +399,10 @@ std::vector<SceneSpec> sceneSpecs(const std::string& data, bool quick) {
     s.description = "random tree (quick)";
     s.urdf = jle::randomTreeUrdf(7, 12);
     s.wrench_links = {"link12"};
+    specs.push_back(s);
+    s = planarSavings(data, s);
+    s.description = "planar chain, savings swept (quick)";
+    s.both_precisions = false;
     specs.push_back(s);
   }
   if (quick)
@@ -381,11 +421,22 @@ Scene buildScene(const SceneSpec& spec) {
     jle::WrenchMotion w = jle::randomWrench(spec.wrench_links[i], jle::deriveSeed(spec.seed, 300 + i));
     if (spec.constant_wrench) w.amplitude.setZero();
     if (spec.planar_wrench)
-      for (int c : {1, 3, 5}) w.mean[c] = w.amplitude[c] = 0.0;  // fy, mx, mz
+      for (int c = 0; c < 6; ++c)
+        if ((c < 3) == (c % 3 == spec.plane_normal)) w.mean[c] = w.amplitude[c] = 0.0;
     wrenches.push_back(w);
   }
-  scene.truth = std::make_unique<jle::GroundTruth>(model, motion, wrenches);
+  scene.truth = std::make_unique<jle::GroundTruth>(model, motion, wrenches, spec.gravity);
   scene.readings = scene.truth->sample(spec.sensor, spec.duration, jle::deriveSeed(spec.seed, 200));
+  if (spec.planar_sensor)
+    for (jle::WrenchReading& r : scene.readings.wrenches) {
+      // A sensor of the in-plane force and the moment about the normal: its out-of-plane
+      // channels (noise and bias only, the load being planar) are not there.
+      const int n = spec.plane_normal;
+      r.force[n] = 0.0;
+      const double mn = r.moment[n];
+      r.moment.setZero();
+      r.moment[n] = mn;
+    }
   scene.settle = std::min(0.5, 0.1 * spec.duration);
 
   const jle::Model<double>& m = scene.truth->model();
@@ -436,6 +487,8 @@ struct Outputs {
   Eigen::MatrixXd qdd;         // nq x published
   double wall_us = 0.0;        // per joint sample, steady_clock over the whole run
   double cpu_us = 0.0;         // per joint sample, this thread's CPU time
+  bool planar = false;         // Estimator::planar(): the 3x3 path in use
+  long planar_published = 0;   // estimates computed by the 3x3 path (lastWasPlanar())
 };
 
 double threadCpuSeconds() {
@@ -477,12 +530,14 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config, const st
       out.loads.insert(out.loads.end(), d.moment[i].data(), d.moment[i].data() + 3);
     }
     out.qdd.col(published++) = estimator.qdd();
+    if (estimator.lastWasPlanar()) ++out.planar_published;
   }
   const auto stop = std::chrono::steady_clock::now();
   const double cpu_stop = threadCpuSeconds();
   out.wall_us = std::chrono::duration<double, std::micro>(stop - start).count() / static_cast<double>(n);
   out.cpu_us = 1e6 * (cpu_stop - cpu_start) / static_cast<double>(n);
   out.qdd.conservativeResize(Eigen::NoChange, published);
+  out.planar = estimator.planar();
   return out;
 }
 
@@ -500,6 +555,7 @@ struct RunResult {
   double cpu_us = std::numeric_limits<double>::infinity();
   double stamp_lag_ms = 0;             // mean of (newest sample stamp - estimate stamp)
   double phase_lag_ms = std::nan("");  // lag maximising the cross-correlation of qdd
+  double planar_share = 0.0;           // of the estimates, computed by the 3x3 path
 };
 
 // Lag [s] of the estimated qdd behind the true qdd at the same stamps: the lag that
@@ -673,7 +729,7 @@ void writeRows(std::FILE* csv, const SceneSpec& spec, const Differentiator& diff
   for (const Score& s : result.joints) {
     std::fprintf(csv,
                  "%s,%s,%s,%d,%d,%d,%.3g,%.3g,%s,%s,%s,%ld,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
-                 "%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%g,%d,\"%s\"\n",
+                 "%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%g,%d,%.4g,\"%s\"\n",
                  spec.name.c_str(), diff.label.c_str(), diff.family.c_str(), window, order,
                  kalman ? 0 : c.delay, kalman ? c.process_noise : 0.0,
                  kalman ? measurement_noise : 0.0, precision, savings.c_str(),
@@ -681,7 +737,7 @@ void writeRows(std::FILE* csv, const SceneSpec& spec, const Differentiator& diff
                  s.rms_moment, s.max_moment, relative(s.rms_effort, s.rms_true_effort),
                  relative(s.rms_force, s.rms_true_force), relative(s.rms_moment, s.rms_true_moment),
                  result.stamp_lag_ms, result.phase_lag_ms, delay_ms, result.wall_us, result.cpu_us,
-                 spec.sensor.rate, isShippedDefault(diff) ? 1 : 0,
+                 spec.sensor.rate, isShippedDefault(diff) ? 1 : 0, result.planar_share,
                  described ? "" : spec.description.c_str());
     described = true;
   }
@@ -735,8 +791,10 @@ int main(int argc, char** argv) {
                  "savings,joint,samples,rms_effort,max_effort,rms_force,max_force,rms_moment,"
                  "max_moment,rel_rms_effort,rel_rms_force,rel_rms_moment,stamp_lag_ms,"
                  "phase_lag_ms,delay_ms,time_per_sample_us,cpu_per_sample_us,rate_hz,"
-                 "shipped_default,scene_description\n");
+                 "shipped_default,planar_share,scene_description\n");
     bool exact_ok = true;
+    bool planar_ok = true;      // the planar self-checks (expect_planar, "planar off")
+    double worst_planar = 0.0;  // largest relative difference of "planar off" from default
     double worst_exact = 0.0;
     int exact_runs = 0;
     const std::vector<Differentiator> diffs = differentiators(quick);
@@ -798,6 +856,7 @@ int main(int argc, char** argv) {
             labels.push_back(variant.label);
           }
         std::vector<RunResult> results(configs.size());
+        std::vector<double> default_loads;  // double, default savings: for "planar off"
         for (int rep = 0; rep < repeats; ++rep)
           for (std::size_t v = 0; v < configs.size(); ++v) {
             const Outputs out = runOnce(scene, configs[v], segments[v]);
@@ -808,6 +867,38 @@ int main(int argc, char** argv) {
               results[v] = score(scene, out, segments[v], v == 0);
               if (v == 0) phase_lag_ms = results[v].phase_lag_ms;
               results[v].phase_lag_ms = phase_lag_ms;
+              results[v].planar_share =
+                  out.stamps.empty() ? 0.0
+                                     : static_cast<double>(out.planar_published) /
+                                           static_cast<double>(out.stamps.size());
+              if (v == 0) default_loads = out.loads;
+              const bool is_double = configs[v].precision == jle::Precision::kDouble;
+              const bool planar_wanted =
+                  is_double && configs[v].savings.planar != jle::PlanarMode::kOff;
+              if (spec.expect_planar &&
+                  (out.planar != planar_wanted ||
+                   out.planar_published != (planar_wanted ? static_cast<long>(out.stamps.size()) : 0L))) {
+                planar_ok = false;
+                std::fprintf(stderr, "accuracy: %s, %s, %s: the 3x3 path %s, %ld of %zu estimates\n",
+                             spec.name.c_str(), diff.label.c_str(), labels[v].c_str(),
+                             out.planar ? "in use" : "not in use", out.planar_published,
+                             out.stamps.size());
+              }
+              if (is_double && labels[v] == "planar off") {
+                // savings.planar is exact: the loads with and without it agree to rounding.
+                double diff_max = 0.0, scale = 0.0;
+                for (std::size_t i = 0; i < out.loads.size() && i < default_loads.size(); ++i) {
+                  diff_max = std::max(diff_max, std::abs(out.loads[i] - default_loads[i]));
+                  scale = std::max(scale, std::abs(default_loads[i]));
+                }
+                const double rel = scale > 0.0 ? diff_max / scale : diff_max;
+                worst_planar = std::max(worst_planar, rel);
+                if (out.loads.size() != default_loads.size() || !(rel < 1e-12)) {
+                  planar_ok = false;
+                  std::fprintf(stderr, "accuracy: %s, %s: planar off differs by %.3g relative\n",
+                               spec.name.c_str(), diff.label.c_str(), rel);
+                }
+              }
             }
             results[v].wall_us = std::min(results[v].wall_us, out.wall_us);
             results[v].cpu_us = std::min(results[v].cpu_us, out.cpu_us);
@@ -842,9 +933,13 @@ int main(int argc, char** argv) {
                    "accuracy: exact inputs reproduced to %.3g relative RMS (double, finite "
                    "differences and Savitzky-Golay)\n",
                    worst_exact);
+    std::fprintf(stderr,
+                 "accuracy: savings.planar off vs on: loads differ by at most %.3g of the "
+                 "largest load (double)\n",
+                 worst_planar);
     std::fprintf(stderr, "accuracy: study %.1f s\n",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - study_start).count());
-    return exact_ok ? 0 : 1;
+    return exact_ok && planar_ok ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "accuracy: %s\n", e.what());
     return 1;

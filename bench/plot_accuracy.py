@@ -40,7 +40,7 @@ NUMERIC = [
     "window", "order", "delay_samples", "process_noise", "measurement_noise", "samples", "rms_effort", "max_effort",
     "rms_force", "max_force", "rms_moment", "max_moment", "rel_rms_effort", "rel_rms_force",
     "rel_rms_moment", "stamp_lag_ms", "phase_lag_ms", "delay_ms", "time_per_sample_us",
-    "cpu_per_sample_us", "rate_hz", "shipped_default",
+    "cpu_per_sample_us", "rate_hz", "shipped_default", "planar_share",
 ]
 
 
@@ -286,7 +286,7 @@ def main():
       "the middle of its window. n/a where the true qdd is constant.\n"
       "- **time**: wall clock (`std::chrono::steady_clock`) over the whole run divided by the "
       "number of joint samples, including the F/T samples' `addWrench` and the copy of the "
-      "outputs; in the main scene and the TALOS savings sweep the fastest of 5 runs (the "
+      "outputs; in the main scene and the savings sweeps the fastest of 5 runs (the "
       "precisions and savings of one differentiator take turns, so that a slow spell of a "
       "shared machine hits them alike), elsewhere of one run. The CSV also has the thread's "
       "CPU time.\n"
@@ -363,10 +363,11 @@ def main():
         w("\n")
 
     w("## Savings and precision\n\n")
-    w("Each switch of `EstimatorConfig::savings` off on its own, all four exact ones off, the "
+    w("Each switch of `EstimatorConfig::savings` off on its own, all five exact ones off, the "
       "static thresholds on (0.02 rad/s, 0.5 rad/s^2), and pruning measured where it acts: "
       "loads wanted for the last three joints only (errors then over those three). Time "
-      "relative to the default savings of the same differentiator and precision.\n\n")
+      "relative to the default savings of the same differentiator and precision. *3x3*: share "
+      "of the estimates computed by the planar path (`savings.planar`; float keeps 6x6).\n\n")
     for s in scenes:
         sweep = [r for r in rows if r["scene"] == s and r["joint"] == "ALL" and r["savings"] != "default"]
         if not sweep:
@@ -386,9 +387,10 @@ def main():
                     rel = (f"{100 * (r['time_per_sample_us'] / base['time_per_sample_us'] - 1):+.1f} %"
                            if base else "")
                     body.append([c, precision, r["savings"], fmt(r["rms_effort"], 4),
-                                 fmt(r["rms_force"], 4), us(r["time_per_sample_us"]), rel])
+                                 fmt(r["rms_force"], 4), us(r["time_per_sample_us"]), rel,
+                                 f"{100 * r['planar_share']:.0f} %"])
         w(table(["configuration", "precision", "savings", "RMS effort", "RMS force",
-                 "time [us]", "time vs default"], body))
+                 "time [us]", "time vs default", "3x3"], body))
         w("\n")
 
     w("## Exact inputs\n\n")
