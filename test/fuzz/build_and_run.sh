@@ -27,7 +27,7 @@ common=(-std=c++17 -O1 -g $san -I"$repo/include" -I/usr/include/eigen3
 declare -A needs=(
   [fuzz_urdf]="src/core/urdf_reader.cpp"
   [fuzz_csv]="src/core/urdf_reader.cpp src/core/csv.cpp"
-  [fuzz_messages]="src/core/urdf_reader.cpp src/core/estimator.cpp src/ros/message_inputs.cpp"
+  [fuzz_messages]="src/core/urdf_reader.cpp src/core/estimator.cpp src/core/covariance.cpp src/ros/message_inputs.cpp"
 )
 object() {  # source -> object path, rebuilt when the source or a header is newer
   local src=$1 obj="$work/obj/$(echo "$1" | tr / _).o"
