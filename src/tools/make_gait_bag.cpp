@@ -63,9 +63,15 @@ samples of an instant before its joint state).
 
 The trial (gait time g = t + 0.33 s, stride T = 1.1 s, w = 2 pi / T; the right heel
 strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
-  pelvis  x = 1.2 g - 0.016 sin(2w (g - 0.3T)), y = -0.03 cos(w (g - 0.3T)),
+  pelvis  x = 1.2 g - 0.016 sin(2w (g - 0.3T)) + dx(g), y = -0.03 cos(w (g - 0.3T)) + dy(g),
           z = z0 + 0.02 cos(2w (g - 0.3T)), yaw = 0.07 cos(w g), roll = -0.05 sin(w g)
-          (z0 = the standing height of the pelvis minus 0.05 m)
+          (z0 = the standing height of the pelvis minus 0.06 m); dx, dy: Fourier series
+          of period T, 20 harmonics, solved (12 relaxed fixed-point steps, each harmonic
+          scaled by the inverted pendulum's 1 / (1 + (z_com / g) (k w)^2)) so that the
+          centre of pressure of the model's inverse dynamics follows the plan:
+  centre of pressure  single support: along the stance footprint from the heel (10 %)
+          to the toe (45 %) by a quintic smooth step, then at the toe; double support:
+          from the trailing toe to the leading heel by the split's smooth step
   feet    heel rocker (0 - 10 %: the foot turns down about the heel from 15 deg toe
           up), foot flat (10 - 35 %), toe rocker (35 - 60 %: the heel rises, the foot
           turns about the toe to 50 deg), swing (heel position and foot pitch from
@@ -100,7 +106,7 @@ strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
   --help         this text
 
 Prints the trial's figures (duration, mass, peak vertical ground reaction, centre of
-pressure along the foot, inverse-kinematics error, toe clearance, joint ranges).
+pressure along the footprint and its miss of the plan, inverse-kinematics error, toe clearance, joint ranges).
 Exit status: 0 success; 1 a data error (unreadable URDF, a body the trial does not fit,
 unwritable bag); 2 a usage error.
 )";
@@ -120,7 +126,7 @@ constexpr double kHeelStrikePitch = 15.0 * kPi / 180.0;  // toe up at heel strik
 constexpr double kToeOffPitch = -50.0 * kPi / 180.0;     // heel up at toe off
 constexpr double kToeOut = 5.0 * kPi / 180.0;
 constexpr double kClearance = 0.05;      // [m] heel lift in mid-swing
-constexpr double kPelvisDrop = 0.05;     // [m] mean pelvis height below standing
+constexpr double kPelvisDrop = 0.06;     // [m] mean pelvis height below standing
 constexpr double kHeelAhead = 0.20;      // [m] heel ahead of the hip at heel strike
 constexpr double kSwayX = 0.016;
 constexpr double kSwayY = 0.03;          // [m] lateral sway (amplitude of y)
@@ -129,6 +135,10 @@ constexpr double kJointRate = 200.0;     // [Hz]
 constexpr int kPlateDivisor = 5;         // plate samples per joint sample (1 kHz)
 constexpr int kDisplayDivisor = 10;      // plate samples per display sample (100 Hz)
 constexpr double kLaneWidth = 0.4;       // [m] each plate's width (y)
+constexpr int kHarmonics = 20;           // of the pelvis path's correction (18 Hz)
+constexpr double kCopArrival = 0.45;     // the centre of pressure reaches the toe (of T)
+constexpr int kPelvisIterations = 12;    // of solvePelvis
+constexpr double kRelaxation = 0.7;      // of its steps
 
 struct Options {
   std::string urdf, output;
@@ -185,18 +195,45 @@ double smoothStep(double s) {
 }
 
 // Pelvis pose, twist and acceleration at gait time g (kUsage), world frame.
+// The horizontal correction of the pelvis path (x, y), solved by solvePelvis so that the
+// centre of pressure follows the planned one: a Fourier series of period T in gait time,
+// d(g) = sum_k a_k cos(k w g) + b_k sin(k w g), k = 0 .. kHarmonics.
+struct Correction {
+  std::array<Eigen::Matrix<double, 2, 1>, kHarmonics + 1> a{}, b{};
+  Correction() {
+    for (int k = 0; k <= kHarmonics; ++k) a[k].setZero(), b[k].setZero();
+  }
+  // Value, first and second derivative at gait time g.
+  void at(double g, Eigen::Vector2d& d, Eigen::Vector2d& d1, Eigen::Vector2d& d2) const {
+    const double w = 2.0 * kPi / kStride;
+    d = a[0];
+    d1.setZero();
+    d2.setZero();
+    for (int k = 1; k <= kHarmonics; ++k) {
+      const double wk = k * w, c = std::cos(wk * g), s = std::sin(wk * g);
+      d += a[k] * c + b[k] * s;
+      d1 += wk * (b[k] * c - a[k] * s);
+      d2 -= wk * wk * (a[k] * c + b[k] * s);
+    }
+  }
+};
+
 struct Pelvis {
   double z0 = 0.0;
   double x_offset = 0.0;
+  Correction correction;
   jle::BaseState<double> at(double g) const {
     const double w = 2.0 * kPi / kStride, w2 = 2.0 * w;
     const double c = g - kStartPhase * kStride;
+    Eigen::Vector2d d, d1, d2;
+    correction.at(g, d, d1, d2);
     jle::BaseState<double> b;
-    b.p_world_base = Vector3d(x_offset + kSpeed * g - kSwayX * std::sin(w2 * c),
-                              -kSwayY * std::cos(w * c), z0 + 0.02 * std::cos(w2 * c));
-    b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c), kSwayY * w * std::sin(w * c),
-                         -0.02 * w2 * std::sin(w2 * c));
-    b.a_world = Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c), kSwayY * w * w * std::cos(w * c),
+    b.p_world_base = Vector3d(x_offset + kSpeed * g - kSwayX * std::sin(w2 * c) + d.x(),
+                              -kSwayY * std::cos(w * c) + d.y(), z0 + 0.02 * std::cos(w2 * c));
+    b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c) + d1.x(),
+                         kSwayY * w * std::sin(w * c) + d1.y(), -0.02 * w2 * std::sin(w2 * c));
+    b.a_world = Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c) + d2.x(),
+                         kSwayY * w * w * std::cos(w * c) + d2.y(),
                          -0.02 * w2 * w2 * std::cos(w2 * c));
     const double yaw = 0.07 * std::cos(w * g), yaw_d = -0.07 * w * std::sin(w * g),
                  yaw_dd = -0.07 * w * w * std::cos(w * g);
@@ -228,6 +265,7 @@ struct Leg {
 // time since its last heel strike [s].
 struct FootState {
   Vector3d heel, toe;
+  Vector3d print_heel, print_toe;  // in stance: the footprint's heel and toe (z = 0)
   bool stance = false;
   double since_strike = 0.0;
 };
@@ -260,6 +298,8 @@ struct Gait {
     const double l = leg.foot_length;
     FootState f;
     f.since_strike = tau;
+    f.print_heel = H;
+    f.print_toe = H + l * direction(leg, 0.0);
     const double t1 = kHeelRocker * T, t2 = kHeelOff * T, t3 = kToeOff * T;
     if (tau < t1) {  // heel rocker: pitch = p_hs (1 - S(s)) about the heel
       f.heel = H;
@@ -389,6 +429,98 @@ struct Share {
   double free_moment = 0.0;
 };
 
+// The planned centre of pressure (ground, x y) for the feet at one instant: in single
+// support along the stance footprint from the heel (at the end of the heel rocker) to
+// the toe (at kCopArrival of the cycle, before the heel rises fully), by a quintic smooth
+// step, then at the toe; in double support from the trailing toe to the leading heel by
+// the smooth step of the force's split, so that each foot's share sits at its nominal
+// point.
+Eigen::Vector2d plannedCop(const std::array<FootState, 2>& feet) {
+  Vector3d p;
+  if (feet[0].stance && feet[1].stance) {
+    const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
+    const double w_lead =
+        smoothStep(feet[static_cast<std::size_t>(lead)].since_strike / ((kToeOff - 0.5) * kStride));
+    p = (1.0 - w_lead) * feet[static_cast<std::size_t>(1 - lead)].print_toe +
+        w_lead * feet[static_cast<std::size_t>(lead)].print_heel;
+  } else {
+    const FootState& f = feet[0].stance ? feet[0] : feet[1];
+    const double u = smoothStep((f.since_strike - kHeelRocker * kStride) /
+                                ((kCopArrival - kHeelRocker) * kStride));
+    p = f.print_heel + u * (f.print_toe - f.print_heel);
+  }
+  return p.head<2>();
+}
+
+// Solves the pelvis path's horizontal correction so that the whole-body centre of
+// pressure (from the model's floating-base inverse dynamics, as the plates get it)
+// follows plannedCop over a stride. The trial repeats every stride (translated), so the
+// problem is periodic: on the stride's 1 kHz grid the error e = planned - actual is
+// expanded in the correction's harmonics and each is corrected by the linear inverted
+// pendulum's response, a shift d of the pelvis moving the centre of pressure by
+// d - (z_com / g) d'' (harmonic k: (1 + (z_com / g) (k w)^2) d_k). Returns the largest
+// error [m] of the last evaluation.
+double solvePelvis(const jle::Model<double>& model, jle::Data<double>& data,
+                   const std::array<Leg, 2>& legs, const Gait& gait, Pelvis& pelvis,
+                   const jle::VectorX<double>& q_start, int iterations) {
+  const double T = kStride, h = 1.0 / (kJointRate * kPlateDivisor), w = 2.0 * kPi / T;
+  const int n = static_cast<int>(std::lround(T / h));
+  const double g0 = kStartPhase * T;
+  const Vector3d gravity(0.0, 0.0, -kGravity);
+  const double mass = model.totalMass();
+  std::vector<jle::VectorX<double>> grid(static_cast<std::size_t>(n + 4), q_start);
+  std::vector<Eigen::Vector2d> error(static_cast<std::size_t>(n));
+  jle::VectorX<double> qd(model.nq), qdd(model.nq);
+  double largest = 0.0;
+  for (int iteration = 0;; ++iteration) {
+    for (int k = -2; k < n + 2; ++k) {  // warm start: from the last solution (first: the
+      const double g = g0 + k * h;       // previous sample's)
+      jle::VectorX<double>& qk = grid[static_cast<std::size_t>(k + 2)];
+      if (iteration == 0 && k > -2) qk = grid[static_cast<std::size_t>(k + 1)];
+      for (const Leg& leg : legs) {
+        const FootState foot = gait.at(leg, g);
+        solveLeg(model, data, leg, pelvis.at(g), foot.heel, foot.toe, qk);
+      }
+    }
+    largest = 0.0;
+    double z_com = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const std::size_t c = static_cast<std::size_t>(k + 2);
+      for (int j = 0; j < model.nq; ++j) {
+        const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j],
+                     p2 = grid[c + 2][j], z = grid[c][j];
+        qd[j] = (m2 - 8.0 * m1 + 8.0 * p1 - p2) / (12.0 * h);
+        qdd[j] = (-m2 + 16.0 * m1 - 30.0 * z + 16.0 * p1 - p2) / (12.0 * h * h);
+      }
+      const double g = g0 + k * h;
+      const jle::BaseState<double> base = pelvis.at(g);
+      jle::forwardKinematics(model, data, grid[c], qd, qdd, gravity, base);
+      jle::inverseDynamics(model, data);
+      const Vector3d F = base.R_world_base * data.force[0];
+      const Vector3d M = base.R_world_base * data.moment[0] + base.p_world_base.cross(F);
+      const Eigen::Vector2d cop(-M.y() / F.z(), M.x() / F.z());
+      const std::array<FootState, 2> feet = {gait.at(legs[0], g), gait.at(legs[1], g)};
+      error[static_cast<std::size_t>(k)] = plannedCop(feet) - cop;
+      largest = std::max(largest, error[static_cast<std::size_t>(k)].norm());
+      for (std::size_t i = 0; i < model.com.size(); ++i)
+        z_com += model.mass[i] * jle::comWorld(model, data, static_cast<int>(i)).z() / (mass * n);
+    }
+    if (iteration == iterations) break;
+    for (int m = 0; m <= kHarmonics; ++m) {
+      Eigen::Vector2d A = Eigen::Vector2d::Zero(), B = Eigen::Vector2d::Zero();
+      for (int k = 0; k < n; ++k) {
+        const double g = g0 + k * h;
+        A += error[static_cast<std::size_t>(k)] * std::cos(m * w * g);
+        B += error[static_cast<std::size_t>(k)] * std::sin(m * w * g);
+      }
+      const double response = 1.0 + z_com / kGravity * (m * w) * (m * w);
+      pelvis.correction.a[m] += kRelaxation * (m == 0 ? 1.0 : 2.0) / n * A / response;
+      pelvis.correction.b[m] += kRelaxation * (m == 0 ? 0.0 : 2.0) / n * B / response;
+    }
+  }
+  return largest;
+}
+
 void run(const Options& options) {
   jle::ModelOptions model_options;
   model_options.floating_base = true;
@@ -439,6 +571,10 @@ void run(const Options& options) {
   pelvis.z0 = -sole - kPelvisDrop;
   gait.x_offset = pelvis.x_offset = 0.0;
 
+  // Knees slightly bent: the inverse kinematics stays on the bent-knee branch.
+  for (const Leg& leg : legs) q[leg.coordinate[3]] = 0.3;
+  const double cop_error = solvePelvis(model, data, legs, gait, pelvis, q, kPelvisIterations);
+
   // The 1 kHz grid, with two points either side for the 5-point differences.
   const double h = 1.0 / (kJointRate * kPlateDivisor);
   const long long n_plate = std::llround(options.strides * kStride / h);
@@ -446,8 +582,6 @@ void run(const Options& options) {
   std::vector<jle::VectorX<double>> grid;
   grid.reserve(static_cast<std::size_t>(n_plate + 4));
   double ik_error = 0.0;
-  // Knees slightly bent: the inverse kinematics stays on the bent-knee branch.
-  for (const Leg& leg : legs) q[leg.coordinate[3]] = 0.3;
   double min_toe = 1e9;
   for (long long k = -2; k < n_plate + 2; ++k) {
     const double g = g0 + static_cast<double>(k) * h;
@@ -507,7 +641,7 @@ void run(const Options& options) {
 
   // Figures for the report.
   double peak_fz = 0.0, peak_fz_foot = 0.0, max_residual_split = 0.0;
-  double cop_min = 1e9, cop_max = -1e9, cop_side = 0.0;
+  double cop_min = 1e9, cop_max = -1e9, cop_side = 0.0, cop_shift = 0.0;
   std::vector<double> q_min(static_cast<std::size_t>(model.nq), 1e9),
       q_max(static_cast<std::size_t>(model.nq), -1e9);
 
@@ -577,6 +711,7 @@ void run(const Options& options) {
         const Vector3d a(feet[trail].toe.x(), feet[trail].toe.y(), 0.0);
         const Vector3d b(feet[lead].heel.x(), feet[lead].heel.y(), 0.0);
         const Vector3d e = cop - ((1.0 - w_lead) * a + w_lead * b);
+        cop_shift = std::max(cop_shift, e.norm());
         share[static_cast<std::size_t>(trail)] = {true, (1.0 - w_lead) * F, a + e,
                                                   (1.0 - w_lead) * free_moment};
         share[static_cast<std::size_t>(lead)] = {true, w_lead * F, b + e, w_lead * free_moment};
@@ -585,14 +720,15 @@ void run(const Options& options) {
         if (!feet[static_cast<std::size_t>(stance)].stance)
           throw std::runtime_error("internal: no foot on the ground");
         share[static_cast<std::size_t>(stance)] = {true, F, cop, free_moment};
-        // Where the centre of pressure lies along the foot, heel 0 .. toe 1.
+        // Where the centre of pressure lies on the footprint, heel 0 .. toe 1, and
+        // beside the heel-toe line.
         const FootState& f = feet[static_cast<std::size_t>(stance)];
-        const Vector3d along = f.toe - f.heel;
-        const double u = (cop - f.heel).dot(along) / along.squaredNorm();
+        const Vector3d along = f.print_toe - f.print_heel;
+        const double u = (cop - f.print_heel).dot(along) / along.squaredNorm();
         cop_min = std::min(cop_min, u);
         cop_max = std::max(cop_max, u);
         const Vector3d lateral = Vector3d::UnitZ().cross(along).normalized();
-        cop_side = std::max(cop_side, std::abs((cop - f.heel).dot(lateral)));
+        cop_side = std::max(cop_side, std::abs((cop - f.print_heel).dot(lateral)));
       }
       // Check of the split: the two shares make the whole wrench.
       Vector3d F_sum = Vector3d::Zero(), M_sum = Vector3d::Zero();
@@ -689,6 +825,10 @@ void run(const Options& options) {
   std::printf("  single support: centre of pressure from %.2f to %.2f of heel->toe, up to "
               "%.3f m beside that line\n",
               cop_min, cop_max, cop_side);
+  std::printf("  double support: each foot's centre of pressure within %.3f m of its heel "
+              "(leading) or toe (trailing)\n",
+              cop_shift);
+  std::printf("  centre of pressure: planned path missed by %.3f m at most\n", cop_error);
   std::printf("  inverse kinematics error %.1e m, split error %.1e, lowest toe in mid-swing "
               "%.3f m\n",
               ik_error, max_residual_split, min_toe);

@@ -128,9 +128,11 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   //   quadratic coefficient of t^4 over k = -5..5 is 25 h^2), i.e. 5.2e-5 s^2 x''''; the
   //   swing foot's smooth step (1.32 m in 0.44 s) has |x''''| <= 1.3e4 m/s^4 (0.7 m/s^2
   //   on its 4.6 kg of shank and foot: 3 N), the heel rocker (15 deg in 110 ms) 6.4e5
-  //   rad/s^4 (3.3 m/s^2 on the 1.1 kg foot: 4 N), the pelvis (50.9 kg, 0.02 m at 1.8
-  //   Hz) 1.3 N; each plate signal, a sum of those accelerations, is filtered alike and
-  //   contributes errors of the same size. Together about 20 N;
+  //   rad/s^4 (3.3 m/s^2 on the 1.1 kg foot: 4 N), the pelvis (50.9 kg; its horizontal
+  //   path is solved for the centre of pressure: |x''''| <= 3.6e3 m/s^4, measured on
+  //   the exact accelerations of make_gait_bag --csv) 0.19 m/s^2: 10 N; each plate
+  //   signal, a sum of those accelerations, is filtered alike and contributes errors of
+  //   the same size. Together about 20 N (3 + 4 + 10, not all at once);
   // so 40 N (5.4 % of body weight). The moment about the pelvis origin: the same forces
   // at the feet, up to 1 m below the pelvis: 40 N m.
   double max_force = 0.0, max_moment = 0.0;
