@@ -249,6 +249,7 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
     c.uncertainty.inertia_fraction = 0.1;
     c.uncertainty.linearize_state = variant.find("full") != std::string::npos;
     c.uncertainty.diagonal_only = variant.find("diag") != std::string::npos;
+    c.uncertainty.decimation = 1;
     const std::size_t dec = variant.find("_dec");
     if (dec != std::string::npos) c.uncertainty.decimation = std::stoi(variant.substr(dec + 4));
   } else if (variant == "planar_off") {
@@ -308,6 +309,8 @@ BENCHMARK_CAPTURE(scaling, tree, true)
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec8, file, "", false, "cov_full_dec8");  \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec12, file, "", false, "cov_full_dec12"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec16, file, "", false, "cov_full_dec16"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec17, file, "", false, "cov_full_dec17"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec18, file, "", false, "cov_full_dec18"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec20, file, "", false, "cov_full_dec20"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec24, file, "", false, "cov_full_dec24"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag_dec16, file, "", false, "cov_full_diag_dec16"); \

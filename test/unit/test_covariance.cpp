@@ -200,6 +200,7 @@ void runMonteCarlo(const Scene& scene, int replays) {
   {
     jle::EstimatorConfig c = config;
     c.uncertainty.enabled = true;
+    c.uncertainty.decimation = 1;  // the propagation itself, at every sample
     jle::Estimator estimator(model, c);
     replay(estimator, nullptr, [&](int n) {
       for (std::size_t j = 0; j < np; ++j) {
@@ -348,6 +349,7 @@ void expectMatchesReference(const ReferenceScene& scene, bool linearize_state) {
   w.name = w.link = scene.wrench_link;
   config.wrenches.push_back(w);
   config.uncertainty.enabled = true;
+  config.uncertainty.decimation = 1;  // the propagation itself, at every sample
   config.uncertainty.position_noise = 1e-3;
   config.uncertainty.linearize_state = linearize_state;
   jle::Estimator estimator(model, config);
@@ -492,8 +494,14 @@ DecimationError decimationError(const std::vector<std::vector<double>>& var,
   return e;
 }
 
-constexpr int kDefaultDecimation = 16;
-const double kExtrapolationBound16[2] = {0.0, 0.0};  // panda, talos: set from the table
+// The default (config/default.yaml) and the bound asserted on its worst sigma error,
+// per robot. Measured (docs/uncertainty.md): 0.0020 (Panda), 0.0268 (Talos). The
+// trajectory has no noise, so the measurement is deterministic to rounding; the bounds
+// (0.003, and the 3% the default was chosen by) leave room for other compilers only.
+// They fail if the extrapolation degrades: the line through two gives 0.014 and 0.20 at
+// n = 18, holding 0.072 and 0.22.
+constexpr int kDefaultDecimation = 18;
+constexpr double kExtrapolationBound[2] = {0.003, 0.03};  // panda, talos
 
 TEST(CovarianceDecimation, ExtrapolatesAndMeasuresTheError) {
   int robot = 0;
@@ -503,6 +511,7 @@ TEST(CovarianceDecimation, ExtrapolatesAndMeasuresTheError) {
     jle::EstimatorConfig config;
     config.savings.reuse_unchanged = false;
     config.uncertainty.enabled = true;
+    config.uncertainty.decimation = 1;
     config.uncertainty.position_noise = 1e-4;
     config.uncertainty.mass_fraction = 0.05;
     config.uncertainty.com_offset = 0.005;
@@ -600,7 +609,7 @@ TEST(CovarianceDecimation, ExtrapolatesAndMeasuresTheError) {
                   e[2].mean, e[2].clamped, e[0].where.c_str(), e[1].where.c_str(),
                   e[2].where.c_str());
       if (n == kDefaultDecimation) {
-        EXPECT_LE(e[2].worst, kExtrapolationBound16[robot]) << urdf;
+        EXPECT_LE(e[2].worst, kExtrapolationBound[robot]) << urdf;
         EXPECT_LT(e[2].worst, e[0].worst) << urdf;
       }
     }
@@ -621,6 +630,7 @@ TEST(CovarianceMonteCarlo, InertialParametersTalos) {
   w.name = w.link = "left_sole_link";
   config.wrenches.push_back(w);
   config.uncertainty.enabled = true;
+  config.uncertainty.decimation = 1;  // the propagation itself, at every sample
   config.uncertainty.mass_fraction = 0.1;
   config.uncertainty.com_offset = 0.01;
   config.uncertainty.inertia_fraction = 0.2;
