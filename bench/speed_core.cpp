@@ -240,7 +240,8 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
   } else if (variant.rfind("cov_", 0) == 0) {
     // Covariance of the loads (docs/uncertainty.md): cov_full = every source, the state
     // linearised; cov_qdd = its cheap path (q-ddot, wrench and inertial parts only);
-    // _diag = only the variances; _dec16 = computed every 16th sample, held in between.
+    // _diag = only the variances; _decN = computed every N-th sample, extrapolated in
+    // between (_dec1000: the cost of the extrapolation alone, nearly).
     c.uncertainty.enabled = true;
     c.uncertainty.position_noise = 1e-4;
     c.uncertainty.mass_fraction = 0.05;
@@ -248,7 +249,9 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
     c.uncertainty.inertia_fraction = 0.1;
     c.uncertainty.linearize_state = variant.find("full") != std::string::npos;
     c.uncertainty.diagonal_only = variant.find("diag") != std::string::npos;
-    if (variant.find("dec16") != std::string::npos) c.uncertainty.decimation = 16;
+    c.uncertainty.decimation = 1;
+    const std::size_t dec = variant.find("_dec");
+    if (dec != std::string::npos) c.uncertainty.decimation = std::stoi(variant.substr(dec + 4));
   } else if (variant == "planar_off") {
     c.savings.planar = jle::PlanarMode::kOff;
   }
@@ -303,7 +306,15 @@ BENCHMARK_CAPTURE(scaling, tree, true)
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag, file, "", false, "cov_full_diag"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd, file, "", false, "cov_qdd");           \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag");  \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec16, file, "", false, "cov_full_dec16")
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec8, file, "", false, "cov_full_dec8");  \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec12, file, "", false, "cov_full_dec12"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec16, file, "", false, "cov_full_dec16"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec17, file, "", false, "cov_full_dec17"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec18, file, "", false, "cov_full_dec18"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec20, file, "", false, "cov_full_dec20"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec24, file, "", false, "cov_full_dec24"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag_dec16, file, "", false, "cov_full_diag_dec16"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec1000, file, "", false, "cov_full_dec1000")
 JLE_COVARIANCE(panda, "/urdf/panda.urdf");
 JLE_COVARIANCE(talos, "/urdf/talos_reduced.urdf");
 

@@ -92,6 +92,9 @@ void Estimator::setUpCovariance() {
   covariance_.assign(ns, Matrix6::Zero());
   cov_count_ = 0;
   if (!u.enabled) return;
+  if (u.decimation > 1) {
+    for (auto* c : {&cov_last_, &cov_prev_, &cov_prev2_}) c->assign(ns, Matrix6::Zero());
+  }
   local_.assign(ns, Matrix6::Zero());
   for (auto* t : {&t_w_, &t_al_, &t_acc_, &t_f_, &t_n_}) t->assign(ns, Eigen::Matrix3d::Zero());
   jacobian_.assign(ns, Eigen::Matrix<double, 6, 3>::Zero());
@@ -326,10 +329,44 @@ void Estimator::sweepCoordinate(int j, const Data<double>& nom,
   for (int k : sweep) sweep_mark_[k] = 0;
 }
 
+// Decimation, between two computations: the quadratic through the last three computed
+// covariances (C_k, C_{k-n}, C_{k-2n}) at step = j / n for the j-th sample after k,
+//    C = (1+s)(2+s)/2 C_k - s(2+s) C_{k-n} + s(1+s)/2 C_{k-2n}.
+// The covariance is a smooth function of the state, so this is exact to third order in
+// the time since k (holding C_k: first order; the straight line through the last two:
+// second order, which overshoots where a variance turns round near its minimum;
+// docs/uncertainty.md measures the three). Elementwise, so as symmetric as the computed
+// ones. A variance extrapolated below 0 is set to 0, and its row and column with it (no
+// covariance without variance).
+void Estimator::extrapolateCovariance(double step) {
+  const double w0 = 0.5 * (1.0 + step) * (2.0 + step), w1 = -step * (2.0 + step),
+               w2 = 0.5 * step * (1.0 + step);
+  const bool diagonal = config_.uncertainty.diagonal_only;
+  for (int i : dynamics_segments_) {
+    Matrix6& out = covariance_[i];
+    if (diagonal)
+      out.diagonal() = w0 * cov_last_[i].diagonal() + w1 * cov_prev_[i].diagonal() +
+                       w2 * cov_prev2_[i].diagonal();
+    else
+      out = w0 * cov_last_[i] + w1 * cov_prev_[i] + w2 * cov_prev2_[i];
+    for (int a = 0; a < 6; ++a) {
+      if (out(a, a) >= 0.0) continue;
+      out.row(a).setZero();
+      out.col(a).setZero();
+    }
+  }
+}
+
 void Estimator::computeCovariance(const BaseState<double>& base_state) {
   const UncertaintyConfig& u = config_.uncertainty;
-  // Decimated: the covariance of the last computation is held.
-  if (cov_count_++ % u.decimation != 0) return;
+  // Decimated: between computations, extrapolated from the last three (once there are
+  // three: every sample of the first 2n is computed).
+  const long n = u.decimation;
+  const long count = cov_count_++;
+  if (n > 1 && count > 2 * n && count % n != 0) {
+    extrapolateCovariance(static_cast<double>(count % n) / static_cast<double>(n));
+    return;
+  }
   // The kinematics in double: data_ itself, or a double pass beside the float one.
   if (config_.precision == Precision::kFloat) loadsPass(cov_nominal_, q_, qd_, base_state);
   const Data<double>& nom = config_.precision == Precision::kFloat ? cov_nominal_ : data_;
@@ -412,14 +449,19 @@ void Estimator::computeCovariance(const BaseState<double>& base_state) {
         addForceCongruence(nom.R_parent_child[i], nom.p_parent_child[i], local_[i], local_[p]);
     }
   }
+  if (n > 1 && count % n == 0) {  // the three the extrapolation starts from
+    cov_prev2_.swap(cov_prev_);
+    cov_prev_.swap(cov_last_);
+    for (int i : dynamics_segments_) cov_last_[i] = covariance_[i];
+  }
 }
 
 double Estimator::effortVariance(int segment) const {
   const Matrix6& C = covariance_[static_cast<std::size_t>(segment)];
   const Eigen::Vector3d& u = model_.axis[static_cast<std::size_t>(segment)];
   switch (model_.joint_type[static_cast<std::size_t>(segment)]) {
-    case JointType::kRevolute: return u.dot(C.bottomRightCorner<3, 3>() * u);
-    case JointType::kPrismatic: return u.dot(C.topLeftCorner<3, 3>() * u);
+    case JointType::kRevolute: return std::max(0.0, u.dot(C.bottomRightCorner<3, 3>() * u));
+    case JointType::kPrismatic: return std::max(0.0, u.dot(C.topLeftCorner<3, 3>() * u));
     default: return 0.0;
   }
 }
