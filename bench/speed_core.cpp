@@ -240,8 +240,8 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
   } else if (variant.rfind("cov_", 0) == 0) {
     // Covariance of the loads (docs/uncertainty.md): cov_full = every source, the state
     // linearised; cov_qdd = its cheap path (q-ddot, wrench and inertial parts only);
-    // _diag = only the variances; _decN = computed every N-th sample, extrapolated in
-    // between (_dec1000: the cost of the extrapolation alone, nearly).
+    // _diag = only the variances; _pN = uncertainty.period N ms (the step is 1 ms: computed
+    // every N-th sample), extrapolated in between (_p1000: the extrapolation alone, nearly).
     c.uncertainty.enabled = true;
     c.uncertainty.position_noise = 1e-4;
     c.uncertainty.mass_fraction = 0.05;
@@ -249,9 +249,9 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
     c.uncertainty.inertia_fraction = 0.1;
     c.uncertainty.linearize_state = variant.find("full") != std::string::npos;
     c.uncertainty.diagonal_only = variant.find("diag") != std::string::npos;
-    c.uncertainty.decimation = 1;
-    const std::size_t dec = variant.find("_dec");
-    if (dec != std::string::npos) c.uncertainty.decimation = std::stoi(variant.substr(dec + 4));
+    c.uncertainty.period = 0.0;
+    const std::size_t p = variant.find("_p");
+    if (p != std::string::npos) c.uncertainty.period = 1e-3 * std::stoi(variant.substr(p + 2));
   } else if (variant == "planar_off") {
     c.savings.planar = jle::PlanarMode::kOff;
   }
@@ -306,15 +306,15 @@ BENCHMARK_CAPTURE(scaling, tree, true)
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag, file, "", false, "cov_full_diag"); \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd, file, "", false, "cov_qdd");           \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag");  \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec8, file, "", false, "cov_full_dec8");  \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec12, file, "", false, "cov_full_dec12"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec16, file, "", false, "cov_full_dec16"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec17, file, "", false, "cov_full_dec17"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec18, file, "", false, "cov_full_dec18"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec20, file, "", false, "cov_full_dec20"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec24, file, "", false, "cov_full_dec24"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag_dec16, file, "", false, "cov_full_diag_dec16"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_dec1000, file, "", false, "cov_full_dec1000")
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p8, file, "", false, "cov_full_p8");  \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p12, file, "", false, "cov_full_p12"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p16, file, "", false, "cov_full_p16"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p17, file, "", false, "cov_full_p17"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p18, file, "", false, "cov_full_p18"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p20, file, "", false, "cov_full_p20"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p24, file, "", false, "cov_full_p24"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag_p16, file, "", false, "cov_full_diag_p16"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p1000, file, "", false, "cov_full_p1000")
 JLE_COVARIANCE(panda, "/urdf/panda.urdf");
 JLE_COVARIANCE(talos, "/urdf/talos_reduced.urdf");
 

@@ -64,13 +64,15 @@ struct UncertaintyConfig {
   /// Include the (linearised) dependence on q and q-dot; false: only the q-ddot, wrench
   /// and inertial-parameter parts, which are exact and cheaper.
   bool linearize_state = true;
-  /// The covariance is computed for every n-th published sample; the n - 1 in between
-  /// get the quadratic extrapolation of the last three computed ones (C_k, C_{k-n},
-  /// C_{k-2n}; variances clamped at 0); every sample of the first 2n after a start or
-  /// reset is computed. docs/uncertainty.md measures the cost and the error. 18: the
-  /// smallest n at which the propagation costs at most as much as the loads (Panda,
-  /// Talos), worst sigma error 2.7% at 1 kHz; the error grows with n / rate (1 at low rates).
-  int decimation = 18;
+  /// [s] The covariance is computed for a published sample whose stamp is at least
+  /// `period` after the last computed one (and for the first three after a start, a
+  /// reset, a filter restart or a gap of more than 3 periods); the samples in between
+  /// get the quadratic through the last three computed ones at their actual times
+  /// (variances clamped at 0). 0: computed for every published sample. The error depends
+  /// on the period, not on the joint-state rate. docs/uncertainty.md measures the cost
+  /// and the error. 0.018: the propagation costs at most as much as the loads at 1 kHz
+  /// (Panda, Talos), worst sigma error 2.7%.
+  double period = 0.018;
 };
 
 /// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
@@ -346,10 +348,12 @@ class Estimator {
   std::vector<std::vector<int>> sweep_ancestors_;  // per coordinate, several roots: their ancestors
   std::vector<char> single_root_;                  // per coordinate
   Data<double> cov_nominal_;  // the loads in double (Precision::kFloat)
-  long cov_count_ = 0;        // computed samples since the start or reset (decimation)
-  // Decimation: the last three computed covariances (n samples apart), per segment.
+  // uncertainty.period: the last three computed covariances (newest first), per segment,
+  // their stamps, and how many of them are valid (0 after a start, reset or gap).
   std::vector<Matrix6> cov_last_, cov_prev_, cov_prev2_;
-  void extrapolateCovariance(double step);
+  double cov_time_[3] = {0.0, 0.0, 0.0};
+  int cov_history_ = 0;
+  void extrapolateCovariance(double t);
   // savings.planar (planar.hpp).
   bool planar_ = false;
   bool last_planar_ = false;

@@ -82,7 +82,7 @@ void Estimator::setUpCovariance() {
   checkNoise(u.mass_fraction, "uncertainty.mass_fraction");
   checkNoise(u.com_offset, "uncertainty.com_offset");
   checkNoise(u.inertia_fraction, "uncertainty.inertia_fraction");
-  if (u.decimation < 1) throw std::invalid_argument("uncertainty.decimation must be at least 1");
+  checkNoise(u.period, "uncertainty.period");
   for (const WrenchInputConfig& c : config_.wrenches) {
     checkNoise(c.force_noise, "wrench input '" + c.name + "': force_noise");
     checkNoise(c.moment_noise, "wrench input '" + c.name + "': moment_noise");
@@ -90,9 +90,9 @@ void Estimator::setUpCovariance() {
   const int n = model_.nsegments();
   const std::size_t ns = static_cast<std::size_t>(n);
   covariance_.assign(ns, Matrix6::Zero());
-  cov_count_ = 0;
+  cov_history_ = 0;
   if (!u.enabled) return;
-  if (u.decimation > 1) {
+  if (u.period > 0.0) {
     for (auto* c : {&cov_last_, &cov_prev_, &cov_prev2_}) c->assign(ns, Matrix6::Zero());
   }
   local_.assign(ns, Matrix6::Zero());
@@ -329,18 +329,22 @@ void Estimator::sweepCoordinate(int j, const Data<double>& nom,
   for (int k : sweep) sweep_mark_[k] = 0;
 }
 
-// Decimation, between two computations: the quadratic through the last three computed
-// covariances (C_k, C_{k-n}, C_{k-2n}) at step = j / n for the j-th sample after k,
-//    C = (1+s)(2+s)/2 C_k - s(2+s) C_{k-n} + s(1+s)/2 C_{k-2n}.
+// uncertainty.period, between two computations: the quadratic through the last three
+// computed covariances C_0, C_1, C_2 at their stamps t_0 > t_1 > t_2 (Lagrange, at any
+// spacing), at the stamp t: with x = t - t_0, a = t_1 - t_0, b = t_2 - t_0,
+//    C = (x-a)(x-b)/(a b) C_0 + x(x-b)/(a (a-b)) C_1 + x(x-a)/(b (b-a)) C_2
+// (equal spacing h, s = x/h: (1+s)(2+s)/2 C_0 - s(2+s) C_1 + s(1+s)/2 C_2).
 // The covariance is a smooth function of the state, so this is exact to third order in
-// the time since k (holding C_k: first order; the straight line through the last two:
+// the time since t_0 (holding C_0: first order; the straight line through the last two:
 // second order, which overshoots where a variance turns round near its minimum;
 // docs/uncertainty.md measures the three). Elementwise, so as symmetric as the computed
 // ones. A variance extrapolated below 0 is set to 0, and its row and column with it (no
 // covariance without variance).
-void Estimator::extrapolateCovariance(double step) {
-  const double w0 = 0.5 * (1.0 + step) * (2.0 + step), w1 = -step * (2.0 + step),
-               w2 = 0.5 * step * (1.0 + step);
+void Estimator::extrapolateCovariance(double t) {
+  const double x = t - cov_time_[0], a = cov_time_[1] - cov_time_[0],
+               b = cov_time_[2] - cov_time_[0];
+  const double w0 = (x - a) * (x - b) / (a * b), w1 = x * (x - b) / (a * (a - b)),
+               w2 = x * (x - a) / (b * (b - a));
   const bool diagonal = config_.uncertainty.diagonal_only;
   for (int i : dynamics_segments_) {
     Matrix6& out = covariance_[i];
@@ -349,23 +353,32 @@ void Estimator::extrapolateCovariance(double step) {
                        w2 * cov_prev2_[i].diagonal();
     else
       out = w0 * cov_last_[i] + w1 * cov_prev_[i] + w2 * cov_prev2_[i];
-    for (int a = 0; a < 6; ++a) {
-      if (out(a, a) >= 0.0) continue;
-      out.row(a).setZero();
-      out.col(a).setZero();
+    for (int r = 0; r < 6; ++r) {
+      if (out(r, r) >= 0.0) continue;
+      out.row(r).setZero();
+      out.col(r).setZero();
     }
   }
 }
 
 void Estimator::computeCovariance(const BaseState<double>& base_state) {
   const UncertaintyConfig& u = config_.uncertainty;
-  // Decimated: between computations, extrapolated from the last three (once there are
-  // three: every sample of the first 2n is computed).
-  const long n = u.decimation;
-  const long count = cov_count_++;
-  if (n > 1 && count > 2 * n && count % n != 0) {
-    extrapolateCovariance(static_cast<double>(count % n) / static_cast<double>(n));
-    return;
+  // uncertainty.period: computed once the stamp is a period past the last computed one;
+  // in between, extrapolated from the last three (once there are three). A gap of more
+  // than kGapPeriods periods (or a stamp not after the last) starts the history again:
+  // the quadratic is not trusted that far.
+  // "A period past" to a millionth of it: a stamp difference carries the rounding of the
+  // double time axis, and 18 samples at 1 kHz should be 18 ms, not sometimes 19 samples.
+  constexpr double kGapPeriods = 3.0, kSamePeriod = 1e-6;
+  const double period = u.period;
+  const double t = stamp_;
+  if (period > 0.0) {
+    const double since = t - cov_time_[0];
+    if (cov_history_ > 0 && !(since > 0.0 && since <= kGapPeriods * period)) cov_history_ = 0;
+    if (cov_history_ == 3 && since < (1.0 - kSamePeriod) * period) {
+      extrapolateCovariance(t);
+      return;
+    }
   }
   // The kinematics in double: data_ itself, or a double pass beside the float one.
   if (config_.precision == Precision::kFloat) loadsPass(cov_nominal_, q_, qd_, base_state);
@@ -449,10 +462,14 @@ void Estimator::computeCovariance(const BaseState<double>& base_state) {
         addForceCongruence(nom.R_parent_child[i], nom.p_parent_child[i], local_[i], local_[p]);
     }
   }
-  if (n > 1 && count % n == 0) {  // the three the extrapolation starts from
+  if (period > 0.0) {  // the three the extrapolation starts from
     cov_prev2_.swap(cov_prev_);
     cov_prev_.swap(cov_last_);
     for (int i : dynamics_segments_) cov_last_[i] = covariance_[i];
+    cov_time_[2] = cov_time_[1];
+    cov_time_[1] = cov_time_[0];
+    cov_time_[0] = t;
+    cov_history_ = std::min(cov_history_ + 1, 3);
   }
 }
 

@@ -187,7 +187,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
 
 void Estimator::reset() {
   bank_.reset();
-  cov_count_ = 0;
+  cov_history_ = 0;
   for (Input& input : inputs_) {
     input.count = 0;
     input.head = 0;
@@ -383,6 +383,7 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
   const bool ready = bank_.update(t, channels_.data());
   if (!ready) {
     sample_count_ = 0;
+    cov_history_ = 0;  // the filter restarts: its noise gain too (uncertainty.period)
     return SampleStatus::kWarmingUp;
   }
   if (sample_count_++ % config_.decimation != 0) return SampleStatus::kDecimated;

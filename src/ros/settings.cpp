@@ -360,9 +360,12 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
     su.read("com_offset", u.com_offset);
     su.read("inertia_fraction", u.inertia_fraction);
     su.read("linearize_state", u.linearize_state);
-    su.read("decimation", u.decimation);
-    if (u.decimation < 1)
-      throw SettingsError("parameter '" + su.name("decimation") + "' must be at least 1");
+    su.read("period", u.period);
+    if (!(u.period >= 0.0) || !std::isfinite(u.period))
+      throw SettingsError("parameter '" + su.name("period") + "' must be finite and >= 0 [s]");
+    if (su.has("decimation"))  // the sample count it replaced
+      throw SettingsError("parameter '" + su.name("decimation") + "' is replaced by '" +
+                          su.name("period") + "' [s] (docs/uncertainty.md)");
     const std::pair<const char*, double> values[] = {{"position_noise", u.position_noise},
                                                       {"mass_fraction", u.mass_fraction},
                                                       {"com_offset", u.com_offset},

@@ -81,7 +81,7 @@ TEST(NoAllocation, EstimatorWithEachDifferentiator) {
 }
 
 // The covariance of the loads (every source, the state linearised) allocates nothing
-// per sample either; nor does its decimation (extrapolated between computations).
+// per sample either; nor does uncertainty.period (extrapolated between computations).
 TEST(NoAllocation, EstimatorWithCovariance) {
   const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/panda.urdf");
   for (int variant = 0; variant < 3; ++variant) {
@@ -98,7 +98,7 @@ TEST(NoAllocation, EstimatorWithCovariance) {
     config.uncertainty.com_offset = 0.005;
     config.uncertainty.inertia_fraction = 0.05;
     config.uncertainty.linearize_state = linearize;
-    config.uncertainty.decimation = variant == 2 ? 4 : 1;
+    config.uncertainty.period = variant == 2 ? 4e-3 : 0.0;
     config.precision = linearize ? jle::Precision::kDouble : jle::Precision::kFloat;
     jle::Estimator estimator(model, config);
     std::vector<double> q(static_cast<std::size_t>(model.nq), 0.0);
@@ -110,8 +110,8 @@ TEST(NoAllocation, EstimatorWithCovariance) {
       estimator.addWrench(0, t, Eigen::Vector3d(1, 0, -5), Eigen::Vector3d(0, 0.1, 0));
       estimator.addJointSample(t, q.data());
     }
-    EXPECT_EQ(g_allocations - before, 0) << "linearize_state " << linearize << ", decimation "
-                                          << config.uncertainty.decimation;
+    EXPECT_EQ(g_allocations - before, 0) << "linearize_state " << linearize << ", period "
+                                          << config.uncertainty.period;
     EXPECT_GT(estimator.covariance(model.moving_segments[0])(5, 5), 0.0);
   }
 }
