@@ -361,6 +361,20 @@ void Estimator::extrapolateCovariance(double t) {
   }
 }
 
+namespace {
+
+// Whether the noise gain G is within `tolerance` of G0, entry by entry relative to the
+// standard deviations of G0 (an entry of G0 with a zero diagonal must stay exact).
+bool sameNoiseGain(const Eigen::Matrix3d& G, const Eigen::Matrix3d& G0, double tolerance) {
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      if (!(std::abs(G(a, b) - G0(a, b)) <= tolerance * std::sqrt(G0(a, a) * G0(b, b))))
+        return false;
+  return true;
+}
+
+}  // namespace
+
 void Estimator::computeCovariance(const BaseState<double>& base_state) {
   const UncertaintyConfig& u = config_.uncertainty;
   // uncertainty.period: computed once the stamp is a period past the last computed one;
@@ -376,8 +390,11 @@ void Estimator::computeCovariance(const BaseState<double>& base_state) {
     const double since = t - cov_time_[0];
     if (cov_history_ > 0 && !(since > 0.0 && since <= kGapPeriods * period)) cov_history_ = 0;
     if (cov_history_ == 3 && since < (1.0 - kSamePeriod) * period) {
-      extrapolateCovariance(t);
-      return;
+      if (sameNoiseGain(bank_.noiseGain(), cov_gain_, u.gain_tolerance)) {
+        extrapolateCovariance(t);
+        return;
+      }
+      cov_history_ = 0;  // the past covariances belong to another noise gain
     }
   }
   // The kinematics in double: data_ itself, or a double pass beside the float one.
@@ -462,13 +479,17 @@ void Estimator::computeCovariance(const BaseState<double>& base_state) {
         addForceCongruence(nom.R_parent_child[i], nom.p_parent_child[i], local_[i], local_[p]);
     }
   }
-  if (period > 0.0) {  // the three the extrapolation starts from
+  // The three the extrapolation starts from, a period apart: while the history fills
+  // (after a start, a gap or a change of the noise gain), the samples in between are
+  // computed but not kept, so that the quadratic never reaches far beyond its nodes.
+  if (period > 0.0 && (cov_history_ == 0 || t - cov_time_[0] >= (1.0 - kSamePeriod) * period)) {
     cov_prev2_.swap(cov_prev_);
     cov_prev_.swap(cov_last_);
     for (int i : dynamics_segments_) cov_last_[i] = covariance_[i];
     cov_time_[2] = cov_time_[1];
     cov_time_[1] = cov_time_[0];
     cov_time_[0] = t;
+    cov_gain_ = G;
     cov_history_ = std::min(cov_history_ + 1, 3);
   }
 }

@@ -361,6 +361,9 @@ NodeSettings parseSettings(const XmlRpcValue& params) {
     su.read("inertia_fraction", u.inertia_fraction);
     su.read("linearize_state", u.linearize_state);
     su.read("period", u.period);
+    su.read("gain_tolerance", u.gain_tolerance);
+    if (!(u.gain_tolerance >= 0.0) || !std::isfinite(u.gain_tolerance))
+      throw SettingsError("parameter '" + su.name("gain_tolerance") + "' must be finite and >= 0");
     if (!(u.period >= 0.0) || !std::isfinite(u.period))
       throw SettingsError("parameter '" + su.name("period") + "' must be finite and >= 0 [s]");
     if (su.has("decimation"))  // the sample count it replaced
