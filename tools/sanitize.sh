@@ -16,7 +16,9 @@ cd "$ws"
 # The unit tests only (the benchmarks and node tests are not rebuilt here).
 targets="test_urdf_reader test_closed_form test_invariance test_kdl test_cli
   test_differentiation test_estimator test_savings test_ground_truth test_stability
-  test_no_allocation test_process_bag"
+  test_no_allocation test_process_bag test_planar test_body test_force_plate
+  test_offline_formats test_covariance test_plates test_plates_offline test_sensor_joint
+  test_gait_csv"
 flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
