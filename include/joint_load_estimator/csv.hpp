@@ -88,6 +88,11 @@ class CsvReader {
 /// path is untouched (through a symbolic link, the file it names is replaced). A path
 /// that names a device or a pipe is written in place. To standard output when the path
 /// is empty.
+/// Appends `count` numbers to `line`, separated by `separator`, each as printf's %.17g
+/// (which reads back as the same double), and a newline. Shared by the CSV and the
+/// OpenSim storage writers.
+void appendNumberRow(std::string& line, const double* values, std::size_t count, char separator);
+
 class CsvWriter {
  public:
   /// Throws CsvError if the temporary file cannot be created.

@@ -309,24 +309,28 @@ void CsvWriter::writeHeader(const std::vector<std::string>& names) {
   put();
 }
 
-void CsvWriter::writeRow(const double* values, std::size_t count) {
+void appendNumberRow(std::string& line, const double* values, std::size_t count, char separator) {
   // %.17g is at most 24 characters ("-1.2345678901234567e-308"), plus the separator.
-  line_.reserve(count * 25 + 1);
-  line_.clear();
+  line.reserve(line.size() + count * 25 + 1);
   char buffer[32];
   for (std::size_t i = 0; i < count; ++i) {
-    if (i > 0) line_ += ',';
+    if (i > 0) line += separator;
 #if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
     // Specified as printf's %.17g in the C locale, and several times faster.
     const std::to_chars_result r =
         std::to_chars(buffer, buffer + sizeof buffer, values[i], std::chars_format::general, 17);
-    line_.append(buffer, r.ptr);
+    line.append(buffer, r.ptr);
 #else
     const int n = std::snprintf(buffer, sizeof buffer, "%.17g", values[i]);
-    line_.append(buffer, static_cast<std::size_t>(n));
+    line.append(buffer, static_cast<std::size_t>(n));
 #endif
   }
-  line_ += '\n';
+  line += '\n';
+}
+
+void CsvWriter::writeRow(const double* values, std::size_t count) {
+  line_.clear();
+  appendNumberRow(line_, values, count, ',');
   put();
 }
 

@@ -40,21 +40,8 @@ void StoWriter::writeRow(const double* values, std::size_t count) {
   if (count != columns_)
     throw std::invalid_argument("a .sto row of " + std::to_string(count) + " numbers, " +
                                 std::to_string(columns_) + " columns");
-  line_.reserve(count * 25 + 1);
   line_.clear();
-  char buffer[32];
-  for (std::size_t i = 0; i < count; ++i) {
-    if (i > 0) line_ += '\t';
-#if defined(__cpp_lib_to_chars) && __cpp_lib_to_chars >= 201611L
-    const std::to_chars_result r =
-        std::to_chars(buffer, buffer + sizeof buffer, values[i], std::chars_format::general, 17);
-    line_.append(buffer, r.ptr);
-#else
-    const int n = std::snprintf(buffer, sizeof buffer, "%.17g", values[i]);
-    line_.append(buffer, static_cast<std::size_t>(n));
-#endif
-  }
-  line_ += '\n';
+  appendNumberRow(line_, values, count, '\t');
   if (std::fwrite(line_.data(), 1, line_.size(), body_) != line_.size())
     throw CsvError(where_ + ": cannot write the temporary file: " + errnoText());
   ++rows_;
