@@ -1,43 +1,59 @@
-// The cost of the message side of a sample: filling ~joint_loads from the solver's
-// results and serializing it (what roscpp does before a publish), for the 7-joint arm.
+// The cost of the message side of a sample, on the node's own code for the 7-joint arm
+// with the default settings: a sensor_msgs/JointState through jle::feed (the Pipeline),
+// the record into ~joint_loads (jle::toMessage) and its serialization (what roscpp does
+// before a publish); against the same samples given to the Estimator alone, in the same
+// run, so that the ratio is the message path's overhead.
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/ros/conversions.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <benchmark/benchmark.h>
 #include <ros/serialization.h>
 
+#include <cmath>
 #include <vector>
 
 namespace {
 
-void messageConversion(benchmark::State& state) {
-  const jle::Model<double> model =
+const jle::Model<double>& panda() {
+  static const jle::Model<double> model =
       jle::modelFromUrdfFile(std::string(JLE_BENCH_DATA) + "/urdf/chains/panda_chain.urdf");
-  jle::Data<double> data(model);
-  const Eigen::VectorXd q = Eigen::VectorXd::Constant(model.nq, 0.3);
-  jle::rnea(model, data, q, q, q, Eigen::Vector3d(0, 0, -9.80665));
-  joint_load_estimator::JointLoads msg;
-  const std::size_t n = model.moving_segments.size();
-  msg.name.resize(n);
-  msg.wrench.resize(n);
-  msg.effort.resize(n);
-  msg.measured_effort.resize(n);
-  for (std::size_t i = 0; i < n; ++i) msg.name[i] = model.joint_name[model.moving_segments[i]];
-  std::vector<std::uint8_t> buffer(ros::serialization::serializationLength(msg) + 64);
+  return model;
+}
+
+// Sample k of a smooth motion at 1 kHz (the positions of every coordinate).
+void positions(int k, std::vector<double>& q) {
+  for (std::size_t i = 0; i < q.size(); ++i)
+    q[i] = 0.5 * std::sin(2e-3 * k * (1.0 + 0.1 * static_cast<double>(i)) + static_cast<double>(i));
+}
+
+void estimatorOnly(benchmark::State& state) {
+  jle::Estimator estimator(panda(), jle::Settings().estimator);
+  std::vector<double> q(static_cast<std::size_t>(panda().nq));
+  int k = 0;
   for (auto _ : state) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const int s = model.moving_segments[i];
-      geometry_msgs::Wrench& w = msg.wrench[i];
-      w.force.x = data.force[s].x();
-      w.force.y = data.force[s].y();
-      w.force.z = data.force[s].z();
-      w.torque.x = data.moment[s].x();
-      w.torque.y = data.moment[s].y();
-      w.torque.z = data.moment[s].z();
-      msg.effort[i] = data.effort[s];
-      msg.measured_effort[i] = 0.0;
-    }
+    positions(k, q);
+    benchmark::DoNotOptimize(estimator.addJointSample(1e-3 * k++, q.data()));
+  }
+}
+
+void nodeMessagePath(benchmark::State& state) {
+  jle::Pipeline pipeline(panda(), jle::Settings(), nullptr);
+  sensor_msgs::JointState js;
+  js.name = panda().coordinate_names;
+  js.position.resize(js.name.size());
+  js.effort.assign(js.name.size(), 1.0);
+  joint_load_estimator::JointLoads msg;
+  jle::prepare(pipeline.record(), msg);
+  std::vector<std::uint8_t> buffer(ros::serialization::serializationLength(msg) + 64);
+  const ros::Time start(1700000000, 0);
+  int k = 0;
+  for (auto _ : state) {
+    positions(k, js.position);
+    js.header.stamp = start + ros::Duration(1e-3 * k++);
+    if (jle::feed(pipeline, js, js.header.stamp) != jle::Outcome::kPublished) continue;
+    jle::toMessage(pipeline.record(), msg);
     ros::serialization::OStream stream(buffer.data(), static_cast<uint32_t>(buffer.size()));
     ros::serialization::serialize(stream, msg);
     benchmark::DoNotOptimize(buffer.data());
@@ -46,5 +62,6 @@ void messageConversion(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(messageConversion);
+BENCHMARK(estimatorOnly);
+BENCHMARK(nodeMessagePath);
 BENCHMARK_MAIN();

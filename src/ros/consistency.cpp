@@ -55,9 +55,44 @@ Eigen::Vector3d readVector(const YAML::Node& node, const std::string& where) {
 
 }  // namespace
 
+void EstimatorNode::setUpConsistency() {
+  // Predicted against measured: every sensor's residual, the floating base's.
+  for (std::size_t k = 0; k < settings_.estimator.wrenches.size(); ++k) {
+    const std::string& joint = settings_.estimator.wrenches[k].sensor_joint;
+    if (joint.empty()) continue;
+    sensor_topics_.push_back(k);
+    wrench_topics_[k].consistency_pub =
+        private_nh_.advertise<geometry_msgs::WrenchStamped>("consistency/" + joint, 10);
+  }
+  const Model<double>& model = pipeline_->model();
+  total_weight_ = model.totalMass() * settings_.estimator.gravity_world.norm();
+  pending_bias_.assign(settings_.wrenches.size(), Vector6::Zero());
+  ros::AdvertiseServiceOptions calibrate =
+      ros::AdvertiseServiceOptions::create<joint_load_estimator::CalibrateBias>(
+          "calibrate_bias",
+          [this](joint_load_estimator::CalibrateBias::Request& req,
+                 joint_load_estimator::CalibrateBias::Response& res) {
+            return onCalibrateBias(req, res);
+          },
+          ros::VoidConstPtr(), &service_queue_);
+  calibrate_srv_ = private_nh_.advertiseService(calibrate);
+  service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
+  service_spinner_->start();
+}
+
+void EstimatorNode::applyPendingBias() {
+  if (!bias_pending_.load()) return;
+  std::lock_guard<std::mutex> lock(calibration_mutex_);
+  for (std::size_t k : sensor_topics_)
+    pipeline_->setSensorBias(static_cast<int>(k), pending_bias_[k].head<3>(),
+                             pending_bias_[k].tail<3>());
+  bias_pending_ = false;
+}
+
 void EstimatorNode::publishConsistency(const ros::Time& stamp) {
-  const Data<double>& data = estimator_->data();
-  if (estimator_->model().floating_base) {
+  const Estimator& estimator = pipeline_->estimator();
+  const Data<double>& data = estimator.data();
+  if (estimator.model().floating_base) {
     base_force_max_ = std::max(base_force_max_, data.force[0].norm());
     base_moment_max_ = std::max(base_moment_max_, data.moment[0].norm());
   }
@@ -70,39 +105,41 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
     Calibration& c = calibration_;
     collect = c.active && !c.done && c.failure.empty();
     if (collect && !c.assume_still) {
-      const VectorX<double>& qd = estimator_->qd();
+      const VectorX<double>& qd = estimator.qd();
       for (int i = 0; i < qd.size() && collect; ++i)
-        if (estimator_->coordinateNeeded(i) && std::abs(qd[i]) > settings_.still_velocity) {
+        if (estimator.coordinateNeeded(i) && std::abs(qd[i]) > settings_.still_velocity) {
           std::ostringstream why;
           why << "the robot is not still: the estimated velocity of '"
-              << estimator_->model().coordinate_names[static_cast<std::size_t>(i)] << "' is "
+              << estimator.model().coordinate_names[static_cast<std::size_t>(i)] << "' is "
               << qd[i] << ", above still_velocity " << settings_.still_velocity;
           c.failure = why.str();
           collect = false;
         }
     }
     for (std::size_t k : sensor_topics_)
-      if (collect && !estimator_->sensorUsed(static_cast<int>(k))) {
-        c.failure = "sensor '" + wrench_topics_[k]->settings.input.sensor_joint + "' is stale";
+      if (collect && !estimator.sensorUsed(static_cast<int>(k))) {
+        c.failure = "sensor '" + settings_.estimator.wrenches[k].sensor_joint + "' is stale";
         collect = false;
       }
     if (!collect) calibration_cv_.notify_all();
   }
   for (std::size_t k : sensor_topics_) {
-    WrenchTopic& topic = *wrench_topics_[k];
-    if (!estimator_->sensorUsed(static_cast<int>(k))) continue;
+    WrenchTopic& topic = wrench_topics_[k];
+    const int input = static_cast<int>(k);
+    if (!estimator.sensorUsed(input)) continue;
     // Link frame, about the link origin (the joint origin) -> the reading's
     // frame.
-    const Wrench<double> r = estimator_->sensorResidual(static_cast<int>(k));
-    const Eigen::Matrix3d& R = topic.R_link_sensor;
+    const Wrench<double> r = estimator.sensorResidual(static_cast<int>(k));
+    const Eigen::Isometry3d& X = pipeline_->wrenchFramePose(input);
+    const Eigen::Matrix3d R = X.linear();
     const Eigen::Vector3d f = R.transpose() * r.force;
-    const Eigen::Vector3d m = R.transpose() * (r.moment - topic.p_link_sensor.cross(r.force));
+    const Eigen::Vector3d m = R.transpose() * (r.moment - X.translation().cross(r.force));
     topic.max_force = std::max(topic.max_force, f.norm());
     topic.max_moment = std::max(topic.max_moment, m.norm());
     if (topic.consistency_pub.getNumSubscribers() > 0) {
       wrench_msg_.header.stamp = stamp;
-      wrench_msg_.header.frame_id =
-          topic.sensor_frame.empty() ? topic.settings.input.link : topic.sensor_frame;
+      const std::string& frame = pipeline_->wrenchFrame(input);
+      wrench_msg_.header.frame_id = frame.empty() ? settings_.estimator.wrenches[k].link : frame;
       wrench_msg_.wrench.force = tf2::toMsg(f, wrench_msg_.wrench.force);
       wrench_msg_.wrench.torque = tf2::toMsg(m, wrench_msg_.wrench.torque);
       topic.consistency_pub.publish(wrench_msg_);
@@ -111,8 +148,9 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
       // reading - bias = sign (residual + prediction), so the reading's offset
       // from sign * prediction is bias + sign * residual.
       Vector6 x;
-      x << topic.bias_force + topic.settings.input.sign * f,
-          topic.bias_torque + topic.settings.input.sign * m;
+      const double sign = settings_.estimator.wrenches[k].sign;
+      x << pipeline_->sensorBiasForce(input) + sign * f,
+          pipeline_->sensorBiasTorque(input) + sign * m;
       Calibration& c = calibration_;
       const double n = static_cast<double>(c.samples + 1);
       const Vector6 delta = x - c.mean[k];
@@ -122,7 +160,7 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
   }
   if (collect) {
     Calibration& c = calibration_;
-    const double t = estimator_->stamp();
+    const double t = estimator.stamp();
     if (c.samples == 0) c.first_stamp = t;
     ++c.samples;
     c.last_sample = ros::WallTime::now();
@@ -138,16 +176,17 @@ void EstimatorNode::diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrap
   auto warn = [&](const std::string& w) { warnings += (warnings.empty() ? "" : "; ") + w; };
   char text[256];
   for (std::size_t k : sensor_topics_) {
-    WrenchTopic& topic = *wrench_topics_[k];
-    const std::string& joint = topic.settings.input.sensor_joint;
-    if (topic.max_force > topic.settings.force_threshold) {
+    WrenchTopic& topic = wrench_topics_[k];
+    const WrenchTopicSettings& limits = settings_.wrenches[k];
+    const std::string& joint = settings_.estimator.wrenches[k].sensor_joint;
+    if (topic.max_force > limits.force_threshold) {
       std::snprintf(text, sizeof text, "sensor %s: residual force %.3g N > %.3g N", joint.c_str(),
-                    topic.max_force, topic.settings.force_threshold);
+                    topic.max_force, limits.force_threshold);
       warn(text);
     }
-    if (topic.max_moment > topic.settings.moment_threshold) {
+    if (topic.max_moment > limits.moment_threshold) {
       std::snprintf(text, sizeof text, "sensor %s: residual moment %.3g N m > %.3g N m",
-                    joint.c_str(), topic.max_moment, topic.settings.moment_threshold);
+                    joint.c_str(), topic.max_moment, limits.moment_threshold);
       warn(text);
     }
     status.add(joint + ": max |residual force| [N]", topic.max_force);
@@ -155,7 +194,7 @@ void EstimatorNode::diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrap
     topic.max_force = 0.0;
     topic.max_moment = 0.0;
   }
-  if (estimator_->model().floating_base) {
+  if (pipeline_->model().floating_base) {
     const double limit = settings_.base_residual_threshold * total_weight_;
     if (base_force_max_ > limit) {
       std::snprintf(text, sizeof text,
@@ -219,18 +258,17 @@ bool EstimatorNode::onCalibrateBias(joint_load_estimator::CalibrateBias::Request
   const long n = calibration_.samples;
   std::vector<std::string> frames;
   for (std::size_t k : sensor_topics_) {
-    WrenchTopic& topic = *wrench_topics_[k];
     const Vector6& mean = calibration_.mean[k];
     const Vector6 stddev =
         n > 1 ? Vector6((calibration_.m2[k] / static_cast<double>(n - 1)).cwiseSqrt())
               : Vector6::Zero();
-    topic.bias_force = mean.head<3>();
-    topic.bias_torque = mean.tail<3>();
-    frames.push_back(topic.sensor_frame);
-    res.sensors.push_back(topic.settings.input.sensor_joint);
+    pending_bias_[k] = mean;
+    frames.push_back(pipeline_->wrenchFrame(static_cast<int>(k)));
+    res.sensors.push_back(settings_.estimator.wrenches[k].sensor_joint);
     res.bias.push_back(toWrench(mean));
     res.stddev.push_back(toWrench(stddev));
   }
+  bias_pending_ = true;
   lock.unlock();
   res.success = true;
   std::ostringstream message;
@@ -303,10 +341,10 @@ void EstimatorNode::loadBiasFile() {
     throw SettingsError("bias_file '" + path + "': 'sensors' must be a map");
   for (const auto& entry : sensors) {
     const std::string name = entry.first.as<std::string>();
-    WrenchTopic* topic = nullptr;
+    int input = -1;
     for (std::size_t k : sensor_topics_)
-      if (wrench_topics_[k]->settings.input.sensor_joint == name) topic = wrench_topics_[k].get();
-    if (!topic) {
+      if (settings_.estimator.wrenches[k].sensor_joint == name) input = static_cast<int>(k);
+    if (input < 0) {
       ROS_WARN("bias_file '%s': sensor '%s' is not configured: ignored", path.c_str(),
                name.c_str());
       continue;
@@ -314,18 +352,14 @@ void EstimatorNode::loadBiasFile() {
     const std::string where = "bias_file '" + path + "': sensors/" + name;
     const Eigen::Vector3d force = readVector(entry.second["force"], where + "/force");
     const Eigen::Vector3d torque = readVector(entry.second["torque"], where + "/torque");
-    {
-      std::lock_guard<std::mutex> lock(calibration_mutex_);  // a nodelet may already run
-      topic->bias_force = force;
-      topic->bias_torque = torque;
-    }
+    pipeline_->setSensorBias(input, force, torque);  // no subscription yet
     const std::string frame = entry.second["frame"] ? entry.second["frame"].as<std::string>() : "";
-    if (!topic->settings.frame.empty() && !frame.empty() && frame != topic->settings.frame)
+    const std::string& configured = settings_.wrenches[static_cast<std::size_t>(input)].frame;
+    if (!configured.empty() && !frame.empty() && frame != configured)
       ROS_WARN("%s: calibrated in frame '%s', configured frame is '%s'", where.c_str(),
-               frame.c_str(), topic->settings.frame.c_str());
+               frame.c_str(), configured.c_str());
     ROS_INFO("sensor '%s': bias force [%g %g %g] N, torque [%g %g %g] N m from '%s'", name.c_str(),
-             topic->bias_force.x(), topic->bias_force.y(), topic->bias_force.z(),
-             topic->bias_torque.x(), topic->bias_torque.y(), topic->bias_torque.z(), path.c_str());
+             force.x(), force.y(), force.z(), torque.x(), torque.y(), torque.z(), path.c_str());
   }
 }
 

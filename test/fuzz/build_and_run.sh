@@ -22,13 +22,9 @@ mkdir -p "$work/obj"
 san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 common=(-std=c++17 -O1 -g $san -I"$repo/include" -I/usr/include/eigen3
         -DJLE_FUZZ_DATA="\"$repo/test/data\"" -Wall -Wextra)
-# The library sources each target needs (compiled once, shared; without the fuzzer
-# runtime so that they hold no main).
-declare -A needs=(
-  [fuzz_urdf]="src/core/urdf_reader.cpp"
-  [fuzz_csv]="src/core/urdf_reader.cpp src/core/csv.cpp"
-  [fuzz_messages]="src/core/urdf_reader.cpp src/core/estimator.cpp src/core/covariance.cpp src/ros/message_inputs.cpp"
-)
+# Every target links the whole ROS-free core (compiled once, shared; without the fuzzer
+# runtime so that it holds no main): no list to keep up to date.
+core_sources=$(cd "$repo" && ls src/core/*.cpp)
 object() {  # source -> object path, rebuilt when the source or a header is newer
   local src=$1 obj="$work/obj/$(echo "$1" | tr / _).o"
   if [ ! -f "$obj" ] || [ -n "$(find "$repo/$src" "$repo/include" -newer "$obj" -print -quit)" ]; then
@@ -42,7 +38,7 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 status=0
 for t in "${targets[@]}"; do
   objs=()
-  for s in ${needs[$t]}; do objs+=("$(object "$s")"); done
+  for s in $core_sources; do objs+=("$(object "$s")"); done
   "$cxx" "${common[@]}" -fsanitize=fuzzer "$here/$t.cpp" "${objs[@]}" -ltinyxml2 -o "$work/$t"
   # Regressions first: each must now run clean.
   reg="$here/regressions/$t"

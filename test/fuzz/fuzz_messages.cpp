@@ -1,13 +1,12 @@
-// libFuzzer target: the node's message path without ROS. The fuzz bytes decode into a
-// stream of JointState-like messages (names from a small alphabet with unknown and
-// repeated ones, NaN / inf / huge values, empty and mismatched arrays, duplicate and
-// backward stamps), wrench samples and resets, fed like the node feeds them: the size
-// checks of EstimatorNode::onJointState, jle::JointStateMap, then
-// jle::Estimator::addJointSample / addWrench. Checks the documented status of every
-// sample (kNonFinite, kDuplicate, kOutOfOrder against a shadow of the last accepted
-// stamp). Built by build_and_run.sh.
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/ros/message_inputs.hpp>
+// libFuzzer target: the node's message path, jle::Pipeline, the code the node and
+// process_bag run. The fuzz bytes decode into a stream of JointState-like messages
+// (names from a small alphabet with unknown and repeated ones, NaN / inf / huge values,
+// empty and mismatched arrays, stamp 0, duplicate, backward and jumping stamps over the
+// whole range a ROS stamp holds), wrench messages (frames known and unknown) and jumps
+// of the clock. Checks the documented outcome of every message against a shadow of
+// the rules (invalid sizes and values, stamp order, resets), that every message is
+// counted once, and the published record. Built by build_and_run.sh.
+#include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <cmath>
@@ -39,6 +38,11 @@ class Bytes {
     double d;
     std::memcpy(&d, &bits, sizeof d);
     return d;
+  }
+  std::uint64_t raw64() {
+    std::uint64_t bits = 0;
+    for (int i = 0; i < 8; ++i) bits = (bits << 8) | byte();
+    return bits;
   }
   // A value from a table of the interesting ones, or the next 8 bytes as a double.
   double value() {
@@ -81,24 +85,31 @@ const jle::Model<double>& model() {
 
 }  // namespace
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  Bytes in(data, size);
-  const jle::Model<double>& m = model();
+namespace {
 
-  // The configuration from the first bytes.
-  jle::EstimatorConfig config;
+constexpr jle::Stamp kMaxStamp = 4294967295999999999;  // a ROS time: uint32 s, uint32 ns
+constexpr jle::Stamp kStart = 1700000000000000000;
+// Random stamps stay within 2^51 ns (26 days) of the start: the time axis (a double of
+// seconds since the first stamp) resolves 1 ns there; farther jumps re-anchor it
+// (test_pipeline checks that).
+constexpr jle::Stamp kReach = jle::Stamp{1} << 51;
+
+// The settings from the first two bytes.
+jle::Settings settingsFrom(Bytes& in) {
+  jle::Settings settings;
+  jle::EstimatorConfig& config = settings.estimator;
   const std::uint8_t c0 = in.byte();
   switch (c0 % 3) {
-    case 0: config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay; break;
+    case 0:
+      config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
+      config.differentiator.window = 5;
+      config.differentiator.delay = (c0 >> 2) % 3;
+      break;
     case 1:
       config.differentiator.type = jle::DifferentiatorType::kFiniteDifference;
       config.differentiator.window = 3;
       break;
     default: config.differentiator.type = jle::DifferentiatorType::kKalman; break;
-  }
-  if (config.differentiator.type == jle::DifferentiatorType::kSavitzkyGolay) {
-    config.differentiator.window = 5;
-    config.differentiator.delay = (c0 >> 2) % 3;
   }
   config.decimation = 1 + (c0 >> 4) % 3;
   config.precision = (c0 & 0x80) ? jle::Precision::kFloat : jle::Precision::kDouble;
@@ -114,107 +125,127 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   wrench.timeout = 0.05;
   wrench.stale_policy = static_cast<jle::StalePolicy>((c1 >> 5) % 3);
   config.wrenches.push_back(wrench);
+  jle::WrenchTopicSettings topic;
+  topic.topic = "ft";
+  settings.wrenches.push_back(topic);
+  return settings;
+}
 
-  std::unique_ptr<jle::Estimator> estimator;
-  try {
-    estimator = std::make_unique<jle::Estimator>(m, config);
-  } catch (const std::invalid_argument&) {
-    return 0;  // a configuration the estimator refuses (documented)
+// The next stamp [ns] and clock from the fuzz bytes, within what a ROS time holds.
+void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
+  switch (in.byte() % 9) {
+    case 0: break;                                               // duplicate
+    case 1: stamp = std::max<jle::Stamp>(0, stamp - 10000000); break;  // backward 10 ms
+    case 2: stamp = std::min(kMaxStamp, stamp + 1000000000); break;    // a gap of 1 s
+    case 3:
+      stamp = kStart - kReach + static_cast<jle::Stamp>(in.raw64() % static_cast<std::uint64_t>(2 * kReach));
+      break;
+    case 4: stamp = 0; break;                                    // "no stamp": the clock
+    case 5: clock = std::max<jle::Stamp>(1, clock - 5000000000); break;  // clock jumps back
+    default: stamp = std::min(kMaxStamp, stamp + 2000000 * (1 + in.byte() % 8)); break;
   }
-  jle::JointStateMap map(m, jle::publishedSegments(m, config.joints));
+  clock = std::min(kMaxStamp, clock + 1000000);
+}
 
-  double t = 100.0;
-  double last_accepted = 0.0;
-  bool have_last = false;
-  double last_wrench = -std::numeric_limits<double>::infinity();
-  bool have_wrench = false;
+// The shadow of the pipeline's rules on stamps: the last joint state taken, resets.
+struct Shadow {
+  jle::Stamp last = 0;  // 0: none since the start or a reset
+  jle::Stamp last_clock = 0;
+  void clockSeen(jle::Stamp stamp, jle::Stamp clock) {
+    const bool clock_back = last_clock != 0 && clock < last_clock && !(stamp > last);
+    const bool stamp_back = last != 0 && static_cast<double>(last - stamp) * 1e-9 > 1.0;
+    last_clock = clock;
+    if (clock_back || stamp_back) last = 0;
+  }
+};
+
+struct JointMessage {
   std::vector<std::string> names;
-  std::vector<double> position, effort;
+  std::vector<double> position, velocity, effort;
+  bool valid = true;  // sizes agree and every value is finite
+};
 
+void decodeJointState(Bytes& in, JointMessage& js) {
+  const std::size_t n = in.byte() % 9;
+  js.names.resize(n);
+  for (std::string& s : js.names) s = kNames[in.byte() % kNameCount];
+  const std::uint8_t shape = in.byte();
+  std::size_t np = n, ne = (shape & 1) ? n : 0, nv = (shape & 128) ? n : 0;
+  if ((shape & 6) == 2) np = n + 1;
+  if ((shape & 6) == 4 && n > 0) np = n - 1;
+  if ((shape & 24) == 8) ne = n + 2;
+  js.position.resize(np);
+  js.velocity.resize(nv);
+  js.effort.resize(ne);
+  for (double& v : js.position) v = (shape & 32) ? in.value() : 0.1 * (in.byte() % 32);
+  for (double& v : js.velocity) v = in.value();
+  for (double& v : js.effort) v = in.value();
+  js.valid = np == n && (ne == 0 || ne == n) && (nv == 0 || nv == n);
+  for (const auto* field : {&js.position, &js.velocity, &js.effort})
+    for (double v : *field) js.valid = js.valid && std::isfinite(v);
+}
+
+void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stamp stamp,
+                       jle::Outcome outcome, Shadow& shadow) {
+  using jle::Outcome;
+  if (!js.valid) {
+    JLE_FUZZ_CHECK(outcome == Outcome::kInvalid && !p.problem().empty());
+    return;
+  }
+  JLE_FUZZ_CHECK(outcome != Outcome::kInvalid && outcome != Outcome::kFrame);
+  if (outcome == Outcome::kWaiting) return;
+  if (outcome == Outcome::kOrder) {
+    JLE_FUZZ_CHECK(shadow.last != 0 && stamp <= shadow.last);
+    return;
+  }
+  JLE_FUZZ_CHECK(shadow.last == 0 || stamp > shadow.last);
+  shadow.last = stamp;
+  if (outcome == Outcome::kPublished) {
+    JLE_FUZZ_CHECK(p.record().stamp <= stamp);
+    JLE_FUZZ_CHECK(p.record().effort.size() == p.record().joint.size());
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  Bytes in(data, size);
+  std::unique_ptr<jle::Pipeline> pipeline;
+  try {
+    pipeline = std::make_unique<jle::Pipeline>(model(), settingsFrom(in), nullptr);
+  } catch (const std::invalid_argument&) {
+    return 0;  // a configuration the pipeline refuses (documented)
+  }
+  jle::Pipeline& p = *pipeline;
+  jle::Stamp stamp = kStart, clock = stamp;
+  Shadow shadow;
+  JointMessage js;
+  long messages = 0;
   for (int op = 0; op < 400 && !in.empty(); ++op) {
     const std::uint8_t kind = in.byte();
-    // The time step of this message.
-    switch (in.byte() % 8) {
-      case 0: break;             // duplicate stamp
-      case 1: t -= 0.01; break;  // backward
-      case 2: t += 1.0; break;   // a gap: the filters restart
-      case 3: t = in.value(); break;
-      default: t += 0.002 * (1 + in.byte() % 8); break;
-    }
-    if (kind % 8 == 7) {
-      estimator->reset();  // forgets the joint and the wrench history
-      have_last = false;
-      have_wrench = false;
-      continue;
-    }
-    if (kind % 8 == 6) {  // a wrench sample
+    advance(in, stamp, clock);
+    ++messages;
+    const jle::Stamp effective = stamp == 0 ? clock : stamp;
+    if (kind % 8 >= 6) {  // a wrench message, in a frame the URDF has or not
       Eigen::Vector3d f, mo;
       for (int i = 0; i < 3; ++i) f[i] = in.value();
       for (int i = 0; i < 3; ++i) mo[i] = in.value();
-      const bool taken = estimator->addWrench(0, t, f, mo);
-      const bool valid = std::isfinite(t) && f.allFinite() && mo.allFinite() &&
-                         (!have_wrench || t > last_wrench);
-      JLE_FUZZ_CHECK(taken == valid);
-      if (taken) {
-        last_wrench = t;
-        have_wrench = true;
-      }
+      const std::string frame = kind % 8 == 7 ? "tool0" : (kind & 8) ? "base_link" : "nowhere";
+      const jle::Outcome outcome = p.onWrench(0, stamp, clock, frame, f, mo);
+      if (f.allFinite() && mo.allFinite()) shadow.clockSeen(effective, clock);
+      if (!f.allFinite() || !mo.allFinite()) JLE_FUZZ_CHECK(outcome == jle::Outcome::kInvalid);
+      if (frame == "nowhere" && f.allFinite() && mo.allFinite())
+        JLE_FUZZ_CHECK(outcome == jle::Outcome::kFrame);
       continue;
     }
-    // A joint-state message.
-    const std::size_t n = in.byte() % 9;
-    names.resize(n);
-    for (std::string& s : names) s = kNames[in.byte() % kNameCount];
-    const std::uint8_t shape = in.byte();
-    std::size_t np = n, ne = (shape & 1) ? n : 0;
-    if ((shape & 6) == 2) np = n + 1;
-    if ((shape & 6) == 4 && n > 0) np = n - 1;
-    if ((shape & 24) == 8) ne = n + 2;
-    position.resize(np);
-    effort.resize(ne);
-    for (double& v : position) v = (shape & 32) ? in.value() : 0.1 * (in.byte() % 32);
-    for (double& v : effort) v = in.value();
-
-    // EstimatorNode::onJointState: sizes, then finiteness, are checked before anything.
-    if (position.size() != n || (!effort.empty() && effort.size() != n)) continue;
-    bool finite = true;
-    for (double v : position) finite = finite && std::isfinite(v);
-    for (double v : effort) finite = finite && std::isfinite(v);
-    if (!finite && !(shape & 64)) continue;  // else: let the estimator see it
-
-    const int unknown = map.update(names, position, effort);
-    JLE_FUZZ_CHECK(unknown >= -1 && unknown < static_cast<int>(n));
-    if (unknown >= 0) {
-      const std::string& u = names[static_cast<std::size_t>(unknown)];
-      JLE_FUZZ_CHECK(u == "unknown_joint" || u.empty() || u == "elbow_joint " ||
-            u == "wrist_3_link-tool0_fixed_joint");
-    }
-    JLE_FUZZ_CHECK(map.q().size() == static_cast<std::size_t>(m.nq));
-    if (map.firstMissing() >= 0) continue;
-
-    bool q_finite = true;
-    for (double v : map.q()) q_finite = q_finite && std::isfinite(v);
-    const jle::SampleStatus status = estimator->addJointSample(t, map.q().data());
-    if (!std::isfinite(t) || !q_finite) {
-      JLE_FUZZ_CHECK(status == jle::SampleStatus::kNonFinite);
-      continue;
-    }
-    JLE_FUZZ_CHECK(status != jle::SampleStatus::kNonFinite);
-    if (have_last && t == last_accepted) {
-      JLE_FUZZ_CHECK(status == jle::SampleStatus::kDuplicate);
-      continue;
-    }
-    if (have_last && t < last_accepted) {
-      JLE_FUZZ_CHECK(status == jle::SampleStatus::kOutOfOrder);
-      continue;
-    }
-    JLE_FUZZ_CHECK(status != jle::SampleStatus::kDuplicate && status != jle::SampleStatus::kOutOfOrder);
-    have_last = true;
-    last_accepted = t;
-    if (status == jle::SampleStatus::kPublished) {
-      JLE_FUZZ_CHECK(std::isfinite(estimator->stamp()) && estimator->stamp() <= t);
-      JLE_FUZZ_CHECK(estimator->q().size() == m.nq);
-    }
+    decodeJointState(in, js);
+    const jle::Outcome outcome =
+        p.onJointState(stamp, clock, js.names, js.position, js.velocity, js.effort);
+    if (js.valid) shadow.clockSeen(effective, clock);
+    checkJointOutcome(p, js, effective, outcome, shadow);
   }
+  const jle::PipelineCounters& c = p.counters();
+  JLE_FUZZ_CHECK(c.received(jle::InputKind::kJointState) + c.received(jle::InputKind::kWrench) ==
+                 messages);
   return 0;
 }

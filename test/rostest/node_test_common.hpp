@@ -21,6 +21,10 @@
 #include <sensor_msgs/JointState.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -28,6 +32,8 @@
 #include <cstdint>
 #include <string>
 #include <vector>
+
+extern char** environ;
 
 namespace jle_test {
 
@@ -50,6 +56,46 @@ bool waitFor(Pred pred, double timeout = kTimeout) {
     ros::WallDuration(0.0002).sleep();
   }
   return false;
+}
+
+/// Runs a program (PATH searched) to completion while spinning; its exit status, or -1
+/// (also when it runs longer than `timeout` wall seconds: it is then interrupted).
+inline int runSpinning(const std::vector<std::string>& args, double timeout) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    ros::spinOnce();
+    if (ros::WallTime::now() > end) {
+      kill(pid, SIGINT);
+      waitpid(pid, &status, 0);
+      return -1;
+    }
+    ros::WallDuration(0.001).sleep();
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// Spins until count() has not changed for `quiet` wall seconds (the last messages in
+/// flight have arrived), or `timeout` has passed.
+template <typename Count>
+void spinUntilQuiet(Count count, double quiet = 1.0, double timeout = 30.0) {
+  auto seen = count();
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  ros::WallTime last_change = ros::WallTime::now();
+  while (ros::ok() && ros::WallTime::now() - last_change < ros::WallDuration(quiet) &&
+         ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (count() != seen) {
+      seen = count();
+      last_change = ros::WallTime::now();
+    }
+    ros::WallDuration(0.01).sleep();
+  }
 }
 
 /// The test's node handle (created in main after ros::init).

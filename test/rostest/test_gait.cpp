@@ -3,6 +3,8 @@
 // node. The plates were computed so that they explain the motion; the pelvis residual the
 // node publishes must therefore stay within what the filters cost, and every joint must
 // get its loads.
+#include "node_test_common.hpp"
+
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -20,41 +22,18 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
-
 namespace {
 
 using joint_load_estimator::JointLoads;
 
 constexpr double kGravity = 9.80665;
 
-// Runs a program (PATH searched) to completion while spinning; its exit status, or -1.
-int runSpinning(const std::vector<std::string>& args, double timeout) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    ros::spinOnce();
-    if (ros::WallTime::now() > end) {
-      kill(pid, SIGINT);
-      waitpid(pid, &status, 0);
-      return -1;
-    }
-    ros::WallDuration(0.001).sleep();
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   const std::string urdf = std::string(JLE_TEST_DATA) + "/urdf/body_75kg_175cm.urdf";
   char dir_template[] = "/tmp/jle_gait_XXXXXX";
   ASSERT_NE(mkdtemp(dir_template), nullptr);
   const std::string bag = std::string(dir_template) + "/gait.bag";
-  ASSERT_EQ(runSpinning({JLE_MAKE_GAIT_BAG, "--urdf", urdf, "--output", bag}, 60.0), 0);
+  ASSERT_EQ(jle_test::runSpinning({JLE_MAKE_GAIT_BAG, "--urdf", urdf, "--output", bag}, 60.0), 0);
 
   jle::ModelOptions options;
   options.floating_base = true;
@@ -84,22 +63,13 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
 
   // rosbag play waits until the node listens to every input topic, then plays at the
   // bag's pace, driving /clock.
-  ASSERT_EQ(runSpinning({"rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", bag,
+  ASSERT_EQ(jle_test::runSpinning({"rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", bag,
                          "--topics", "/joint_states", "/tf", "/tf_static",
                          "/force_plate_1/wrench", "/force_plate_2/wrench"},
                         60.0),
             0);
   // The last messages in flight: until nothing new arrives for 1 s.
-  std::size_t seen = 0;
-  ros::WallTime quiet = ros::WallTime::now();
-  while (ros::WallTime::now() - quiet < ros::WallDuration(1.0)) {
-    ros::spinOnce();
-    if (loads.size() + residuals.size() != seen) {
-      seen = loads.size() + residuals.size();
-      quiet = ros::WallTime::now();
-    }
-    ros::WallDuration(0.01).sleep();
-  }
+  jle_test::spinUntilQuiet([&] { return loads.size() + residuals.size(); });
 
   // 3 strides of 1.1 s at 200 Hz = 660 joint states; decimation 2 gives 330 estimates
   // less the filter's start (10 samples). Messages are not dropped (queues of 10000).

@@ -1,15 +1,15 @@
 // Soak: 1e6 joint samples of a 7-joint arm (the Panda chain) at 1 kHz of simulated time
-// through the node's message path (jle::JointStateMap, jle::Estimator::addJointSample,
-// addWrench), as fast as it runs, with bad messages mixed in every 50 samples: NaN
+// through the node's message path (jle::Pipeline, with the default settings and a wrench
+// input), as fast as it runs, with bad messages mixed in every 50 samples: NaN
 // positions, a position array of the wrong length, a duplicate stamp, a backward stamp,
 // an unknown joint name, a NaN wrench and a backward wrench. Checks that
 //  - memory stays flat: VmRSS at 100% of the samples exceeds VmRSS at 10% by < 1 MB;
-//  - no good sample is lost: every good sample after the filter's warm-up is kPublished
-//    (the warm-up being exactly window - 1 samples, once);
-//  - every bad message is counted under its own kind, as many times as it was injected.
+//  - no good sample is lost: every good sample after the filter's warm-up is published
+//    (the warm-up happening once, at the start);
+//  - every bad message is counted under its own reason (the pipeline's counters), as
+//    many times as it was injected.
 // Prints the figures; exits 1 on a failed check. Usage: soak [SAMPLES (default 1000000)]
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/ros/message_inputs.hpp>
+#include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <chrono>
@@ -18,7 +18,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,128 +43,136 @@ const char* const kBadName[kKinds] = {"nan_position",  "wrong_length",  "duplica
 }  // namespace
 
 int main(int argc, char** argv) {
+  using jle::InputKind;
+  using jle::Outcome;
   const long samples = argc > 1 ? std::atol(argv[1]) : 1000000;
   const jle::Model<double> model =
       jle::modelFromUrdfFile(JLE_TEST_DATA "/urdf/chains/panda_chain.urdf");
-  jle::EstimatorConfig config;  // the defaults: Savitzky-Golay, window 9, causal
+  jle::Settings settings;  // the defaults, as the node runs them, and one wrench input
   jle::WrenchInputConfig ft;
   ft.name = "ft";
   ft.link = "panda_link8";
-  config.wrenches.push_back(ft);
-  jle::Estimator estimator(model, config);
-  jle::JointStateMap map(model, jle::publishedSegments(model, {}));
+  settings.estimator.wrenches.push_back(ft);
+  jle::WrenchTopicSettings topic;
+  topic.topic = "ft";
+  settings.wrenches.push_back(topic);
+  jle::Pipeline pipeline(model, settings, nullptr);
   const int nq = model.nq;
-  const double dt = 1e-3;
+  const jle::Stamp dt = 1000000;  // [ns] 1 kHz
+  const std::string frame = "panda_link8";
 
   std::vector<std::string> names = model.coordinate_names, names_unknown = names;
   names_unknown.push_back("ghost_joint");
   std::vector<double> position(static_cast<std::size_t>(nq)), position_unknown(names_unknown.size());
-  const std::vector<double> no_effort;
+  const std::vector<double> none;
   std::vector<double> short_position(static_cast<std::size_t>(nq - 1), 0.0);
 
-  long injected[kKinds] = {}, counted[kKinds] = {};
-  long good = 0, published = 0, warming = 0, other = 0;
+  long injected[kKinds] = {};
+  long good = 0, published = 0, warming = 0, late_warming = 0, other = 0;
   long rss_10 = -1;
-  double t = 0.0;
-
-  // What the node does with a joint-state message (size check, map, estimator).
-  auto message = [&](double stamp, const std::vector<std::string>& n,
-                     const std::vector<double>& p) -> std::optional<jle::SampleStatus> {
-    if (p.size() != n.size()) {  // dropped before the map, as the node does
-      ++counted[kLength];
-      return std::nullopt;
-    }
-    if (map.update(n, p, no_effort) >= 0) ++counted[kUnknown];
-    return estimator.addJointSample(stamp, map.q().data());
+  auto message = [&](jle::Stamp stamp, const std::vector<std::string>& n,
+                     const std::vector<double>& p) {
+    return pipeline.onJointState(stamp, stamp, n, p, none, none);
   };
 
   const auto start = std::chrono::steady_clock::now();
   for (long i = 0; i < samples; ++i) {
     if (i == samples / 10) rss_10 = vmRssKb();
-    t = 1.0 + static_cast<double>(i) * dt;
+    const jle::Stamp stamp = 1700000000000000000 + i * dt;
+    const double t = 1.0 + static_cast<double>(i) * 1e-3;
     for (int k = 0; k < nq; ++k)
       position[static_cast<std::size_t>(k)] =
           0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
     const Eigen::Vector3d f(10.0 * std::sin(t), 2.0, -5.0), m(0.1, 0.2 * std::cos(t), 0.0);
-    if (!estimator.addWrench(0, t, f, m)) ++other;
+    if (pipeline.onWrench(0, stamp, stamp, frame, f, m) != Outcome::kUsed) ++other;
 
     // The good sample (every 50th carries an unknown joint name besides the 7).
-    std::optional<jle::SampleStatus> s;
+    Outcome s;
     if (i % 50 == 25) {
       ++injected[kUnknown];
       for (int k = 0; k < nq; ++k) position_unknown[static_cast<std::size_t>(k)] = position[static_cast<std::size_t>(k)];
       position_unknown.back() = 1.0;
-      s = message(t, names_unknown, position_unknown);
+      s = message(stamp, names_unknown, position_unknown);
     } else {
-      s = message(t, names, position);
+      s = message(stamp, names, position);
     }
     ++good;
-    if (!s) ++other;
-    else if (*s == jle::SampleStatus::kPublished) ++published;
-    else if (*s == jle::SampleStatus::kWarmingUp) ++warming;
+    if (s == Outcome::kPublished) ++published;
+    else if (s == Outcome::kUsed) (published == 0 ? warming : late_warming)++;
     else ++other;
 
     // The bad messages, after it.
     if (i % 50 != 10) continue;
+    const jle::Stamp half = dt / 2;
     switch ((i / 50) % 6) {
-      case 0: {  // a NaN position: the estimator refuses the sample
+      case 0: {  // a NaN position: refused before it reaches the filters
         ++injected[kNan];
         std::vector<double> p = position;
         p[3] = std::numeric_limits<double>::quiet_NaN();
-        s = message(t + 0.5 * dt, names, p);
-        if (s && *s == jle::SampleStatus::kNonFinite) ++counted[kNan];
-        // The next good message carries every joint, so the NaN does not linger.
+        message(stamp + half, names, p);
         break;
       }
       case 1:
         ++injected[kLength];
-        message(t + 0.5 * dt, names, short_position);
+        message(stamp + half, names, short_position);
         break;
       case 2:
         ++injected[kDuplicate];
-        s = message(t, names, position);
-        if (s && *s == jle::SampleStatus::kDuplicate) ++counted[kDuplicate];
+        message(stamp, names, position);
         break;
       case 3:
         ++injected[kBackward];
-        s = message(t - 0.5 * dt, names, position);
-        if (s && *s == jle::SampleStatus::kOutOfOrder) ++counted[kBackward];
+        message(stamp - half, names, position);
         break;
       case 4:
         ++injected[kWrenchNan];
-        if (!estimator.addWrench(0, t + 0.5 * dt,
-                                 Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0), m))
-          ++counted[kWrenchNan];
+        pipeline.onWrench(0, stamp + half, stamp + half, frame,
+                          Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0), m);
         break;
       default:
         ++injected[kWrenchBackward];
-        if (!estimator.addWrench(0, t - 0.5 * dt, f, m)) ++counted[kWrenchBackward];
+        pipeline.onWrench(0, stamp - half, stamp - half, frame, f, m);
         break;
     }
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const long rss_100 = vmRssKb();
+  const jle::PipelineCounters& c = pipeline.counters();
+  // What the pipeline counted, per kind of bad message (NaN and wrong length are both
+  // invalid joint states, duplicate and backward both out of order).
+  const long counted[kKinds] = {
+      c.count(InputKind::kJointState, Outcome::kInvalid) - injected[kLength],
+      c.count(InputKind::kJointState, Outcome::kInvalid) - injected[kNan],
+      c.count(InputKind::kJointState, Outcome::kOrder) - injected[kBackward],
+      c.count(InputKind::kJointState, Outcome::kOrder) - injected[kDuplicate],
+      c.unknown_joints,
+      c.count(InputKind::kWrench, Outcome::kInvalid),
+      c.count(InputKind::kWrench, Outcome::kOrder)};
 
   bool ok = true;
-  auto expect = [&](bool c, const char* what) {
-    if (!c) {
+  auto expect = [&](bool cond, const char* what) {
+    if (!cond) {
       std::printf("FAILED: %s\n", what);
       ok = false;
     }
   };
   std::printf("samples %ld in %.2f s (%.2f us/sample, %.0f simulated s)\n", samples, seconds,
-              1e6 * seconds / static_cast<double>(samples), static_cast<double>(samples) * dt);
+              1e6 * seconds / static_cast<double>(samples), static_cast<double>(samples) * 1e-3);
   std::printf("VmRSS at 10%%: %ld kB, at 100%%: %ld kB, growth %ld kB (limit 1024)\n", rss_10,
               rss_100, rss_100 - rss_10);
-  std::printf("good %ld: published %ld, warming up %ld (window - 1 = %d), other %ld\n", good,
-              published, warming, config.differentiator.window - 1, other);
+  std::printf("good %ld: published %ld, warming up %ld at the start, %ld later, other %ld\n",
+              good, published, warming, late_warming, other);
   for (int k = 0; k < kKinds; ++k)
     std::printf("bad %-16s injected %7ld counted %7ld\n", kBadName[k], injected[k], counted[k]);
   expect(rss_10 > 0 && rss_100 - rss_10 < 1024, "VmRSS grew by 1 MB or more");
-  expect(warming == config.differentiator.window - 1, "warm-up is not window - 1 samples");
+  expect(warming > 0 && warming < 20 && late_warming == 0,
+         "warm-up is not a few samples, once, at the start");
   expect(published == good - warming, "a good sample was not published");
-  expect(other == 0, "a good sample or wrench got another status");
+  expect(other == 0, "a good sample or wrench got another outcome");
+  expect(c.received(InputKind::kJointState) == good + injected[kNan] + injected[kLength] +
+                                                    injected[kDuplicate] + injected[kBackward],
+         "a joint state was not counted");
   for (int k = 0; k < kKinds; ++k) expect(injected[k] > 0 && counted[k] == injected[k], kBadName[k]);
   std::printf("soak: %s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;

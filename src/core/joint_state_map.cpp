@@ -1,58 +1,8 @@
-#include <joint_load_estimator/ros/message_inputs.hpp>
+#include <joint_load_estimator/joint_state_map.hpp>
 
 #include <limits>
-#include <stdexcept>
 
 namespace jle {
-
-ModelOptions modelOptions(const NodeSettings& settings) {
-  ModelOptions options;
-  options.floating_base = settings.floating_base;
-  options.keep_fixed_joints = settings.keep_fixed_joints;
-  return options;
-}
-
-void completeSensorLinks(const Model<double>& model, NodeSettings& settings) {
-  for (std::size_t k = 0; k < settings.wrenches.size(); ++k) {
-    WrenchInputConfig& input = settings.wrenches[k].input;
-    if (input.sensor_joint.empty() || !input.link.empty()) continue;
-    for (int s = 1; s < model.nsegments(); ++s)
-      if (model.joint_name[static_cast<std::size_t>(s)] == input.sensor_joint)
-        input.link = model.link_name[static_cast<std::size_t>(s)];
-    if (k < settings.estimator.wrenches.size()) settings.estimator.wrenches[k].link = input.link;
-  }
-}
-
-std::vector<int> publishedSegments(const Model<double>& model,
-                                   const std::vector<std::string>& joints) {
-  if (joints.empty()) return model.moving_segments;
-  std::vector<int> segments;
-  for (const std::string& j : joints) {
-    int segment = -1;
-    for (int s = 1; s < model.nsegments(); ++s)
-      if (model.joint_name[static_cast<std::size_t>(s)] == j &&
-          (isMoving(model.joint_type[static_cast<std::size_t>(s)]) ||
-           model.joint_type[static_cast<std::size_t>(s)] == JointType::kFixed))
-        segment = s;
-    if (segment < 0)
-      throw SettingsError("parameter 'joints': '" + j + "' is not a joint of the model");
-    segments.push_back(segment);
-  }
-  return segments;
-}
-
-bool rigidFrameInLink(const Model<double>& model, const std::string& link, const std::string& frame,
-                      Eigen::Matrix3d& R_link_frame, Eigen::Vector3d& p_link_frame) {
-  const Frame<double>& l = model.frames[static_cast<std::size_t>(model.frameIndex(link))];
-  for (const Frame<double>& f : model.frames) {
-    if (f.name != frame) continue;
-    if (f.segment != l.segment) return false;
-    R_link_frame = l.R_segment_frame.transpose() * f.R_segment_frame;
-    p_link_frame = l.R_segment_frame.transpose() * (f.p_segment_frame - l.p_segment_frame);
-    return true;
-  }
-  return false;
-}
 
 JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>& published_segments)
     : coordinate_names_(model.coordinate_names),

@@ -1,0 +1,53 @@
+// Joint states, which may each carry a subset of the joints (several publishers), mapped
+// onto the model's coordinates. ROS-free; the Pipeline's unit for it.
+#pragma once
+
+#include <joint_load_estimator/model.hpp>
+
+#include <string>
+#include <vector>
+
+namespace jle {
+
+/// The latest position of every coordinate and the latest measured effort of every
+/// published joint, from joint-state messages that may each carry a subset of the
+/// joints. The name-to-index mapping is cached for the last layout of names seen, so a
+/// stream of messages with one layout costs string comparisons and no allocation.
+class JointStateMap {
+ public:
+  /// `published_segments` as publishedSegments() returns them.
+  JointStateMap(const Model<double>& model, const std::vector<int>& published_segments);
+
+  /// Takes a message's names and positions (same size, checked by the caller) and its
+  /// efforts (empty, or the same size). Mimic joints are ignored (a mimic follows its
+  /// leader). Returns the index in `names` of the first joint the model does not have,
+  /// or -1 if there is none (the others are still taken).
+  int update(const std::vector<std::string>& names, const std::vector<double>& position,
+             const std::vector<double>& effort);
+
+  /// The positions, model.coordinate_names order (size nq).
+  const std::vector<double>& q() const { return q_; }
+  /// Whether coordinate k has had a position.
+  bool received(int k) const { return received_[static_cast<std::size_t>(k)] != 0; }
+  /// Index of the first coordinate with no position received yet, or -1 if none.
+  int firstMissing() const;
+  /// Latest measured effort per published joint (NaN until one is received).
+  const std::vector<double>& effort() const { return effort_; }
+
+ private:
+  void bind(const std::vector<std::string>& names);
+
+  std::vector<std::string> coordinate_names_;
+  std::vector<std::string> moving_joint_names_;  // every moving joint, mimics included
+  std::vector<std::string> published_joint_names_;
+  std::vector<double> q_;
+  std::vector<char> received_;
+  std::vector<double> effort_;
+  // Cached binding of the last layout of names: per message index, the coordinate
+  // (-1: none: a mimic or unknown), the published joint (-1: none) and whether known.
+  std::vector<std::string> layout_;
+  std::vector<int> coordinate_of_, published_of_;
+  std::vector<char> known_;
+};
+
+}  // namespace jle

@@ -1,0 +1,218 @@
+// The whole message path, ROS-free: raw samples (joint states, wrenches, force plates,
+// each with its stamp) in, one result record out. Every front end drives it: the node,
+// the nodelet, process_bag, the soaks and the fuzzers; a front end converts messages to
+// its arguments and its record to messages, and decides nothing. Offline and online give
+// the same loads for the same samples in the same order.
+#pragma once
+
+#include <joint_load_estimator/config.hpp>
+#include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/joint_state_map.hpp>
+#include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace jle {
+
+/// A message stamp [ns since the epoch]: a ROS header's sec * 1e9 + nsec.
+using Stamp = std::int64_t;
+
+/// What became of one input message. Every message is either used or counted under
+/// the reason it was not (PipelineCounters).
+enum class Outcome : std::uint8_t {
+  kUsed,          ///< taken (a joint state entered the filters; no loads for it yet)
+  kPublished,     ///< a joint state: loads computed, record() holds them
+  kInvalid,       ///< sizes disagree, or a non-finite value
+  kOrder,         ///< same or older stamp than the input's previous one
+  kFrame,         ///< frame neither rigid to the link in the URDF nor known to the FrameSource
+  kNoBasePose,    ///< floating base: no pose of the base at the stamp
+  kWaiting,       ///< a coordinate the computed loads need has had no position yet
+  kStale,         ///< an input with stale_policy stop is stale: no loads
+  kUnchanged,     ///< same filtered inputs as the last loads and republish_unchanged off
+  kCount
+};
+
+const char* toString(Outcome outcome);
+
+/// The kinds of input message, for counting and for throttling messages per kind.
+enum class InputKind : std::uint8_t { kJointState, kWrench, kPlate, kCount };
+
+/// Counts per kind of input and per outcome, plus the events.
+struct PipelineCounters {
+  std::array<std::array<long, static_cast<int>(Outcome::kCount)>,
+             static_cast<int>(InputKind::kCount)>
+      outcomes{};
+  long unknown_joints = 0;  ///< joint states naming a joint the model does not have
+  long resets = 0;          ///< backward time jumps (the filters were reset)
+
+  long received(InputKind kind) const;
+  long count(InputKind kind, Outcome outcome) const {
+    return outcomes[static_cast<int>(kind)][static_cast<int>(outcome)];
+  }
+  /// Over every kind of input.
+  long count(Outcome outcome) const;
+};
+
+/// Frames the URDF does not hold rigidly (tf2 in the ROS layer: the node's listener, or
+/// process_bag's buffer filled from a bag's /tf and /tf_static).
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  /// Pose of `frame` in `target` at `stamp` (0: the latest known). False with `error`
+  /// set when it is not known at that stamp.
+  virtual bool lookup(const std::string& target, const std::string& frame, Stamp stamp,
+                      Eigen::Isometry3d& X_target_frame, std::string& error) = 0;
+};
+
+/// The loads of one published sample, sized at construction (no allocation per sample).
+/// Index i runs over the published joints.
+struct LoadsRecord {
+  Stamp stamp = 0;                 ///< the stamp of the joint state the loads describe
+  std::vector<std::string> joint;  ///< URDF joint names
+  std::vector<std::string> link;   ///< child link: the frame of force and moment
+  std::vector<int> segment;        ///< model segment of each joint
+  /// Joint wrench (on the child, by the parent), child link frame, moment about the
+  /// joint origin [N], [N m].
+  std::vector<Eigen::Vector3d> force, moment;
+  std::vector<double> effort;           ///< [N m or N] projection on the joint axis
+  std::vector<double> measured_effort;  ///< from the joint state at `stamp`; NaN: none
+  /// With uncertainty enabled: 1-sigma effort [N m or N] and the wrench covariance per
+  /// joint, row-major, 36 numbers (fx fy fz mx my mz), or 6 variances (diagonal_only).
+  std::vector<double> effort_stddev, covariance;
+  std::vector<double> effort_per_kg;  ///< effort / body_mass; empty when not configured
+};
+
+/// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
+ModelOptions modelOptions(const Settings& settings);
+
+/// Segments whose loads are published: `joints` (URDF names of moving joints, or of
+/// fixed joints kept as segments), or every moving segment when it is empty. Throws
+/// SettingsError naming the joint.
+std::vector<int> publishedSegments(const Model<double>& model,
+                                   const std::vector<std::string>& joints);
+
+class Pipeline {
+ public:
+  /// `model` as modelOptions(settings) asks. `frames` may be null (only the URDF's own
+  /// frames are known) and must outlive the pipeline. Throws SettingsError or
+  /// std::invalid_argument naming the key, link or joint.
+  Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames);
+
+  /// A joint state: names, positions (same size), velocities and efforts (empty or the
+  /// same size). `stamp` 0 is replaced by `clock`, the front end's clock when the
+  /// message arrived (the node: ros::Time::now(); a bag: the message's bag time), which
+  /// also tells a backward jump of time (a looping bag).
+  Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
+                       const std::vector<double>& position, const std::vector<double>& velocity,
+                       const std::vector<double>& effort);
+  /// A wrench of input k (settings.wrenches[k]) as the message carries it: force [N]
+  /// and torque [N m] in `frame_id` (the configured frame, when set, wins), moment about
+  /// its origin.
+  Outcome onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
+                   const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
+  /// A sample of force plate k (settings.force_plates[k]): what the foot applies to
+  /// the plate, plate frame, moment about the plate origin.
+  Outcome onPlate(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
+                  const Eigen::Vector3d& force, const Eigen::Vector3d& moment);
+
+  /// The sensor offset of wrench input k in the reading's own frame and sign,
+  /// subtracted from every later reading (bias_file, ~calibrate_bias).
+  void setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
+  const Eigen::Vector3d& sensorBiasForce(int k) const { return wrenches_[ix(k)].bias_force; }
+  const Eigen::Vector3d& sensorBiasTorque(int k) const { return wrenches_[ix(k)].bias_torque; }
+
+  /// Why the last message was not used (its outcome's explanation, naming the joint,
+  /// input or frame); empty after a used message.
+  const std::string& problem() const { return problem_; }
+  /// The first joint of the last joint state that the model does not have (ignored,
+  /// the others used), or empty.
+  const std::string& unknownJoint() const { return unknown_joint_; }
+  /// Whether the last message reset the filters (time jumped back), and from when to
+  /// when [ns].
+  bool jumped() const { return jumped_; }
+  Stamp jumpFrom() const { return jump_from_; }
+  Stamp jumpTo() const { return jump_to_; }
+
+  const LoadsRecord& record() const { return record_; }
+  const PipelineCounters& counters() const { return counters_; }
+  const Settings& settings() const { return settings_; }
+  const Estimator& estimator() const { return estimator_; }
+  const Model<double>& model() const { return estimator_.model(); }
+  /// The stamp [ns] of the estimator's time t [s].
+  Stamp absolute(double t) const;
+
+  /// Wrench input k's last resolved frame and its pose in the input's link (the
+  /// sensor residual is re-expressed in it).
+  const std::string& wrenchFrame(int k) const { return wrenches_[ix(k)].frame; }
+  const Eigen::Isometry3d& wrenchFramePose(int k) const { return wrenches_[ix(k)].X_link_frame; }
+  /// The frame of plate k whose pose the estimator holds (the COP's frame), or empty.
+  const std::string& plateFrame(int k) const { return plates_[ix(k)].frame; }
+
+ private:
+  struct WrenchInput {
+    std::string frame;  // last resolved frame
+    bool rigid = false;  // `frame` is a URDF frame rigid to the link: pose cached
+    Eigen::Isometry3d X_link_frame = Eigen::Isometry3d::Identity();
+    Eigen::Vector3d bias_force = Eigen::Vector3d::Zero(), bias_torque = Eigen::Vector3d::Zero();
+  };
+  struct PlateInput {
+    std::string frame;  // frame whose pose the estimator holds
+    bool pose_known = false;
+  };
+  // One joint sample entering the filters: its time, stamp and measured efforts.
+  struct Sample {
+    double t = 0.0;
+    Stamp stamp = 0;
+    bool has_effort = false;
+    std::vector<double> effort;
+  };
+
+  static std::size_t ix(int k) { return static_cast<std::size_t>(k); }
+  double relative(Stamp stamp);
+  Outcome count(InputKind kind, Outcome outcome);
+  Outcome fail(InputKind kind, Outcome outcome, const std::string& why);
+  void checkTimeJump(Stamp stamp, Stamp clock);
+  bool checkJointState(const std::vector<std::string>& names, const std::vector<double>& position,
+                       const std::vector<double>& velocity, const std::vector<double>& effort);
+  void mapJointState(const std::vector<std::string>& names, const std::vector<double>& position,
+                     const std::vector<double>& effort);
+  bool basePose(Stamp stamp, BasePose& base);
+  Outcome sample(Stamp stamp, double t, bool has_effort, const BasePose* base);
+  Outcome staleProblem();
+  void remember(double t, Stamp stamp, bool has_effort);
+  bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
+  bool resolvePlatePose(int k, const std::string& frame);
+  void fillRecord();
+  const Sample* sampleAt(double t) const;
+
+  Settings settings_;
+  FrameSource* frames_;
+  Estimator estimator_;
+  JointStateMap joints_;
+  LoadsRecord record_;
+  PipelineCounters counters_;
+  std::vector<WrenchInput> wrenches_;
+  std::vector<PlateInput> plates_;
+  double body_mass_ = 0.0;  // [kg] effort_per_kg divisor; 0: none
+  // The time axis: seconds since the first stamp seen (a double holds epoch seconds only
+  // to 2.4e-7 s). Kept across resets: a negative time is fine.
+  Stamp time_ref_ = 0;
+  bool have_ref_ = false;
+  Stamp last_stamp_ = 0;  // last joint state taken (0 after a reset)
+  Stamp last_clock_ = 0;
+  // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
+  std::vector<Sample> ring_;
+  std::size_t ring_head_ = 0, ring_count_ = 0;
+  std::string problem_, unknown_joint_;
+  bool jumped_ = false;
+  Stamp jump_from_ = 0, jump_to_ = 0;
+};
+
+}  // namespace jle

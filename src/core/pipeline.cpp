@@ -1,0 +1,455 @@
+#include <joint_load_estimator/frames.hpp>
+#include <joint_load_estimator/pipeline.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+
+namespace jle {
+namespace {
+
+constexpr std::size_t kRing = 128;  // joint samples remembered: more than any filter's delay
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr Stamp kReach = Stamp{1} << 52;  // [ns] of the time axis around its origin
+
+bool allFinite(const std::vector<double>& v, std::size_t& bad) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i])) {
+      bad = i;
+      return false;
+    }
+  return true;
+}
+
+std::string seconds(Stamp stamp) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9f", static_cast<double>(stamp) * 1e-9);
+  return text;
+}
+
+}  // namespace
+
+const char* toString(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kUsed: return "used";
+    case Outcome::kPublished: return "published";
+    case Outcome::kInvalid: return "invalid";
+    case Outcome::kOrder: return "stamp order";
+    case Outcome::kFrame: return "unresolved frame";
+    case Outcome::kNoBasePose: return "no base pose";
+    case Outcome::kWaiting: return "waiting for a joint";
+    case Outcome::kStale: return "stale input";
+    case Outcome::kUnchanged: return "unchanged";
+    case Outcome::kCount: break;
+  }
+  return "?";
+}
+
+long PipelineCounters::received(InputKind kind) const {
+  long n = 0;
+  for (long c : outcomes[static_cast<int>(kind)]) n += c;
+  return n;
+}
+
+long PipelineCounters::count(Outcome outcome) const {
+  long n = 0;
+  for (const auto& kind : outcomes) n += kind[static_cast<int>(outcome)];
+  return n;
+}
+
+ModelOptions modelOptions(const Settings& settings) {
+  ModelOptions options;
+  options.floating_base = settings.floating_base;
+  options.keep_fixed_joints = settings.keep_fixed_joints;
+  for (const WrenchInputConfig& input : settings.estimator.wrenches)
+    if (!input.sensor_joint.empty() &&
+        std::find(options.keep_fixed_joints.begin(), options.keep_fixed_joints.end(),
+                  input.sensor_joint) == options.keep_fixed_joints.end())
+      options.keep_fixed_joints.push_back(input.sensor_joint);
+  return options;
+}
+
+std::vector<int> publishedSegments(const Model<double>& model,
+                                   const std::vector<std::string>& joints) {
+  if (joints.empty()) return model.moving_segments;
+  std::vector<int> segments;
+  for (const std::string& j : joints) {
+    int segment = -1;
+    for (int s = 1; s < model.nsegments(); ++s) {
+      const JointType type = model.joint_type[static_cast<std::size_t>(s)];
+      if (model.joint_name[static_cast<std::size_t>(s)] == j &&
+          (isMoving(type) || type == JointType::kFixed))
+        segment = s;
+    }
+    if (segment < 0)
+      throw SettingsError("parameter 'joints': '" + j + "' is not a joint of the model");
+    segments.push_back(segment);
+  }
+  return segments;
+}
+
+namespace {
+
+// The link of every force/torque sensor input (sensor_joint set, link empty) is its
+// joint's child link. Joints the model does not keep are left for the Estimator to
+// refuse by name.
+Settings checkedSettings(const Model<double>& model, Settings settings) {
+  validate(settings);
+  for (WrenchInputConfig& input : settings.estimator.wrenches) {
+    if (input.sensor_joint.empty() || !input.link.empty()) continue;
+    for (int s = 1; s < model.nsegments(); ++s)
+      if (model.joint_name[static_cast<std::size_t>(s)] == input.sensor_joint)
+        input.link = model.link_name[static_cast<std::size_t>(s)];
+  }
+  if (model.floating_base && settings.base_frame.empty()) settings.base_frame = model.link_name[0];
+  return settings;
+}
+
+}  // namespace
+
+Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames)
+    : settings_(checkedSettings(model, settings)),
+      frames_(frames),
+      estimator_(model, settings_.estimator),
+      joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints)),
+      wrenches_(settings_.estimator.wrenches.size()),
+      plates_(settings_.estimator.plates.size()),
+      ring_(kRing) {
+  const Model<double>& m = estimator_.model();
+  record_.segment = publishedSegments(m, settings_.estimator.joints);
+  const std::size_t n = record_.segment.size();
+  for (int s : record_.segment) {
+    record_.joint.push_back(m.joint_name[static_cast<std::size_t>(s)]);
+    record_.link.push_back(m.link_name[static_cast<std::size_t>(s)]);
+  }
+  record_.force.assign(n, Eigen::Vector3d::Zero());
+  record_.moment.assign(n, Eigen::Vector3d::Zero());
+  record_.effort.assign(n, 0.0);
+  record_.measured_effort.assign(n, kNaN);
+  const UncertaintyConfig& u = settings_.estimator.uncertainty;
+  if (u.enabled) {
+    record_.effort_stddev.assign(n, 0.0);
+    record_.covariance.assign((u.diagonal_only ? 6 : 36) * n, 0.0);
+  }
+  if (settings_.body_mass != 0.0) {
+    body_mass_ = settings_.body_mass > 0.0 ? settings_.body_mass : m.totalMass();
+    if (!(body_mass_ > 0.0))
+      throw SettingsError("parameter 'body_mass' is -1 but the URDF's total mass is " +
+                          std::to_string(body_mass_) + " kg");
+    record_.effort_per_kg.assign(n, 0.0);
+  }
+  for (Sample& s : ring_) s.effort.assign(n, kNaN);
+}
+
+double Pipeline::relative(Stamp stamp) {
+  if (!have_ref_) {
+    time_ref_ = stamp;
+    have_ref_ = true;
+  }
+  return static_cast<double>(stamp - time_ref_) * 1e-9;
+}
+
+Stamp Pipeline::absolute(double t) const {
+  const Sample* s = sampleAt(t);
+  return s ? s->stamp : time_ref_ + static_cast<Stamp>(std::llround(t * 1e9));
+}
+
+Outcome Pipeline::count(InputKind kind, Outcome outcome) {
+  ++counters_.outcomes[static_cast<int>(kind)][static_cast<int>(outcome)];
+  return outcome;
+}
+
+Outcome Pipeline::fail(InputKind kind, Outcome outcome, const std::string& why) {
+  problem_ = why;
+  return count(kind, outcome);
+}
+
+void Pipeline::checkTimeJump(Stamp stamp, Stamp clock) {
+  // A looping bag (rosbag play -l) or a restarted simulation sends time backwards: the
+  // filters' memory belongs to another timeline. The clock and the stamps come on
+  // different connections, so the clock may go back one message after the stamps did
+  // (or before): a clock going back is a jump only while the stamps do not go forward,
+  // else one jump would reset twice.
+  jumped_ = false;
+  const bool clock_back = last_clock_ != 0 && clock < last_clock_ && !(stamp > last_stamp_);
+  const bool stamp_back = last_stamp_ != 0 && static_cast<double>(last_stamp_ - stamp) * 1e-9 >
+                                                  settings_.time_jump_threshold;
+  // The time axis resolves 1 ns within 2^52 ns (52 days) of its origin: a stamp farther
+  // away starts a new timeline, with a new origin.
+  const bool far = have_ref_ && std::abs(stamp - time_ref_) > kReach;
+  last_clock_ = clock;
+  if (far) have_ref_ = false;
+  if (!clock_back && !stamp_back && !far) return;
+  jumped_ = true;
+  jump_from_ = last_stamp_;
+  jump_to_ = stamp;
+  estimator_.reset();
+  ring_count_ = 0;
+  last_stamp_ = 0;
+  ++counters_.resets;
+}
+
+bool Pipeline::checkJointState(const std::vector<std::string>& names,
+                               const std::vector<double>& position,
+                               const std::vector<double>& velocity,
+                               const std::vector<double>& effort) {
+  const std::string& topic = settings_.joint_states_topic;
+  const std::size_t n = names.size();
+  const std::pair<const char*, const std::vector<double>*> fields[] = {
+      {"position", &position}, {"velocity", &velocity}, {"effort", &effort}};
+  for (const auto& field : fields) {
+    const std::size_t size = field.second->size();
+    if (size != n && (size != 0 || field.second == &position)) {
+      problem_ = topic + ": " + std::to_string(n) + " names but " + std::to_string(size) + " " +
+                 field.first + " values: message dropped";
+      return false;
+    }
+  }
+  std::size_t bad = 0;
+  for (const auto& field : fields)
+    if (!allFinite(*field.second, bad)) {
+      problem_ = topic + ": " + field.first + " of joint '" + names[bad] + "' is " +
+                 std::to_string((*field.second)[bad]) + ": message dropped";
+      return false;
+    }
+  return true;
+}
+
+void Pipeline::mapJointState(const std::vector<std::string>& names,
+                             const std::vector<double>& position,
+                             const std::vector<double>& effort) {
+  const int unknown = joints_.update(names, position, effort);
+  if (unknown < 0) {
+    unknown_joint_.clear();
+    return;
+  }
+  unknown_joint_ = names[static_cast<std::size_t>(unknown)];
+  ++counters_.unknown_joints;
+}
+
+Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
+                               const std::vector<double>& position,
+                               const std::vector<double>& velocity,
+                               const std::vector<double>& effort) {
+  constexpr InputKind kind = InputKind::kJointState;
+  problem_.clear();
+  unknown_joint_.clear();
+  if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
+  if (stamp == 0) stamp = clock;
+  checkTimeJump(stamp, clock);
+  mapJointState(names, position, effort);
+  const double t = relative(stamp);
+  for (int i = 0; i < model().nq; ++i)
+    if (!joints_.received(i) && estimator_.coordinateNeeded(i))
+      return fail(kind, Outcome::kWaiting,
+                  settings_.joint_states_topic + ": no position received yet for joint '" +
+                      model().coordinate_names[static_cast<std::size_t>(i)] + "': not publishing");
+  BasePose base;
+  if (model().floating_base && !basePose(stamp, base)) return count(kind, Outcome::kNoBasePose);
+  return sample(stamp, t, !effort.empty(), &base);
+}
+
+bool Pipeline::basePose(Stamp stamp, BasePose& base) {
+  std::string error = "no frame source (tf2)";
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  if (frames_ && frames_->lookup(settings_.world_frame, settings_.base_frame, stamp, X, error)) {
+    base.position = X.translation();
+    base.orientation = Eigen::Quaterniond(X.rotation());
+    return true;
+  }
+  problem_ = "floating base: no pose of '" + settings_.base_frame + "' in '" +
+             settings_.world_frame + "' at " + seconds(stamp) + ": " + error;
+  return false;
+}
+
+Outcome Pipeline::sample(Stamp stamp, double t, bool has_effort, const BasePose* base) {
+  constexpr InputKind kind = InputKind::kJointState;
+  const SampleStatus status = estimator_.addJointSample(t, joints_.q().data(), base);
+  switch (status) {
+    case SampleStatus::kDuplicate:
+    case SampleStatus::kOutOfOrder:
+      return fail(kind, Outcome::kOrder,
+                  settings_.joint_states_topic + ": " + toString(status) + " " + seconds(stamp) +
+                      " (previous " + seconds(last_stamp_) + "): message dropped");
+    case SampleStatus::kNonFinite:
+      return fail(kind, Outcome::kInvalid,
+                  settings_.joint_states_topic + ": non-finite stamp or base pose: dropped");
+    default: break;
+  }
+  last_stamp_ = stamp;
+  remember(t, stamp, has_effort);
+  if (status == SampleStatus::kStale) return staleProblem();
+  if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
+  if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged)
+    return count(kind, Outcome::kUnchanged);
+  fillRecord();
+  return count(kind, Outcome::kPublished);
+}
+
+Outcome Pipeline::staleProblem() {
+  std::string stale;
+  for (std::size_t k = 0; k < wrenches_.size(); ++k)
+    if (estimator_.stale(static_cast<int>(k)))
+      stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
+  for (std::size_t k = 0; k < plates_.size(); ++k)
+    if (estimator_.plateStale(static_cast<int>(k)))
+      stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
+  return fail(InputKind::kJointState, Outcome::kStale,
+              "stale inputs (stale_policy stop): " + stale + ": not publishing");
+}
+
+void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
+  Sample& s = ring_[ring_head_];
+  s.t = t;
+  s.stamp = stamp;
+  s.has_effort = has_effort;
+  if (has_effort) s.effort = joints_.effort();  // same size: no allocation
+  ring_head_ = (ring_head_ + 1) % kRing;
+  if (ring_count_ < kRing) ++ring_count_;
+}
+
+const Pipeline::Sample* Pipeline::sampleAt(double t) const {
+  // The estimate's time is one of the samples' own times (the filter's delay is a whole
+  // number of samples); half a nanosecond separates it from any other.
+  for (std::size_t i = 0; i < ring_count_; ++i) {
+    const Sample& s = ring_[(ring_head_ + kRing - 1 - i) % kRing];
+    if (std::abs(s.t - t) < 0.5e-9) return &s;
+  }
+  return nullptr;
+}
+
+void Pipeline::fillRecord() {
+  const Data<double>& data = estimator_.data();
+  const Sample* s = sampleAt(estimator_.stamp());
+  record_.stamp = s ? s->stamp : absolute(estimator_.stamp());
+  const bool measured = s && s->has_effort;
+  const UncertaintyConfig& u = settings_.estimator.uncertainty;
+  const std::size_t per_joint = u.diagonal_only ? 6 : 36;
+  for (std::size_t i = 0; i < record_.segment.size(); ++i) {
+    const int segment = record_.segment[i];
+    const std::size_t j = static_cast<std::size_t>(segment);
+    record_.force[i] = data.force[j];
+    record_.moment[i] = data.moment[j];
+    record_.effort[i] = data.effort[j];
+    record_.measured_effort[i] = measured ? s->effort[i] : kNaN;
+    if (!record_.effort_per_kg.empty()) record_.effort_per_kg[i] = data.effort[j] / body_mass_;
+    if (!u.enabled) continue;
+    const Eigen::Matrix<double, 6, 6>& C = estimator_.covariance(segment);
+    double* out = &record_.covariance[per_joint * i];
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c)
+        if (!u.diagonal_only)
+          out[6 * r + c] = C(r, c);
+        else if (r == c)
+          out[r] = C(r, r);
+    record_.effort_stddev[i] = std::sqrt(estimator_.effortVariance(segment));
+  }
+}
+
+void Pipeline::setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
+  wrenches_.at(ix(k)).bias_force = force;
+  wrenches_[ix(k)].bias_torque = torque;
+}
+
+bool Pipeline::resolveWrenchFrame(int k, const std::string& frame, Stamp stamp) {
+  WrenchInput& input = wrenches_[ix(k)];
+  if (input.rigid && frame == input.frame) return true;
+  const std::string& link = settings_.estimator.wrenches[ix(k)].link;
+  input.frame = frame;
+  // A URDF frame on the same segment as the link: a constant transform from the model.
+  Eigen::Matrix3d R;
+  Eigen::Vector3d p;
+  input.rigid = rigidFrameInLink(model(), link, frame, R, p);
+  if (input.rigid) {
+    input.X_link_frame.linear() = R;
+    input.X_link_frame.translation() = p;
+    return true;
+  }
+  std::string error = "no frame source (tf2)";
+  if (frames_ && frames_->lookup(link, frame, stamp, input.X_link_frame, error)) return true;
+  problem_ = "wrench '" + settings_.wrenches[ix(k)].topic + "': frame '" + frame +
+             "' is neither a URDF link rigid to '" + link + "' nor known to tf2: " + error;
+  return false;
+}
+
+Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
+                           const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
+  constexpr InputKind kind = InputKind::kWrench;
+  problem_.clear();
+  const std::string& topic = settings_.wrenches.at(ix(k)).topic;
+  if (!force.allFinite() || !torque.allFinite())
+    return fail(kind, Outcome::kInvalid, "wrench '" + topic + "': non-finite force or torque: dropped");
+  const std::string& configured = settings_.wrenches[ix(k)].frame;
+  const std::string& frame = configured.empty() ? frame_id : configured;
+  if (frame.empty())
+    return fail(kind, Outcome::kFrame,
+                "wrench '" + topic + "': empty header.frame_id and no 'frame' configured: dropped");
+  if (stamp == 0) stamp = clock;
+  // A looping bag may deliver the new loop's first wrench before its first joint state:
+  // the jump is detected here too, so that wrench is not refused as old.
+  checkTimeJump(stamp, clock);
+  if (!resolveWrenchFrame(k, frame, stamp)) return count(kind, Outcome::kFrame);
+  const WrenchInput& input = wrenches_[ix(k)];
+  // The sensor's offset is in its own frame and sign: removed before anything else.
+  const Eigen::Vector3d f = force - input.bias_force, m = torque - input.bias_torque;
+  Eigen::Vector3d f_link, m_link;
+  wrenchInLink(input.X_link_frame.linear(), input.X_link_frame.translation(), f, m, f_link,
+               m_link);
+  if (!estimator_.addWrench(k, relative(stamp), f_link, m_link))
+    return fail(kind, Outcome::kOrder,
+                "wrench '" + topic + "': stamp " + seconds(stamp) + " not newer than the last: dropped");
+  return count(kind, Outcome::kUsed);
+}
+
+bool Pipeline::resolvePlatePose(int k, const std::string& frame) {
+  PlateInput& plate = plates_[ix(k)];
+  if (plate.pose_known && frame == plate.frame) return true;
+  if (settings_.force_plates[ix(k)].pose_configured) {  // the estimator holds the configured pose
+    plate.frame = frame;
+    plate.pose_known = true;
+    return true;
+  }
+  // A lab plate is fixed in the world: looked up until found, then kept. The estimator's
+  // world is world_frame for a floating base, the URDF root link for a fixed one.
+  const std::string& world = model().floating_base ? settings_.world_frame : model().link_name[0];
+  std::string error = "no frame source (tf2)";
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  if (!frames_ || !frames_->lookup(world, frame, 0, X, error)) {
+    problem_ = "force plate '" + settings_.estimator.plates[ix(k)].plate.name +
+               "': no pose of frame '" + frame + "' in '" + world +
+               "' from tf2 (and no position/orientation configured): " + error;
+    return false;
+  }
+  estimator_.setPlatePose(k, X.rotation(), X.translation());
+  plate.frame = frame;
+  plate.pose_known = true;
+  return true;
+}
+
+Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
+                          const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
+  constexpr InputKind kind = InputKind::kPlate;
+  problem_.clear();
+  const std::string& name = settings_.estimator.plates.at(ix(k)).plate.name;
+  if (!force.allFinite() || !moment.allFinite())
+    return fail(kind, Outcome::kInvalid,
+                "force plate '" + name + "': non-finite force or torque: dropped");
+  const PlateTopicSettings& configured = settings_.force_plates[ix(k)];
+  const std::string& frame = configured.frame.empty() ? frame_id : configured.frame;
+  if (frame.empty() && !configured.pose_configured)
+    return fail(kind, Outcome::kFrame,
+                "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
+  if (stamp == 0) stamp = clock;
+  checkTimeJump(stamp, clock);  // as for wrenches: a looping bag
+  if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
+  if (!estimator_.addPlateSample(k, relative(stamp), force, moment))
+    return fail(kind, Outcome::kOrder,
+                "force plate '" + name + "': stamp " + seconds(stamp) +
+                    " not newer than the last: dropped");
+  return count(kind, Outcome::kUsed);
+}
+
+}  // namespace jle

@@ -1,0 +1,85 @@
+#include <joint_load_estimator/ros/conversions.hpp>
+
+#include <tf2/exceptions.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+namespace jle {
+namespace {
+
+void fromMsg(const geometry_msgs::WrenchStamped& msg, Eigen::Vector3d& f, Eigen::Vector3d& m) {
+  f << msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z;
+  m << msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z;
+}
+
+}  // namespace
+
+bool Tf2FrameSource::lookup(const std::string& target, const std::string& frame, Stamp stamp,
+                            Eigen::Isometry3d& X_target_frame, std::string& error) {
+  try {
+    X_target_frame =
+        tf2::transformToEigen(buffer_.lookupTransform(target, frame, toRosTime(stamp)));
+    return true;
+  } catch (const tf2::TransformException& e) {
+    error = e.what();
+    return false;
+  }
+}
+
+Outcome feed(Pipeline& pipeline, const sensor_msgs::JointState& msg, const ros::Time& clock) {
+  return pipeline.onJointState(toStamp(msg.header.stamp), toStamp(clock), msg.name, msg.position,
+                               msg.velocity, msg.effort);
+}
+
+Outcome feedWrench(Pipeline& pipeline, int k, const geometry_msgs::WrenchStamped& msg,
+                   const ros::Time& clock) {
+  Eigen::Vector3d f, m;
+  fromMsg(msg, f, m);
+  return pipeline.onWrench(k, toStamp(msg.header.stamp), toStamp(clock), msg.header.frame_id, f,
+                           m);
+}
+
+Outcome feedPlate(Pipeline& pipeline, int k, const geometry_msgs::WrenchStamped& msg,
+                  const ros::Time& clock) {
+  Eigen::Vector3d f, m;
+  fromMsg(msg, f, m);
+  return pipeline.onPlate(k, toStamp(msg.header.stamp), toStamp(clock), msg.header.frame_id, f,
+                          m);
+}
+
+void prepare(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
+  const std::size_t n = record.joint.size();
+  msg.name = record.joint;
+  msg.wrench.resize(n);
+  msg.effort.resize(n);
+  msg.measured_effort.resize(n);
+  msg.effort_stddev.resize(record.effort_stddev.size());
+  msg.covariance.resize(record.covariance.size());
+  msg.effort_per_kg.resize(record.effort_per_kg.size());
+}
+
+void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
+  msg.header.stamp = toRosTime(record.stamp);
+  for (std::size_t i = 0; i < record.joint.size(); ++i) {
+    geometry_msgs::Wrench& w = msg.wrench[i];
+    w.force.x = record.force[i].x();
+    w.force.y = record.force[i].y();
+    w.force.z = record.force[i].z();
+    w.torque.x = record.moment[i].x();
+    w.torque.y = record.moment[i].y();
+    w.torque.z = record.moment[i].z();
+  }
+  msg.effort = record.effort;  // equal sizes: copies, no allocation
+  msg.measured_effort = record.measured_effort;
+  msg.effort_stddev = record.effort_stddev;
+  msg.covariance = record.covariance;
+  msg.effort_per_kg = record.effort_per_kg;
+}
+
+void toWrenchMessage(const LoadsRecord& record, std::size_t i, geometry_msgs::WrenchStamped& msg) {
+  msg.header.stamp = toRosTime(record.stamp);
+  msg.header.frame_id = record.link[i];
+  msg.wrench.force = tf2::toMsg(record.force[i], msg.wrench.force);
+  msg.wrench.torque = tf2::toMsg(record.moment[i], msg.wrench.torque);
+}
+
+}  // namespace jle

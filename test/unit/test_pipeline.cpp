@@ -1,0 +1,325 @@
+// The message path (pipeline.hpp), against independent references: the exact loads of
+// an exactly differentiable trajectory fed as partial joint states from two publishers
+// with jittered stamps; the joints a published subset needs; stamps and measured
+// efforts paired with a delayed estimate; frames from the URDF and from a frame source;
+// a floating base; sensor biases; time jumps; and that every message is counted once.
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+namespace {
+
+using jle::InputKind;
+using jle::Outcome;
+using jle::Stamp;
+
+const std::string kData = JLE_TEST_DATA;
+constexpr Stamp kStart = 1700000000123456789;  // [ns]
+constexpr Stamp kMs = 1000000;
+const std::vector<double> kNone;
+
+jle::Model<double> ur5() { return jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf"); }
+
+// The arm's joints (0-2): q_i(t) = a_i + b_i t + c_i t^2 (t [s] since kStart), for which
+// the 3-point difference is exact; the wrist's (3-5) are held still, so that a sample
+// holding their last message's positions is exact too.
+double q(int i, double t) {
+  return i < 3 ? 0.1 * i - 0.3 + (0.5 - 0.2 * i) * t + 0.7 * std::cos(i) * t * t : 0.2 * i;
+}
+double qd(int i, double t) { return i < 3 ? (0.5 - 0.2 * i) + 1.4 * std::cos(i) * t : 0.0; }
+double qdd(int i) { return i < 3 ? 1.4 * std::cos(i) : 0.0; }
+
+jle::Settings finiteDifferences() {
+  jle::Settings s;
+  s.estimator.differentiator.type = jle::DifferentiatorType::kFiniteDifference;
+  s.estimator.differentiator.window = 3;
+  return s;
+}
+
+void addWrenchInput(jle::Settings& s, const std::string& link, const std::string& frame = "") {
+  jle::WrenchInputConfig input;
+  input.name = "ft";
+  input.link = link;
+  s.estimator.wrenches.push_back(input);
+  jle::WrenchTopicSettings topic;
+  topic.topic = "ft";
+  topic.frame = frame;
+  s.wrenches.push_back(topic);
+}
+
+// Frames a test names, at any stamp (a tf2 buffer's role).
+class FixedFrames : public jle::FrameSource {
+ public:
+  std::map<std::pair<std::string, std::string>, Eigen::Isometry3d> poses;
+  long lookups = 0;
+  bool lookup(const std::string& target, const std::string& frame, Stamp,
+              Eigen::Isometry3d& X, std::string& error) override {
+    ++lookups;
+    const auto it = poses.find({target, frame});
+    if (it == poses.end()) {
+      error = "unknown to the test";
+      return false;
+    }
+    X = it->second;
+    return true;
+  }
+};
+
+TEST(Pipeline, PartialMessagesGiveTheExactLoads) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline pipeline(model, settings, nullptr);
+  const std::vector<std::string> arm = {model.coordinate_names[0], model.coordinate_names[1],
+                                        model.coordinate_names[2]};
+  const std::vector<std::string> wrist = {model.coordinate_names[3], model.coordinate_names[4],
+                                          model.coordinate_names[5]};
+  const Eigen::Vector3d f(3.0, -1.0, 4.0), m(0.2, 0.1, -0.3);  // constant: resampling exact
+  jle::Data<double> reference(model);
+  int published = 0;
+  for (int k = 0; k < 100; ++k) {
+    // Both publishers stamp the same instant (one driver cycle), jittered by 20%.
+    const Stamp stamp = kStart + k * kMs + static_cast<Stamp>(2e5 * std::sin(k));
+    const double t = static_cast<double>(stamp - kStart) * 1e-9;
+    std::vector<double> pa, pw;
+    for (int i = 0; i < 3; ++i) pa.push_back(q(i, t));
+    for (int i = 3; i < 6; ++i) pw.push_back(q(i, t));
+    ASSERT_EQ(pipeline.onWrench(0, stamp, stamp, "tool0", f, m), Outcome::kUsed);
+    // The wrist's driver speaks once, first: the arm's joints are still missing. Then
+    // the arm's messages alone make the samples, the wrist held.
+    if (k == 0) {
+      EXPECT_EQ(pipeline.onJointState(stamp, stamp, wrist, pw, kNone, kNone), Outcome::kWaiting);
+      EXPECT_NE(pipeline.problem().find("'" + arm[0] + "'"), std::string::npos)
+          << pipeline.problem();
+    }
+    if (pipeline.onJointState(stamp, stamp, arm, pa, kNone, kNone) != Outcome::kPublished)
+      continue;
+    ++published;
+    const jle::LoadsRecord& r = pipeline.record();
+    Eigen::VectorXd qv(6), qdv(6), qddv(6);
+    // The 3-point estimate describes the middle sample: the record's stamp is its own.
+    const double tr = static_cast<double>(r.stamp - kStart) * 1e-9;
+    for (int i = 0; i < 6; ++i) {
+      qv[i] = q(i, tr);
+      qdv[i] = qd(i, tr);
+      qddv[i] = qdd(i);
+    }
+    jle::forwardKinematics(model, reference, qv, qdv, qddv, settings.estimator.gravity_world);
+    jle::addExternalWrench(model, reference, model.frameIndex("tool0"), f, m,
+                           jle::WrenchFrame::kLocal);
+    jle::inverseDynamics(model, reference);
+    for (std::size_t i = 0; i < r.segment.size(); ++i) {
+      const int s = r.segment[i];
+      // 3-point rounding at 1 ms: ~1e-13 rad/s^2 on qdd times O(1) inertias.
+      const double scale = 1.0 + reference.force[s].norm() + reference.moment[s].norm();
+      EXPECT_LT((r.force[i] - reference.force[s]).norm(), 1e-9 * scale);
+      EXPECT_LT((r.moment[i] - reference.moment[s]).norm(), 1e-9 * scale);
+      EXPECT_NEAR(r.effort[i], reference.effort[s], 1e-9 * scale);
+    }
+  }
+  EXPECT_EQ(published, 98);  // every stamp but the window's start
+  const jle::PipelineCounters& c = pipeline.counters();
+  EXPECT_EQ(c.received(InputKind::kJointState), 101);
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kPublished), 98);
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kWaiting), 1);
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kUsed), 2);
+}
+
+TEST(Pipeline, WaitsOnlyForTheCoordinatesThePublishedJointsNeed) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/talos_reduced.urdf");
+  jle::Settings settings = finiteDifferences();
+  settings.estimator.joints = {"leg_left_4_joint"};
+  jle::Pipeline pipeline(model, settings, nullptr);
+  std::vector<std::string> leg;
+  for (int j = 1; j <= 6; ++j) leg.push_back("leg_left_" + std::to_string(j) + "_joint");
+  int published = 0;
+  for (int k = 0; k < 10; ++k) {
+    const std::vector<double> p(leg.size(), 0.1 * k);
+    if (pipeline.onJointState(kStart + k * kMs, 0, leg, p, kNone, kNone) == Outcome::kPublished)
+      ++published;
+  }
+  EXPECT_EQ(published, 8);
+  ASSERT_EQ(pipeline.record().joint, std::vector<std::string>{"leg_left_4_joint"});
+  // Without the knee's own coordinate: waiting, naming it.
+  jle::Pipeline waiting(model, settings, nullptr);
+  leg.erase(leg.begin() + 3);
+  EXPECT_EQ(waiting.onJointState(kStart, 0, leg, std::vector<double>(5, 0.0), kNone, kNone),
+            Outcome::kWaiting);
+  EXPECT_NE(waiting.problem().find("'leg_left_4_joint'"), std::string::npos) << waiting.problem();
+}
+
+TEST(Pipeline, DelayedEstimateCarriesTheStampAndEffortsOfItsSample) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  settings.estimator.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
+  settings.estimator.differentiator.window = 9;
+  settings.estimator.differentiator.delay = 4;  // centred: 4 samples behind the newest
+  jle::Pipeline pipeline(model, settings, nullptr);
+  std::map<Stamp, double> effort_at;
+  for (int k = 0; k < 40; ++k) {
+    const Stamp stamp = kStart + 2 * k * kMs + (k % 3) * 137;  // odd nanoseconds
+    std::vector<double> p(6), e(6);
+    for (int i = 0; i < 6; ++i) {
+      p[static_cast<std::size_t>(i)] = 0.01 * k * i;
+      e[static_cast<std::size_t>(i)] = 100.0 * k + i;
+    }
+    effort_at[stamp] = e[0];
+    if (pipeline.onJointState(stamp, stamp, model.coordinate_names, p, kNone, e) !=
+        Outcome::kPublished)
+      continue;
+    const jle::LoadsRecord& r = pipeline.record();
+    ASSERT_EQ(r.stamp, kStart + 2 * (k - 4) * kMs + ((k - 4) % 3) * 137);
+    ASSERT_TRUE(effort_at.count(r.stamp));
+    EXPECT_EQ(r.measured_effort[0], effort_at[r.stamp]);
+  }
+}
+
+TEST(Pipeline, WrenchFramesFromTheUrdfOrTheFrameSource) {
+  const jle::Model<double> model = ur5();
+  const Eigen::Vector3d f(1.0, 2.0, 3.0), m(0.3, -0.2, 0.1);
+  // The same wrench given in tool0's frame and in a sensor frame 0.1 m along its z,
+  // rotated 90 degrees about z: the same loads (to rounding).
+  Eigen::Isometry3d X_tool_sensor = Eigen::Isometry3d::Identity();
+  X_tool_sensor.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_tool_sensor.translation() << 0.0, 0.0, 0.1;
+  const Eigen::Vector3d f_sensor = X_tool_sensor.linear().transpose() * f;
+  const Eigen::Vector3d m_sensor =
+      X_tool_sensor.linear().transpose() * (m - X_tool_sensor.translation().cross(f));
+  FixedFrames frames;
+  frames.poses[{"tool0", "sensor"}] = X_tool_sensor;
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline direct(model, settings, nullptr), through(model, settings, &frames);
+  EXPECT_EQ(through.onWrench(0, kStart, kStart, "nowhere", f, m), Outcome::kFrame);
+  EXPECT_NE(through.problem().find("'nowhere'"), std::string::npos) << through.problem();
+  for (int k = 0; k < 5; ++k) {
+    const Stamp stamp = kStart + k * kMs;
+    ASSERT_EQ(direct.onWrench(0, stamp, stamp, "tool0", f, m), Outcome::kUsed);
+    ASSERT_EQ(through.onWrench(0, stamp, stamp, "sensor", f_sensor, m_sensor), Outcome::kUsed);
+    const std::vector<double> p(6, 0.1 * k);
+    const Outcome a = direct.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone);
+    const Outcome b = through.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone);
+    ASSERT_EQ(a, b);
+    if (a != Outcome::kPublished) continue;
+    for (std::size_t i = 0; i < direct.record().effort.size(); ++i)
+      EXPECT_NEAR(direct.record().effort[i], through.record().effort[i], 1e-12);
+  }
+  // A moving frame is asked for at every message; a URDF frame rigid to the link never.
+  EXPECT_EQ(frames.lookups, 6);
+  // Without a frame source, only the URDF's frames resolve.
+  EXPECT_EQ(direct.onWrench(0, kStart + 9 * kMs, 0, "sensor", f, m), Outcome::kFrame);
+}
+
+TEST(Pipeline, SensorBiasIsRemovedInTheReadingsFrame) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline clean(model, settings, nullptr), biased(model, settings, nullptr);
+  const Eigen::Vector3d bf(1.5, -2.25, 3.0), bt(0.125, -0.0625, 0.25);
+  biased.setSensorBias(0, bf, bt);
+  const Eigen::Vector3d f(1.0, 2.0, 3.0), m(0.3, -0.2, 0.1);
+  int compared = 0;
+  for (int k = 0; k < 5; ++k) {
+    const Stamp stamp = kStart + k * kMs;
+    clean.onWrench(0, stamp, stamp, "tool0", f, m);
+    biased.onWrench(0, stamp, stamp, "tool0", f + bf, m + bt);
+    const std::vector<double> p(6, 0.1 * k);
+    if (clean.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone) !=
+        Outcome::kPublished)
+      continue;
+    ASSERT_EQ(biased.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone),
+              Outcome::kPublished);
+    ++compared;
+    for (std::size_t i = 0; i < clean.record().effort.size(); ++i)
+      EXPECT_NEAR(clean.record().effort[i], biased.record().effort[i], 1e-12);  // (x + b) - b
+  }
+  EXPECT_EQ(compared, 3);
+}
+
+TEST(Pipeline, FloatingBasePoseFromTheFrameSource) {
+  jle::ModelOptions options;
+  options.floating_base = true;
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/free_body.urdf", options);
+  jle::Settings settings = finiteDifferences();
+  settings.floating_base = true;
+  FixedFrames frames;
+  jle::Pipeline pipeline(model, settings, &frames);
+  EXPECT_EQ(pipeline.onJointState(kStart, kStart, {}, kNone, kNone, kNone), Outcome::kNoBasePose);
+  EXPECT_NE(pipeline.problem().find("'" + model.link_name[0] + "' in 'world'"), std::string::npos)
+      << pipeline.problem();
+  // At rest in the world: the base carries the weight (its residual, segment 0).
+  frames.poses[{"world", model.link_name[0]}] = Eigen::Isometry3d::Identity();
+  Outcome last = Outcome::kUsed;
+  for (int k = 1; k < 5; ++k)
+    last = pipeline.onJointState(kStart + k * kMs, kStart + k * kMs, {}, kNone, kNone, kNone);
+  ASSERT_EQ(last, Outcome::kPublished);
+  EXPECT_NEAR(pipeline.estimator().data().force[0].norm(), model.totalMass() * 9.80665, 1e-9);
+}
+
+TEST(Pipeline, TimeJumpsResetAndFarStampsReanchorTheTimeAxis) {
+  const jle::Model<double> model = ur5();
+  jle::Pipeline pipeline(model, finiteDifferences(), nullptr);
+  const std::vector<double> p(6, 0.2);
+  auto feed = [&](Stamp stamp, Stamp clock) {
+    return pipeline.onJointState(stamp, clock, model.coordinate_names, p, kNone, kNone);
+  };
+  for (int k = 0; k < 5; ++k) feed(kStart + k * kMs, kStart + k * kMs);
+  // Back by less than time_jump_threshold (1 s): out of order, dropped, no reset.
+  EXPECT_EQ(feed(kStart, kStart + 5 * kMs), Outcome::kOrder);
+  EXPECT_EQ(pipeline.counters().resets, 0);
+  // Back by 2 s (a looping bag): reset, the filters start again from this sample.
+  EXPECT_EQ(feed(kStart - 2000 * kMs, kStart + 6 * kMs), Outcome::kUsed);
+  EXPECT_TRUE(pipeline.jumped());
+  EXPECT_EQ(pipeline.counters().resets, 1);
+  // The clock going back while the stamps do not move forward: a reset too.
+  EXPECT_EQ(feed(kStart - 2000 * kMs, kStart), Outcome::kUsed);
+  EXPECT_EQ(pipeline.counters().resets, 2);
+  // 100 days ahead: beyond what the time axis resolves to 1 ns, a new origin; the record
+  // still carries the exact stamps.
+  const Stamp far = kStart + Stamp{100} * 86400 * 1000000000;
+  for (int k = 0; k < 3; ++k) feed(far + k * kMs + 1, far + k * kMs + 1);
+  EXPECT_EQ(pipeline.counters().resets, 3);
+  EXPECT_EQ(pipeline.record().stamp, far + kMs + 1);
+}
+
+TEST(Pipeline, MalformedMessagesAreCountedAndNamed) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline pipeline(model, settings, nullptr);
+  const std::vector<std::string>& names = model.coordinate_names;
+  std::vector<double> p(6, 0.0);
+  EXPECT_EQ(pipeline.onJointState(kStart, 0, names, std::vector<double>(5), kNone, kNone),
+            Outcome::kInvalid);
+  EXPECT_EQ(pipeline.onJointState(kStart, 0, names, p, std::vector<double>(2), kNone),
+            Outcome::kInvalid);
+  p[2] = std::nan("");
+  EXPECT_EQ(pipeline.onJointState(kStart, 0, names, p, kNone, kNone), Outcome::kInvalid);
+  EXPECT_NE(pipeline.problem().find("'" + names[2] + "'"), std::string::npos) << pipeline.problem();
+  p[2] = 0.0;
+  std::vector<std::string> extra = names;
+  extra.push_back("gripper_joint");
+  p.push_back(0.0);
+  EXPECT_EQ(pipeline.onJointState(kStart, 0, extra, p, kNone, kNone), Outcome::kUsed);
+  EXPECT_EQ(pipeline.unknownJoint(), "gripper_joint");
+  EXPECT_EQ(pipeline.onWrench(0, kStart, 0, "", Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones()),
+            Outcome::kFrame);
+  EXPECT_EQ(pipeline.onWrench(0, kStart, 0, "tool0", Eigen::Vector3d::Constant(INFINITY),
+                              Eigen::Vector3d::Ones()),
+            Outcome::kInvalid);
+  const jle::PipelineCounters& c = pipeline.counters();
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kInvalid), 3);
+  EXPECT_EQ(c.unknown_joints, 1);
+  EXPECT_EQ(c.received(InputKind::kWrench), 2);
+  // Stamp 0 takes the clock: the next message at that clock is a duplicate.
+  EXPECT_EQ(pipeline.onJointState(0, kStart, names, std::vector<double>(6), kNone, kNone),
+            Outcome::kOrder);
+}
+
+}  // namespace
