@@ -375,8 +375,8 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
       // The sensor's offset, as it reports; the residual goes out in the reading's frame.
       {
         std::lock_guard<std::mutex> lock(calibration_mutex_);
-        f -= topic.bias_force;
-        m -= topic.bias_torque;
+        f -= topic.bias.force;
+        m -= topic.bias.torque;
         topic.sensor_frame = frame;
       }
       topic.R_link_sensor = R;

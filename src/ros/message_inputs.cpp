@@ -41,19 +41,6 @@ std::vector<int> publishedSegments(const Model<double>& model,
   return segments;
 }
 
-bool rigidFrameInLink(const Model<double>& model, const std::string& link, const std::string& frame,
-                      Eigen::Matrix3d& R_link_frame, Eigen::Vector3d& p_link_frame) {
-  const Frame<double>& l = model.frames[static_cast<std::size_t>(model.frameIndex(link))];
-  for (const Frame<double>& f : model.frames) {
-    if (f.name != frame) continue;
-    if (f.segment != l.segment) return false;
-    R_link_frame = l.R_segment_frame.transpose() * f.R_segment_frame;
-    p_link_frame = l.R_segment_frame.transpose() * (f.p_segment_frame - l.p_segment_frame);
-    return true;
-  }
-  return false;
-}
-
 JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>& published_segments)
     : coordinate_names_(model.coordinate_names),
       q_(static_cast<std::size_t>(model.nq), 0.0),

@@ -4,7 +4,9 @@
 #include <joint_load_estimator/CalibrateBias.h>
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/sensor_bias.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PointStamped.h>
@@ -62,28 +64,27 @@ class EstimatorNode {
     Eigen::Matrix3d R_link_frame = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p_link_frame = Eigen::Vector3d::Zero();
     // Sensor inputs (sensor_joint): the frame of the last reading and its pose in the
-    // link (the residual is published in it), the consistency output and its extremes.
+    // link (the residual is published in it), the residual of the last published
+    // sample in that frame, the consistency output and its extremes.
     std::string sensor_frame;
     Eigen::Matrix3d R_link_sensor = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p_link_sensor = Eigen::Vector3d::Zero();
+    Wrench<double> residual;
     ros::Publisher consistency_pub;  // ~consistency/<sensor_joint>
     double max_force = 0.0, max_moment = 0.0;  // |residual| since the last diagnosis
     // The sensor's offset as it reports (its frame and sign), subtracted from each
     // reading. Written by ~calibrate_bias: guarded by calibration_mutex_.
-    Eigen::Vector3d bias_force = Eigen::Vector3d::Zero(), bias_torque = Eigen::Vector3d::Zero();
+    SensorBias bias;
   };
 
-  // ~calibrate_bias in progress: fed by publish(), read by the service thread.
+  // ~calibrate_bias in progress: fed by publishConsistency(), read by the service
+  // thread.
   struct Calibration {
-    bool active = false, done = false;
-    bool assume_still = true;
-    double duration = 0.0, first_stamp = 0.0;
-    std::string failure;  // non-empty: refused while collecting
-    long samples = 0;
-    ros::WallTime last_sample;
-    // Per wrench topic: running mean and sum of squared deviations (Welford) of the
-    // offset estimates, reading frame and sign: (force, torque).
-    std::vector<Eigen::Matrix<double, 6, 1>> mean, m2;
+    bool active = false;        // a service call is waiting for its window
+    ros::WallTime last_sample;  // when the window last took a sample (or started)
+    BiasEstimator estimator;    // one sensor per entry of sensor_topics_, in their order
+    std::vector<BiasSample> sample;  // the sample handed to it (kept: no allocation)
+    std::vector<char> needed;        // per coordinate: whether the loads need it
   };
 
   struct PlateTopic {
@@ -109,12 +110,15 @@ class EstimatorNode {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   // Predicted against measured (sensor residuals, floating-base residual).
   void publishConsistency(const ros::Time& stamp);
+  void publishResidual(WrenchTopic& topic, const ros::Time& stamp);
+  void collectBiasSample();
   void diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool onCalibrateBias(joint_load_estimator::CalibrateBias::Request& req,
                        joint_load_estimator::CalibrateBias::Response& res);
+  void startCalibration(double duration, bool assume_still);
+  void waitForCalibration(std::unique_lock<std::mutex>& lock);
+  std::vector<BiasFileEntry> applyCalibration(joint_load_estimator::CalibrateBias::Response& res);
   void loadBiasFile();
-  std::string saveBiasFile(const joint_load_estimator::CalibrateBias::Response& res, long samples,
-                           const std::vector<std::string>& frames);
 
   ros::NodeHandle nh_, private_nh_;
   NodeSettings settings_;

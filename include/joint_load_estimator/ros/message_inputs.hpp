@@ -5,6 +5,7 @@
 // ROS-message-free (plain vectors and Eigen), so that it is cheap to test.
 #pragma once
 
+#include <joint_load_estimator/frames.hpp>
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -29,23 +30,6 @@ void completeSensorLinks(const Model<double>& model, NodeSettings& settings);
 /// SettingsError "parameter 'joints': 'NAME' is not a joint of the model".
 std::vector<int> publishedSegments(const Model<double>& model,
                                    const std::vector<std::string>& joints);
-
-/// Pose of URDF link `frame` in the frame of URDF link `link` when both lie on one
-/// segment (rigidly attached: a constant transform from the model). False when `frame`
-/// is not a URDF link or moves relative to `link` (then only tf2 knows it). Throws
-/// std::invalid_argument if `link` is not a URDF link.
-bool rigidFrameInLink(const Model<double>& model, const std::string& link, const std::string& frame,
-                      Eigen::Matrix3d& R_link_frame, Eigen::Vector3d& p_link_frame);
-
-/// A wrench (force [N], moment [N m] about the origin of frame F, both in F) expressed
-/// in link L's frame with its moment about L's origin, F's pose in L being
-/// (R_link_frame, p_link_frame).
-inline void wrenchInLink(const Eigen::Matrix3d& R_link_frame, const Eigen::Vector3d& p_link_frame,
-                         const Eigen::Vector3d& f_frame, const Eigen::Vector3d& m_frame,
-                         Eigen::Vector3d& f_link, Eigen::Vector3d& m_link) {
-  f_link = R_link_frame * f_frame;
-  m_link = R_link_frame * m_frame + p_link_frame.cross(f_link);
-}
 
 /// The latest position of every coordinate and the latest measured effort of every
 /// published joint, from joint-state messages that may each carry a subset of the
