@@ -1,56 +1,28 @@
 // Predicted against measured: the residual of every force/torque sensor (its
 // reading minus the model's prediction of the wrench across its joint) and of a
 // floating base, their diagnostics, and the sensors' bias calibration
-// (~calibrate_bias, bias_file).
+// (~calibrate_bias, bias_file). The numbers come from the core (sensor_bias.hpp);
+// this file converts, publishes and waits.
 #include <tf2_eigen/tf2_eigen.h>
-#include <yaml-cpp/yaml.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <iomanip>
 #include <joint_load_estimator/ros/estimator_node.hpp>
 #include <sstream>
 
 namespace jle {
 namespace {
 
-using Vector6 = Eigen::Matrix<double, 6, 1>;
-
 // A calibration fails when no loads are computed for this long [wall s] (the
 // joint states stopped): the window would never fill.
 constexpr double kNoSampleTimeout = 5.0;
 
-geometry_msgs::Wrench toWrench(const Vector6& v) {
+geometry_msgs::Wrench toWrench(const SensorBias& b) {
   geometry_msgs::Wrench w;
-  w.force.x = v[0];
-  w.force.y = v[1];
-  w.force.z = v[2];
-  w.torque.x = v[3];
-  w.torque.y = v[4];
-  w.torque.z = v[5];
+  w.force = tf2::toMsg(b.force, w.force);
+  w.torque = tf2::toMsg(b.torque, w.torque);
   return w;
-}
-
-std::string formatVector(const Vector6& v, int start) {
-  std::ostringstream out;
-  out << std::setprecision(17) << "[" << v[start] << ", " << v[start + 1] << ", " << v[start + 2]
-      << "]";
-  return out.str();
-}
-
-Eigen::Vector3d readVector(const YAML::Node& node, const std::string& where) {
-  if (!node || !node.IsSequence() || node.size() != 3)
-    throw SettingsError(where + " must be a list of 3 numbers");
-  Eigen::Vector3d v;
-  try {
-    for (std::size_t i = 0; i < 3; ++i) v[static_cast<int>(i)] = node[i].as<double>();
-  } catch (const YAML::Exception&) {
-    throw SettingsError(where + " must be a list of 3 numbers");
-  }
-  if (!v.allFinite()) throw SettingsError(where + " is not finite");
-  return v;
 }
 
 }  // namespace
@@ -66,7 +38,7 @@ void EstimatorNode::setUpConsistency() {
   }
   const Model<double>& model = pipeline_->model();
   total_weight_ = model.totalMass() * settings_.estimator.gravity_world.norm();
-  pending_bias_.assign(settings_.wrenches.size(), Vector6::Zero());
+  pending_bias_.assign(settings_.wrenches.size(), SensorBias());
   ros::AdvertiseServiceOptions calibrate =
       ros::AdvertiseServiceOptions::create<joint_load_estimator::CalibrateBias>(
           "calibrate_bias",
@@ -84,8 +56,7 @@ void EstimatorNode::applyPendingBias() {
   if (!bias_pending_.load()) return;
   std::lock_guard<std::mutex> lock(calibration_mutex_);
   for (std::size_t k : sensor_topics_)
-    pipeline_->setSensorBias(static_cast<int>(k), pending_bias_[k].head<3>(),
-                             pending_bias_[k].tail<3>());
+    pipeline_->setSensorBias(static_cast<int>(k), pending_bias_[k].force, pending_bias_[k].torque);
   bias_pending_ = false;
 }
 
@@ -96,79 +67,52 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
     base_force_max_ = std::max(base_force_max_, data.force[0].norm());
     base_moment_max_ = std::max(base_moment_max_, data.moment[0].norm());
   }
-  if (sensor_topics_.empty()) return;
-  const bool calibrating = calibrating_.load();
-  std::unique_lock<std::mutex> lock(calibration_mutex_, std::defer_lock);
-  bool collect = false;
-  if (calibrating) {
-    lock.lock();
-    Calibration& c = calibration_;
-    collect = c.active && !c.done && c.failure.empty();
-    if (collect && !c.assume_still) {
-      const VectorX<double>& qd = estimator.qd();
-      for (int i = 0; i < qd.size() && collect; ++i)
-        if (estimator.coordinateNeeded(i) && std::abs(qd[i]) > settings_.still_velocity) {
-          std::ostringstream why;
-          why << "the robot is not still: the estimated velocity of '"
-              << estimator.model().coordinate_names[static_cast<std::size_t>(i)] << "' is "
-              << qd[i] << ", above still_velocity " << settings_.still_velocity;
-          c.failure = why.str();
-          collect = false;
-        }
-    }
-    for (std::size_t k : sensor_topics_)
-      if (collect && !estimator.sensorUsed(static_cast<int>(k))) {
-        c.failure = "sensor '" + settings_.estimator.wrenches[k].sensor_joint + "' is stale";
-        collect = false;
-      }
-    if (!collect) calibration_cv_.notify_all();
-  }
   for (std::size_t k : sensor_topics_) {
-    WrenchTopic& topic = wrench_topics_[k];
     const int input = static_cast<int>(k);
     if (!estimator.sensorUsed(input)) continue;
-    // Link frame, about the link origin (the joint origin) -> the reading's
-    // frame.
-    const Wrench<double> r = estimator.sensorResidual(static_cast<int>(k));
     const Eigen::Isometry3d& X = pipeline_->wrenchFramePose(input);
-    const Eigen::Matrix3d R = X.linear();
-    const Eigen::Vector3d f = R.transpose() * r.force;
-    const Eigen::Vector3d m = R.transpose() * (r.moment - X.translation().cross(r.force));
-    topic.max_force = std::max(topic.max_force, f.norm());
-    topic.max_moment = std::max(topic.max_moment, m.norm());
-    if (topic.consistency_pub.getNumSubscribers() > 0) {
-      wrench_msg_.header.stamp = stamp;
-      const std::string& frame = pipeline_->wrenchFrame(input);
-      wrench_msg_.header.frame_id = frame.empty() ? settings_.estimator.wrenches[k].link : frame;
-      wrench_msg_.wrench.force = tf2::toMsg(f, wrench_msg_.wrench.force);
-      wrench_msg_.wrench.torque = tf2::toMsg(m, wrench_msg_.wrench.torque);
-      topic.consistency_pub.publish(wrench_msg_);
-    }
-    if (collect) {
-      // reading - bias = sign (residual + prediction), so the reading's offset
-      // from sign * prediction is bias + sign * residual.
-      Vector6 x;
-      const double sign = settings_.estimator.wrenches[k].sign;
-      x << pipeline_->sensorBiasForce(input) + sign * f,
-          pipeline_->sensorBiasTorque(input) + sign * m;
-      Calibration& c = calibration_;
-      const double n = static_cast<double>(c.samples + 1);
-      const Vector6 delta = x - c.mean[k];
-      c.mean[k] += delta / n;
-      c.m2[k] += delta.cwiseProduct(x - c.mean[k]);
-    }
+    wrench_topics_[k].residual =
+        residualInReading(estimator.sensorResidual(input), X.linear(), X.translation());
+    publishResidual(k, stamp);
   }
-  if (collect) {
-    Calibration& c = calibration_;
-    const double t = estimator.stamp();
-    if (c.samples == 0) c.first_stamp = t;
-    ++c.samples;
-    c.last_sample = ros::WallTime::now();
-    if (t - c.first_stamp >= c.duration) {
-      c.done = true;
-      calibration_cv_.notify_all();
+  if (!sensor_topics_.empty() && calibrating_.load()) collectBiasSample();
+}
+
+void EstimatorNode::publishResidual(std::size_t k, const ros::Time& stamp) {
+  WrenchTopic& topic = wrench_topics_[k];
+  const Wrench<double>& r = topic.residual;
+  topic.max_force = std::max(topic.max_force, r.force.norm());
+  topic.max_moment = std::max(topic.max_moment, r.moment.norm());
+  if (topic.consistency_pub.getNumSubscribers() == 0) return;
+  const std::string& frame = pipeline_->wrenchFrame(static_cast<int>(k));
+  wrench_msg_.header.stamp = stamp;
+  wrench_msg_.header.frame_id = frame.empty() ? settings_.estimator.wrenches[k].link : frame;
+  tf2::toMsg(r.force, wrench_msg_.wrench.force);
+  tf2::toMsg(r.moment, wrench_msg_.wrench.torque);
+  topic.consistency_pub.publish(wrench_msg_);
+}
+
+void EstimatorNode::collectBiasSample() {
+  const Estimator& estimator = pipeline_->estimator();
+  std::lock_guard<std::mutex> lock(calibration_mutex_);
+  Calibration& c = calibration_;
+  if (c.active && c.estimator.collecting()) {
+    for (std::size_t i = 0; i < sensor_topics_.size(); ++i) {
+      const std::size_t k = sensor_topics_[i];
+      const int input = static_cast<int>(k);
+      BiasSample& sample = c.sample[i];
+      sample.used = estimator.sensorUsed(input);
+      if (sample.used)
+        sample.offset = readingOffset(wrench_topics_[k].residual,
+                                      settings_.estimator.wrenches[k].sign,
+                                      {pipeline_->sensorBiasForce(input),
+                                       pipeline_->sensorBiasTorque(input)});
     }
+    if (c.estimator.add(estimator.stamp(), c.sample, estimator.qd(), c.needed))
+      c.last_sample = ros::WallTime::now();
   }
+  // The service thread waits for the window to fill or fail.
+  if (!(c.active && c.estimator.collecting())) calibration_cv_.notify_all();
 }
 
 void EstimatorNode::diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -231,136 +175,83 @@ bool EstimatorNode::onCalibrateBias(joint_load_estimator::CalibrateBias::Request
     res.message = "a calibration is already running";
     return true;
   }
-  calibration_ = Calibration();
-  calibration_.active = true;
-  calibration_.assume_still = req.assume_still;
-  calibration_.duration = req.duration;
-  calibration_.last_sample = ros::WallTime::now();
-  calibration_.mean.assign(wrench_topics_.size(), Vector6::Zero());
-  calibration_.m2.assign(wrench_topics_.size(), Vector6::Zero());
-  calibrating_ = true;
-  // Loads are computed on the node's own thread; this one only waits for the
-  // window.
-  while (!calibration_.done && calibration_.failure.empty() && !shutting_down_ && ros::ok()) {
-    if ((ros::WallTime::now() - calibration_.last_sample).toSec() > kNoSampleTimeout) {
-      calibration_.failure = "no loads were computed for 5 s (no joint states?)";
-      break;
-    }
-    calibration_cv_.wait_for(lock, std::chrono::milliseconds(100));
-  }
-  calibrating_ = false;
-  calibration_.active = false;
-  if (!calibration_.done) {
-    res.message = calibration_.failure.empty() ? "the node is shutting down" : calibration_.failure;
+  startCalibration(req.duration, req.assume_still);
+  waitForCalibration(lock);
+  const BiasEstimator& bias = calibration_.estimator;
+  if (!bias.done()) {
+    res.message = bias.failure().empty() ? "the node is shutting down" : bias.failure();
     res.message += ": no bias changed";
     return true;
   }
-  const long n = calibration_.samples;
-  std::vector<std::string> frames;
-  for (std::size_t k : sensor_topics_) {
-    const Vector6& mean = calibration_.mean[k];
-    const Vector6 stddev =
-        n > 1 ? Vector6((calibration_.m2[k] / static_cast<double>(n - 1)).cwiseSqrt())
-              : Vector6::Zero();
-    pending_bias_[k] = mean;
-    frames.push_back(pipeline_->wrenchFrame(static_cast<int>(k)));
-    res.sensors.push_back(settings_.estimator.wrenches[k].sensor_joint);
-    res.bias.push_back(toWrench(mean));
-    res.stddev.push_back(toWrench(stddev));
-  }
+  const long n = bias.samples();
+  const std::vector<BiasFileEntry> entries = applyCalibration(res);
   bias_pending_ = true;
   lock.unlock();
   res.success = true;
   std::ostringstream message;
   message << "bias of " << res.sensors.size() << " sensor(s) estimated from " << n << " samples";
-  const std::string error = saveBiasFile(res, n, frames);
-  if (settings_.bias_file.empty())
+  const std::string& path = settings_.bias_file;
+  const std::string error = path.empty() ? "" : saveBiasFile(path, entries, n);
+  if (path.empty())
     message << "; not stored (no bias_file)";
   else if (!error.empty())
     message << "; NOT stored: " << error;
   else
-    res.file = settings_.bias_file;
+    res.file = path;
   res.message = message.str();
   ROS_INFO("calibrate_bias: %s", res.message.c_str());
   return true;
 }
 
-std::string EstimatorNode::saveBiasFile(const joint_load_estimator::CalibrateBias::Response& res,
-                                        long samples, const std::vector<std::string>& frames) {
-  if (settings_.bias_file.empty()) return "";
-  std::ostringstream out;
-  out << "# Force/torque sensor offsets written by joint_load_estimator "
-         "~calibrate_bias:\n"
-         "# the reading minus the model's prediction, averaged while the robot "
-         "was still, in\n"
-         "# the sensor's frame and sign convention (moment about the frame's "
-         "origin). The\n"
-         "# node subtracts them from the readings when started with bias_file "
-         "= this file.\n"
-         "sensors:\n";
-  for (std::size_t i = 0; i < res.sensors.size(); ++i) {
-    Vector6 b, s;
-    b << res.bias[i].force.x, res.bias[i].force.y, res.bias[i].force.z, res.bias[i].torque.x,
-        res.bias[i].torque.y, res.bias[i].torque.z;
-    s << res.stddev[i].force.x, res.stddev[i].force.y, res.stddev[i].force.z,
-        res.stddev[i].torque.x, res.stddev[i].torque.y, res.stddev[i].torque.z;
-    out << "  " << res.sensors[i] << ":\n"
-        << "    frame: \"" << frames[i] << "\"\n"
-        << "    force: " << formatVector(b, 0) << "          # [N]\n"
-        << "    torque: " << formatVector(b, 3) << "         # [N m]\n"
-        << "    force_stddev: " << formatVector(s, 0) << "   # [N] per-sample spread\n"
-        << "    torque_stddev: " << formatVector(s, 3) << "  # [N m]\n"
-        << "    samples: " << samples << "\n";
-  }
-  // Written beside the target and renamed: a reader never sees half a file.
-  const std::string tmp = settings_.bias_file + ".tmp";
-  {
-    std::ofstream file(tmp);
-    if (!(file << out.str()) || !file.flush()) return "cannot write '" + tmp + "'";
-  }
-  if (std::rename(tmp.c_str(), settings_.bias_file.c_str()) != 0)
-    return "cannot rename '" + tmp + "' to '" + settings_.bias_file + "'";
-  return "";
+void EstimatorNode::startCalibration(double duration, bool assume_still) {
+  const Model<double>& model = pipeline_->model();
+  std::vector<std::string> sensors;
+  for (std::size_t k : sensor_topics_) sensors.push_back(settings_.estimator.wrenches[k].sensor_joint);
+  Calibration& c = calibration_;
+  c.estimator = BiasEstimator(sensors, model.coordinate_names);
+  c.estimator.start(duration, assume_still, settings_.still_velocity);
+  c.sample.assign(sensor_topics_.size(), BiasSample());
+  c.needed.assign(static_cast<std::size_t>(model.nq), 0);
+  for (int i = 0; i < model.nq; ++i)
+    c.needed[static_cast<std::size_t>(i)] = pipeline_->estimator().coordinateNeeded(i);
+  c.last_sample = ros::WallTime::now();
+  c.active = true;
+  calibrating_ = true;
 }
 
-void EstimatorNode::loadBiasFile() {
-  const std::string& path = settings_.bias_file;
-  if (path.empty()) return;
-  if (!std::ifstream(path).good()) {
-    ROS_INFO("bias_file '%s' does not exist (yet): sensor biases are zero", path.c_str());
-    return;
-  }
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw SettingsError("bias_file '" + path + "': " + e.what());
-  }
-  const YAML::Node sensors = root["sensors"];
-  if (!sensors || !sensors.IsMap())
-    throw SettingsError("bias_file '" + path + "': 'sensors' must be a map");
-  for (const auto& entry : sensors) {
-    const std::string name = entry.first.as<std::string>();
-    int input = -1;
-    for (std::size_t k : sensor_topics_)
-      if (settings_.estimator.wrenches[k].sensor_joint == name) input = static_cast<int>(k);
-    if (input < 0) {
-      ROS_WARN("bias_file '%s': sensor '%s' is not configured: ignored", path.c_str(),
-               name.c_str());
-      continue;
+void EstimatorNode::waitForCalibration(std::unique_lock<std::mutex>& lock) {
+  Calibration& c = calibration_;
+  // Loads are computed on the node's own thread; this one only waits for the
+  // window.
+  while (c.estimator.collecting() && !shutting_down_ && ros::ok()) {
+    if ((ros::WallTime::now() - c.last_sample).toSec() > kNoSampleTimeout) {
+      c.estimator.fail("no loads were computed for 5 s (no joint states?)");
+      break;
     }
-    const std::string where = "bias_file '" + path + "': sensors/" + name;
-    const Eigen::Vector3d force = readVector(entry.second["force"], where + "/force");
-    const Eigen::Vector3d torque = readVector(entry.second["torque"], where + "/torque");
-    pipeline_->setSensorBias(input, force, torque);  // no subscription yet
-    const std::string frame = entry.second["frame"] ? entry.second["frame"].as<std::string>() : "";
-    const std::string& configured = settings_.wrenches[static_cast<std::size_t>(input)].frame;
-    if (!configured.empty() && !frame.empty() && frame != configured)
-      ROS_WARN("%s: calibrated in frame '%s', configured frame is '%s'", where.c_str(),
-               frame.c_str(), configured.c_str());
-    ROS_INFO("sensor '%s': bias force [%g %g %g] N, torque [%g %g %g] N m from '%s'", name.c_str(),
-             force.x(), force.y(), force.z(), torque.x(), torque.y(), torque.z(), path.c_str());
+    calibration_cv_.wait_for(lock, std::chrono::milliseconds(100));
   }
+  calibrating_ = false;
+  c.active = false;
+}
+
+std::vector<BiasFileEntry> EstimatorNode::applyCalibration(
+    joint_load_estimator::CalibrateBias::Response& res) {
+  const BiasEstimator& bias = calibration_.estimator;
+  std::vector<BiasFileEntry> entries;
+  for (std::size_t i = 0; i < sensor_topics_.size(); ++i) {
+    const std::size_t k = sensor_topics_[i];
+    BiasFileEntry entry;
+    entry.joint = settings_.estimator.wrenches[k].sensor_joint;
+    entry.frame = pipeline_->wrenchFrame(static_cast<int>(k));
+    entry.bias = bias.mean(i);
+    entry.stddev = bias.stddev(i);
+    pending_bias_[k] = entry.bias;  // handed to the pipeline on the callbacks' thread
+    res.sensors.push_back(entry.joint);
+    res.bias.push_back(toWrench(entry.bias));
+    res.stddev.push_back(toWrench(entry.stddev));
+    entries.push_back(entry);
+  }
+  return entries;
 }
 
 }  // namespace jle

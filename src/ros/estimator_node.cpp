@@ -24,7 +24,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   prepare(pipeline_->record(), loads_msg_);
   advertise();
   setUpConsistency();
-  loadBiasFile();  // before the first wrench can arrive
+  applyBiasFile(*pipeline_);  // before the first wrench can arrive
   subscribe();
   updater_.setHardwareID(model.link_name[0]);
   updater_.add("joint loads", this, &EstimatorNode::diagnose);

@@ -247,9 +247,7 @@ class BagProcessor {
       wrench_topics_.push_back(globalName(w.topic));
     for (const jle::PlateTopicSettings& p : settings.force_plates)
       plate_topics_.push_back(globalName(p.topic));
-    jle::applyBiasFile(pipeline_, settings.bias_file, [](const std::string& text) {
-      std::fprintf(stderr, "process_bag: %s\n", text.c_str());
-    });
+    jle::applyBiasFile(pipeline_);
   }
 
   void run();

@@ -5,8 +5,10 @@
 #include <joint_load_estimator/CalibrateBias.h>
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/sensor_bias.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PointStamped.h>
@@ -42,21 +44,21 @@ class EstimatorNode {
  private:
   struct WrenchTopic {
     ros::Subscriber subscriber;
-    ros::Publisher consistency_pub;            // sensors: ~consistency/<sensor_joint>
+    // Sensor inputs (sensor_joint): the residual of the last published sample in the
+    // reading's frame, its output ~consistency/<sensor_joint> and its extremes.
+    Wrench<double> residual;
+    ros::Publisher consistency_pub;
     double max_force = 0.0, max_moment = 0.0;  // |residual| since the last diagnosis
   };
 
-  // ~calibrate_bias in progress: fed by publish(), read by the service thread.
+  // ~calibrate_bias in progress: fed by publishConsistency(), read by the service
+  // thread.
   struct Calibration {
-    bool active = false, done = false;
-    bool assume_still = true;
-    double duration = 0.0, first_stamp = 0.0;
-    std::string failure;  // non-empty: refused while collecting
-    long samples = 0;
-    ros::WallTime last_sample;
-    // Per wrench topic: running mean and sum of squared deviations (Welford) of the
-    // offset estimates, reading frame and sign: (force, torque).
-    std::vector<Eigen::Matrix<double, 6, 1>> mean, m2;
+    bool active = false;        // a service call is waiting for its window
+    ros::WallTime last_sample;  // when the window last took a sample (or started)
+    BiasEstimator estimator;    // one sensor per entry of sensor_topics_, in their order
+    std::vector<BiasSample> sample;  // the sample handed to it (kept: no allocation)
+    std::vector<char> needed;        // per coordinate: whether the loads need it
   };
 
   struct PlateTopic {
@@ -78,13 +80,15 @@ class EstimatorNode {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   // Predicted against measured (sensor residuals, floating-base residual).
   void publishConsistency(const ros::Time& stamp);
+  void publishResidual(std::size_t k, const ros::Time& stamp);
+  void collectBiasSample();
   void diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool onCalibrateBias(joint_load_estimator::CalibrateBias::Request& req,
                        joint_load_estimator::CalibrateBias::Response& res);
+  void startCalibration(double duration, bool assume_still);
+  void waitForCalibration(std::unique_lock<std::mutex>& lock);
+  std::vector<BiasFileEntry> applyCalibration(joint_load_estimator::CalibrateBias::Response& res);
   void applyPendingBias();
-  void loadBiasFile();
-  std::string saveBiasFile(const joint_load_estimator::CalibrateBias::Response& res, long samples,
-                           const std::vector<std::string>& frames);
 
   ros::NodeHandle nh_, private_nh_;
   Settings settings_;
@@ -122,7 +126,7 @@ class EstimatorNode {
   Calibration calibration_;
   std::atomic<bool> calibrating_{false};
   std::atomic<bool> bias_pending_{false};
-  std::vector<Eigen::Matrix<double, 6, 1>> pending_bias_;  // per wrench input, guarded
+  std::vector<SensorBias> pending_bias_;  // per wrench input, guarded
   bool shutting_down_ = false;
   ros::CallbackQueue service_queue_;
   ros::ServiceServer calibrate_srv_;
