@@ -83,7 +83,7 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
     }
     for (std::size_t k : sensor_topics_)
       if (collect && !estimator_->sensorUsed(static_cast<int>(k))) {
-        c.failure = "sensor '" + wrench_topics_[k]->settings.input.sensor_joint + "' is stale";
+        c.failure = "sensor '" + wrench_topics_[k]->input.sensor_joint + "' is stale";
         collect = false;
       }
     if (!collect) calibration_cv_.notify_all();
@@ -102,7 +102,7 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
     if (topic.consistency_pub.getNumSubscribers() > 0) {
       wrench_msg_.header.stamp = stamp;
       wrench_msg_.header.frame_id =
-          topic.sensor_frame.empty() ? topic.settings.input.link : topic.sensor_frame;
+          topic.sensor_frame.empty() ? topic.input.link : topic.sensor_frame;
       wrench_msg_.wrench.force = tf2::toMsg(f, wrench_msg_.wrench.force);
       wrench_msg_.wrench.torque = tf2::toMsg(m, wrench_msg_.wrench.torque);
       topic.consistency_pub.publish(wrench_msg_);
@@ -111,8 +111,8 @@ void EstimatorNode::publishConsistency(const ros::Time& stamp) {
       // reading - bias = sign (residual + prediction), so the reading's offset
       // from sign * prediction is bias + sign * residual.
       Vector6 x;
-      x << topic.bias_force + topic.settings.input.sign * f,
-          topic.bias_torque + topic.settings.input.sign * m;
+      x << topic.bias_force + topic.input.sign * f,
+          topic.bias_torque + topic.input.sign * m;
       Calibration& c = calibration_;
       const double n = static_cast<double>(c.samples + 1);
       const Vector6 delta = x - c.mean[k];
@@ -139,7 +139,7 @@ void EstimatorNode::diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrap
   char text[256];
   for (std::size_t k : sensor_topics_) {
     WrenchTopic& topic = *wrench_topics_[k];
-    const std::string& joint = topic.settings.input.sensor_joint;
+    const std::string& joint = topic.input.sensor_joint;
     if (topic.max_force > topic.settings.force_threshold) {
       std::snprintf(text, sizeof text, "sensor %s: residual force %.3g N > %.3g N", joint.c_str(),
                     topic.max_force, topic.settings.force_threshold);
@@ -227,7 +227,7 @@ bool EstimatorNode::onCalibrateBias(joint_load_estimator::CalibrateBias::Request
     topic.bias_force = mean.head<3>();
     topic.bias_torque = mean.tail<3>();
     frames.push_back(topic.sensor_frame);
-    res.sensors.push_back(topic.settings.input.sensor_joint);
+    res.sensors.push_back(topic.input.sensor_joint);
     res.bias.push_back(toWrench(mean));
     res.stddev.push_back(toWrench(stddev));
   }
@@ -305,7 +305,7 @@ void EstimatorNode::loadBiasFile() {
     const std::string name = entry.first.as<std::string>();
     WrenchTopic* topic = nullptr;
     for (std::size_t k : sensor_topics_)
-      if (wrench_topics_[k]->settings.input.sensor_joint == name) topic = wrench_topics_[k].get();
+      if (wrench_topics_[k]->input.sensor_joint == name) topic = wrench_topics_[k].get();
     if (!topic) {
       ROS_WARN("bias_file '%s': sensor '%s' is not configured: ignored", path.c_str(),
                name.c_str());

@@ -35,9 +35,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   if (!nh_.getParam(settings_.robot_description, urdf))
     throw SettingsError("parameter '" + nh_.resolveName(settings_.robot_description) +
                         "' (robot_description) is not set or is not a string");
-  ModelOptions options;
-  options.floating_base = settings_.floating_base;
-  options.keep_fixed_joints = settings_.keep_fixed_joints;
+  const ModelOptions options = modelOptions(settings_);
   Model<double> model;
   try {
     model = modelFromUrdfString(urdf, options);
@@ -53,10 +51,10 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   for (int i = 0; i < model.nq; ++i) coordinate_of_[model.coordinate_names[i]] = i;
   for (int s : model.moving_segments) segment_of_[model.joint_name[s]] = s;
-  if (settings_.joints.empty()) {
+  if (settings_.estimator.joints.empty()) {
     published_segments_ = model.moving_segments;
   } else {
-    for (const std::string& j : settings_.joints) {
+    for (const std::string& j : settings_.estimator.joints) {
       auto it = segment_of_.find(j);
       if (it == segment_of_.end()) {
         // A kept fixed joint is a valid output too.
@@ -93,10 +91,11 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (std::size_t k = 0; k < settings_.wrenches.size(); ++k) {
     auto topic = std::make_unique<WrenchTopic>();
     topic->settings = settings_.wrenches[k];
+    topic->input = settings_.estimator.wrenches[k];
     if (!estimator_->inputNeeded(static_cast<int>(k))) {
       // Acts below none of the published joints: nothing to subscribe to.
       ROS_INFO("wrench '%s' on link '%s' affects none of the published joints: not subscribed",
-               topic->settings.topic.c_str(), topic->settings.input.link.c_str());
+               topic->settings.topic.c_str(), topic->input.link.c_str());
       wrench_topics_.push_back(std::move(topic));
       continue;
     }
@@ -116,7 +115,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   // Predicted against measured: every sensor's residual, the floating base's.
   for (std::size_t k = 0; k < wrench_topics_.size(); ++k) {
     WrenchTopic& topic = *wrench_topics_[k];
-    const std::string& joint = topic.settings.input.sensor_joint;
+    const std::string& joint = topic.input.sensor_joint;
     if (joint.empty()) continue;
     sensor_topics_.push_back(k);
     topic.consistency_pub = private_nh_.advertise<geometry_msgs::WrenchStamped>("consistency/" + joint, 10);
@@ -309,7 +308,7 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
 bool EstimatorNode::resolveFrame(WrenchTopic& topic, const std::string& frame,
                                  const ros::Time& stamp, Eigen::Matrix3d& R, Eigen::Vector3d& p) {
   const Model<double>& model = estimator_->model();
-  const std::string& link = topic.settings.input.link;
+  const std::string& link = topic.input.link;
   if (frame == topic.last_frame && topic.rigid) {
     R = topic.R_link_frame;
     p = topic.p_link_frame;
@@ -371,7 +370,7 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
       ++counters_.dropped_frame;
       return;
     }
-    if (!topic.settings.input.sensor_joint.empty()) {
+    if (!topic.input.sensor_joint.empty()) {
       // The sensor's offset, as it reports; the residual goes out in the reading's frame.
       {
         std::lock_guard<std::mutex> lock(calibration_mutex_);
@@ -519,11 +518,12 @@ void EstimatorNode::setUpPlates() {
   for (std::size_t k = 0; k < settings_.force_plates.size(); ++k) {
     auto plate = std::make_unique<PlateTopic>();
     plate->settings = settings_.force_plates[k];
-    const std::string& name = plate->settings.input.plate.name;
+    plate->input = settings_.estimator.plates[k];
+    const std::string& name = plate->input.plate.name;
     plate->cop_pub = private_nh_.advertise<geometry_msgs::PointStamped>("cop/" + name, 10);
     if (!estimator_->plateNeeded(static_cast<int>(k))) {
       ROS_INFO("force plate '%s' under link '%s' affects none of the published joints: not "
-               "subscribed", name.c_str(), plate->settings.input.plate.link.c_str());
+               "subscribed", name.c_str(), plate->input.plate.link.c_str());
       plate_topics_.push_back(std::move(plate));
       continue;
     }
@@ -559,7 +559,7 @@ bool EstimatorNode::resolvePlatePose(PlateTopic& plate, const std::string& frame
   } catch (const tf2::TransformException& e) {
     ROS_WARN_THROTTLE(kThrottle, "force plate '%s': no pose of frame '%s' in '%s' from tf2 (and "
                       "no position/orientation configured): %s",
-                      plate.settings.input.plate.name.c_str(), frame.c_str(), world.c_str(),
+                      plate.input.plate.name.c_str(), frame.c_str(), world.c_str(),
                       e.what());
     return false;
   }
@@ -569,7 +569,7 @@ void EstimatorNode::onPlate(std::size_t k, const geometry_msgs::WrenchStamped::C
   ++counters_.plate_samples;
   try {
     PlateTopic& plate = *plate_topics_[k];
-    const std::string& name = plate.settings.input.plate.name;
+    const std::string& name = plate.input.plate.name;
     Eigen::Vector3d f, m;
     tf2::fromMsg(msg->wrench.force, f);
     tf2::fromMsg(msg->wrench.torque, m);

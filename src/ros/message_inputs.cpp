@@ -1,25 +1,30 @@
 #include <joint_load_estimator/ros/message_inputs.hpp>
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
 namespace jle {
 
-ModelOptions modelOptions(const NodeSettings& settings) {
+ModelOptions modelOptions(const Settings& settings) {
   ModelOptions options;
   options.floating_base = settings.floating_base;
   options.keep_fixed_joints = settings.keep_fixed_joints;
+  // A sensor's joint is kept as its own segment: its wrench is what the sensor measures.
+  for (const WrenchInputConfig& w : settings.estimator.wrenches) {
+    const std::vector<std::string>& kept = options.keep_fixed_joints;
+    if (!w.sensor_joint.empty() && std::find(kept.begin(), kept.end(), w.sensor_joint) == kept.end())
+      options.keep_fixed_joints.push_back(w.sensor_joint);
+  }
   return options;
 }
 
-void completeSensorLinks(const Model<double>& model, NodeSettings& settings) {
-  for (std::size_t k = 0; k < settings.wrenches.size(); ++k) {
-    WrenchInputConfig& input = settings.wrenches[k].input;
+void completeSensorLinks(const Model<double>& model, Settings& settings) {
+  for (WrenchInputConfig& input : settings.estimator.wrenches) {
     if (input.sensor_joint.empty() || !input.link.empty()) continue;
     for (int s = 1; s < model.nsegments(); ++s)
       if (model.joint_name[static_cast<std::size_t>(s)] == input.sensor_joint)
         input.link = model.link_name[static_cast<std::size_t>(s)];
-    if (k < settings.estimator.wrenches.size()) settings.estimator.wrenches[k].link = input.link;
   }
 }
 

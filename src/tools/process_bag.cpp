@@ -153,21 +153,22 @@ struct Counters {
 /// the constructor or by the first messages.
 class BagProcessor {
  public:
-  BagProcessor(const Options& options, const jle::NodeSettings& settings,
+  BagProcessor(const Options& options, const jle::Settings& settings,
                const jle::Model<double>& model)
       : options_(options),
         settings_(settings),
         estimator_(model, settings.estimator),
-        segments_(jle::publishedSegments(model, settings.joints)),
+        segments_(jle::publishedSegments(model, settings.estimator.joints)),
         joints_(model, segments_),
         effort_ring_(kEffortHistory, std::vector<double>(segments_.size())),
         effort_time_(kEffortHistory, std::numeric_limits<double>::quiet_NaN()),
         row_(1 + (settings.estimator.uncertainty.enabled ? 8 : 7) * segments_.size()) {
     joint_topic_ = globalName(settings.joint_states_topic);
-    for (const jle::WrenchTopicSettings& w : settings.wrenches) {
+    for (std::size_t k = 0; k < settings.wrenches.size(); ++k) {
       WrenchTopic topic;
-      topic.settings = w;
-      topic.topic = globalName(w.topic);
+      topic.settings = settings.wrenches[k];
+      topic.input = settings.estimator.wrenches[k];
+      topic.topic = globalName(topic.settings.topic);
       wrench_topics_.push_back(topic);
     }
     for (const jle::PlateTopicSettings& p : settings.force_plates) plate_topics_.push_back(globalName(p.topic));
@@ -253,6 +254,7 @@ class BagProcessor {
 
   struct WrenchTopic {
     jle::WrenchTopicSettings settings;
+    jle::WrenchInputConfig input;  // settings.estimator.wrenches[k]
     std::string topic;
     std::string last_frame;
     bool resolved = false;
@@ -451,7 +453,7 @@ class BagProcessor {
     const std::string& frame =
         topic.settings.frame.empty() ? msg.header.frame_id : topic.settings.frame;
     if (!topic.resolved || frame != topic.last_frame) {
-      const std::string& link = topic.settings.input.link;
+      const std::string& link = topic.input.link;
       if (frame.empty())
         throw std::runtime_error(topic.topic +
                                  ": empty header.frame_id and no 'frame' "
@@ -580,7 +582,7 @@ class BagProcessor {
 
  private:
   const Options& options_;
-  const jle::NodeSettings& settings_;
+  const jle::Settings& settings_;
   jle::Estimator estimator_;
   std::vector<int> segments_;
   jle::JointStateMap joints_;
@@ -609,7 +611,7 @@ class BagProcessor {
 };
 
 void run(const Options& options) {
-  jle::NodeSettings settings;
+  jle::Settings settings;
   try {
     settings = jle::parseSettings(options.config.empty() ? XmlRpc::XmlRpcValue()
                                                          : jle::loadYaml(options.config));
@@ -623,7 +625,7 @@ void run(const Options& options) {
   for (std::size_t k = 0; k < settings.force_plates.size(); ++k)
     if (!settings.force_plates[k].pose_configured)
       throw std::runtime_error(options.config + ": force_plates[" + std::to_string(k) + "] '" +
-                               settings.force_plates[k].input.plate.name +
+                               settings.estimator.plates[k].plate.name +
                                "' has no position/orientation: process_bag has no tf2 to look "
                                "up the plate's pose");
   const jle::Model<double> model =

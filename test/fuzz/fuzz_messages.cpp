@@ -94,7 +94,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       config.differentiator.type = jle::DifferentiatorType::kFiniteDifference;
       config.differentiator.window = 3;
       break;
-    default: config.differentiator.type = jle::DifferentiatorType::kKalman; break;
+    default:
+      config.differentiator.type = jle::DifferentiatorType::kKalman;
+      config.differentiator.kalman_model = jle::KalmanModel::kConstantAcceleration;
+      config.differentiator.process_noise = 1e3;
+      break;
   }
   if (config.differentiator.type == jle::DifferentiatorType::kSavitzkyGolay) {
     config.differentiator.window = 5;

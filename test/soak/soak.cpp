@@ -47,7 +47,8 @@ int main(int argc, char** argv) {
   const long samples = argc > 1 ? std::atol(argv[1]) : 1000000;
   const jle::Model<double> model =
       jle::modelFromUrdfFile(JLE_TEST_DATA "/urdf/chains/panda_chain.urdf");
-  jle::EstimatorConfig config;  // the defaults: Savitzky-Golay, window 9, causal
+  jle::EstimatorConfig config;
+  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;  // window 9, causal
   jle::WrenchInputConfig ft;
   ft.name = "ft";
   ft.link = "panda_link8";

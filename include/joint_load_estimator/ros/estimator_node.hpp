@@ -56,6 +56,7 @@ class EstimatorNode {
  private:
   struct WrenchTopic {
     WrenchTopicSettings settings;
+    WrenchInputConfig input;  // settings_.estimator.wrenches[k], its link completed
     ros::Subscriber subscriber;
     std::string last_frame;  // cache of the constant frame resolution
     bool rigid = false;      // expressed-in frame rigidly attached to the target link
@@ -88,6 +89,7 @@ class EstimatorNode {
 
   struct PlateTopic {
     PlateTopicSettings settings;
+    PlateInputConfig input;  // settings_.estimator.plates[k]
     ros::Subscriber subscriber;
     ros::Publisher cop_pub;
     std::string frame;  // the plate frame whose pose the estimator holds (COP frame_id)
@@ -117,7 +119,7 @@ class EstimatorNode {
                            const std::vector<std::string>& frames);
 
   ros::NodeHandle nh_, private_nh_;
-  NodeSettings settings_;
+  Settings settings_;
   std::unique_ptr<Estimator> estimator_;
   std::unordered_map<std::string, int> coordinate_of_;  // joint name -> index in q
   std::unordered_map<std::string, int> segment_of_;     // moving joint name -> segment

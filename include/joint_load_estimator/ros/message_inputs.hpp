@@ -16,13 +16,14 @@
 
 namespace jle {
 
-/// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
-ModelOptions modelOptions(const NodeSettings& settings);
+/// The ModelOptions that `settings` ask for: floating_base, and keep_fixed_joints with
+/// the joint of every sensor input (estimator.wrenches[k].sensor_joint) added.
+ModelOptions modelOptions(const Settings& settings);
 
 /// Fills in the link of every force/torque sensor input (sensor_joint set, link empty)
-/// with its joint's child link, in settings.wrenches and settings.estimator.wrenches.
-/// Joints the model does not keep are left for the Estimator to refuse by name.
-void completeSensorLinks(const Model<double>& model, NodeSettings& settings);
+/// in settings.estimator.wrenches with its joint's child link. Joints the model does not
+/// keep are left for the Estimator to refuse by name.
+void completeSensorLinks(const Model<double>& model, Settings& settings);
 
 /// Segments whose loads are published: `joints` (URDF names of moving joints, or of
 /// fixed joints kept as segments), or every moving segment when it is empty. Throws
