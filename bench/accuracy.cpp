@@ -118,11 +118,12 @@ std::vector<Differentiator> differentiators(bool quick) {
   }
   if (!quick) {
     // The filters with the measurement noise left at DifferentiatorConfig's default
-    // (1e-4 rad), not matched to the encoder: the shipped Kalman settings, and the best
-    // constant-jerk ones. Only q / r^2 matters to the gain.
+    // (1e-4 rad), not matched to the encoder: the Kalman settings shipped before the
+    // study (constant acceleration, q = 1e3), and the best constant-jerk ones (1e4 is
+    // the node's default since). Only q / r^2 matters to the gain.
     const jle::DifferentiatorConfig defaults;
     for (auto model : {jle::KalmanModel::kConstantAcceleration, jle::KalmanModel::kConstantJerk})
-      for (double q : model == jle::KalmanModel::kConstantAcceleration ? std::vector<double>{defaults.process_noise}
+      for (double q : model == jle::KalmanModel::kConstantAcceleration ? std::vector<double>{1e3}
                                                                        : std::vector<double>{1e2, 1e4}) {
         jle::DifferentiatorConfig c;
         c.type = jle::DifferentiatorType::kKalman;
@@ -702,10 +703,17 @@ bool sweepsSavings(const std::string& label) {
   return false;
 }
 
-// Whether the differentiator is DifferentiatorConfig's default (what the node runs
-// unless configured otherwise).
+// The former default filter, which docs/accuracy.md compares with the node's.
+jle::DifferentiatorConfig formerDefault() {
+  jle::DifferentiatorConfig d;
+  d.type = jle::DifferentiatorType::kSavitzkyGolay;  // 9 samples, quadratic, causal
+  return d;
+}
+
+// Whether the differentiator is the former default (Savitzky-Golay, 9 samples,
+// quadratic, causal: the shipped_default column).
 bool isShippedDefault(const Differentiator& diff) {
-  const jle::DifferentiatorConfig d, &c = diff.config;
+  const jle::DifferentiatorConfig d = formerDefault(), &c = diff.config;
   if (c.type != d.type) return false;
   if (c.type == jle::DifferentiatorType::kKalman)
     return c.kalman_model == d.kalman_model && c.process_noise == d.process_noise &&

@@ -178,6 +178,8 @@ void differentiation(benchmark::State& state, jle::DifferentiatorType type, int 
   jle::DifferentiatorConfig c;
   c.type = type;
   c.window = window;
+  c.kalman_model = jle::KalmanModel::kConstantAcceleration;  // for kKalman
+  c.process_noise = 1e3;
   const int channels = 7 + 12;  // a 7-joint arm with two wrench inputs
   jle::DifferentiatorBank bank(c, channels);
   std::vector<double> x(channels, 0.0);
@@ -215,6 +217,7 @@ void scaling(benchmark::State& state, bool tree) {
 // A "_gy" suffix: gravity along -y (a vertical planar arm turning about z: planar).
 jle::EstimatorConfig savingsVariant(std::string variant) {
   jle::EstimatorConfig c;
+  c.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;  // 9 samples, causal
   const std::string gy = "_gy";
   if (variant.size() > gy.size() && variant.compare(variant.size() - gy.size(), gy.size(), gy) == 0) {
     c.gravity_world = Eigen::Vector3d(0.0, -9.80665, 0.0);

@@ -533,6 +533,7 @@ DifferentiatorConfig finiteDifference(int order) {
 
 DifferentiatorConfig savitzkyGolay(int window, int order, int delay) {
   DifferentiatorConfig c;
+  c.type = DifferentiatorType::kSavitzkyGolay;
   c.window = window;
   c.order = order;
   c.delay = delay;
@@ -543,6 +544,7 @@ DifferentiatorConfig kalman(jle::KalmanModel model) {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;
   c.kalman_model = model;
+  c.process_noise = 1e3;
   return c;
 }
 

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake catkin python3-catkin-pkg
   ros-base-dev libroscpp-dev ros-message-generation libstd-msgs-dev
-  libsensor-msgs-dev libgeometry-msgs-dev libtf2-ros-dev libtf2-eigen-dev
+  libsensor-msgs-dev libgeometry-msgs-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev
   libdiagnostic-updater-dev librosbag-dev libnodelet-dev pluginlib-dev
   libeigen3-dev libtinyxml2-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch

@@ -3,6 +3,7 @@
 // out. ROS-free.
 #pragma once
 
+#include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
@@ -18,138 +19,6 @@
 #include <vector>
 
 namespace jle {
-
-/// What to do with a wrench input that has not been heard from for longer than its
-/// timeout.
-enum class StalePolicy : std::uint8_t {
-  kHold,  ///< keep using its last value
-  kZero,  ///< take it as zero (the contact has ended)
-  kStop,  ///< publish no loads while it is stale
-};
-
-/// One measured wrench acting on the robot.
-struct WrenchInputConfig {
-  std::string name;  ///< for messages (the topic)
-  std::string link;  ///< URDF link the wrench acts on; samples are given in its frame
-  double sign = 1.0;  ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies (force plate)
-  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
-  StalePolicy stale_policy = StalePolicy::kHold;
-  /// Non-empty: the input is a force/torque sensor mounted at this FIXED joint of the
-  /// URDF (kept as its own segment; `link` must be empty or the joint's child link). It
-  /// measures the joint wrench: what the proximal side (the joint's parent link) exerts
-  /// on the distal side (its child link); samples are given like any input's, in the
-  /// child link frame, moment about its origin (the joint origin). It is not applied as
-  /// an external load: the joint's wrench is predicted from the model of the distal
-  /// subtree and the other inputs (predictedWrench), and the measurement replaces the
-  /// prediction before it is passed on, so the joints proximal to the sensor carry the
-  /// measured wrench (the sensor knows about unmodelled payloads and contacts).
-  std::string sensor_joint;
-  /// Standard deviation of each sample's components, for the covariance of the loads
-  /// (UncertaintyConfig): force [N] and moment [N m], per component, white.
-  double force_noise = 0.0;
-  double moment_noise = 0.0;
-};
-
-/// The uncertainty of the inputs, propagated to the covariance of every computed joint
-/// wrench (Estimator::covariance; docs/uncertainty.md). All standard deviations are
-/// 1 sigma; the errors are taken as independent, zero-mean and (for the sensors) white.
-struct UncertaintyConfig {
-  bool enabled = false;
-  bool diagonal_only = false;  ///< only the 6 variances per joint (off-diagonal terms left 0)
-  /// [rad or m] noise of each joint position sample (an encoder of step D: D / sqrt(12)).
-  double position_noise = 0.0;
-  double mass_fraction = 0.0;     ///< relative, per link
-  double com_offset = 0.0;        ///< [m] per axis, per link
-  double inertia_fraction = 0.0;  ///< relative (the whole tensor scaled), per link
-  /// Include the (linearised) dependence on q and q-dot; false: only the q-ddot, wrench
-  /// and inertial-parameter parts, which are exact and cheaper.
-  bool linearize_state = true;
-  /// [s] The covariance is computed for a published sample whose stamp is at least
-  /// `period` after the last computed one (and for the first three after a start, a
-  /// reset, a filter restart or a gap of more than 3 periods); the samples in between
-  /// get the quadratic through the last three computed ones at their actual times
-  /// (variances clamped at 0). 0: computed for every published sample. The error depends
-  /// on the period, not on the joint-state rate. docs/uncertainty.md measures the cost
-  /// and the error. 0.018: the propagation costs at most as much as the loads at 1 kHz
-  /// (Panda, Talos), worst sigma error 2.7%.
-  double period = 0.018;
-  /// With period > 0: an extrapolated sample is computed instead when the filter's noise
-  /// gain (the covariance of the estimated q, q-dot, q-ddot per unit measurement
-  /// variance) has moved by more than this fraction since the last computed sample
-  /// (irregular stamps: the gain changes with every spacing, which no extrapolation of
-  /// the past follows). 0.02 bounds the sigma error from that source to ~1%.
-  double gain_tolerance = 0.02;
-};
-
-/// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
-/// frame, moment about the plate origin; its reaction acts on `plate.link`.
-/// The plate's six components are resampled and filtered at the joint stamps like a
-/// wrench input's. The contact threshold acts on each raw sample before filtering (a
-/// sample below it enters the filter as zero) and again on the raw signal at the
-/// estimate's stamp: the reaction is applied only when the plate is in contact at that
-/// stamp, so the filters' memory of a stance never loads a swinging foot. The applied
-/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot.
-struct PlateInputConfig {
-  ForcePlateConfig plate;
-  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
-  StalePolicy stale_policy = StalePolicy::kZero;
-};
-
-/// Arithmetic of the dynamics (the filters always run in double).
-enum class Precision : std::uint8_t { kDouble, kFloat };
-
-/// savings.planar: whether to solve the planar 3x3 system (planar.hpp).
-enum class PlanarMode : std::uint8_t {
-  kAuto,  ///< when the model is detected planar (exact: within 1e-12 relative of 6x6)
-  kOn,    ///< always: the user asserts planarity, out-of-plane parts are dropped
-  kOff,   ///< never
-};
-
-/// Work the estimator skips when a scene does not need it. Each switch exists for
-/// measurement; the exact ones are on by default.
-struct Savings {
-  /// Compute only the segments distal to the published joints, and the kinematics
-  /// they depend on.
-  bool prune = true;
-  /// A chain of massless, unloaded segments passes its distal wrench on unchanged.
-  bool massless_chains = true;
-  /// Skip the gyroscopic term where omega lies along a principal axis of inertia.
-  bool gyroscopic = true;
-  /// Joint velocities and accelerations whose magnitudes are all below these
-  /// thresholds are taken as zero (quasi-static scene). 0 = off (the default: not exact).
-  double static_velocity = 0.0;      ///< [rad/s or m/s]
-  double static_acceleration = 0.0;  ///< [rad/s^2 or m/s^2]
-  /// When the filtered inputs have not changed since the last computation, reuse its
-  /// result instead of recomputing (exact: same inputs, same outputs).
-  bool reuse_unchanged = true;
-  /// With reuse_unchanged: publish the reused result with the new stamp (true) or
-  /// publish nothing for an unchanged sample (false; the node's choice, not the estimator's).
-  bool republish_unchanged = true;
-  /// Solve the planar 3x3 system of the paper's section 6 instead of the 6x6 one when
-  /// every computed joint turns about one normal n, slides across it, gravity and the
-  /// inertias agree (planar.hpp states the exact conditions). The published 6-D
-  /// wrenches are unchanged (within 1e-12 relative). kAuto: detected at construction,
-  /// and a sample whose filtered wrench input leaves the plane takes the 6x6 path.
-  /// kOn: also where detection refuses (not exact there). Precision::kFloat always
-  /// keeps the 6x6 path.
-  PlanarMode planar = PlanarMode::kAuto;
-};
-
-struct EstimatorConfig {
-  DifferentiatorConfig differentiator;
-  Precision precision = Precision::kDouble;
-  Savings savings;
-  /// Joints whose loads are wanted (URDF names); empty: all. With savings.prune, only
-  /// what they depend on is computed.
-  std::vector<std::string> joints;
-  Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};  ///< [m/s^2]
-  std::vector<WrenchInputConfig> wrenches;
-  /// Loads are computed for every n-th joint sample (the filters see every sample).
-  int decimation = 1;
-  UncertaintyConfig uncertainty;
-  /// Force plates (after the wrench inputs in the filter bank).
-  std::vector<PlateInputConfig> plates;
-};
 
 /// What became of a joint sample.
 enum class SampleStatus : std::uint8_t {

@@ -69,24 +69,10 @@ void addForceCongruence(const Eigen::Matrix3d& R, const Eigen::Vector3d& r, cons
   out.bottomRightCorner<3, 3>() += SB + SB.transpose() + Y.bottomRightCorner<3, 3>();
 }
 
-void checkNoise(double value, const std::string& name) {
-  if (!(value >= 0.0) || !std::isfinite(value))
-    throw std::invalid_argument(name + " must be finite and non-negative");
-}
-
 }  // namespace
 
 void Estimator::setUpCovariance() {
   const UncertaintyConfig& u = config_.uncertainty;
-  checkNoise(u.position_noise, "uncertainty.position_noise");
-  checkNoise(u.mass_fraction, "uncertainty.mass_fraction");
-  checkNoise(u.com_offset, "uncertainty.com_offset");
-  checkNoise(u.inertia_fraction, "uncertainty.inertia_fraction");
-  checkNoise(u.period, "uncertainty.period");
-  for (const WrenchInputConfig& c : config_.wrenches) {
-    checkNoise(c.force_noise, "wrench input '" + c.name + "': force_noise");
-    checkNoise(c.moment_noise, "wrench input '" + c.name + "': moment_noise");
-  }
   const int n = model_.nsegments();
   const std::size_t ns = static_cast<std::size_t>(n);
   covariance_.assign(ns, Matrix6::Zero());

@@ -60,8 +60,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
       qd_(VectorX<double>::Zero(model.nq)),
       qdd_(VectorX<double>::Zero(model.nq)),
       cov_nominal_(model_) {
-  if (config_.decimation < 1) throw std::invalid_argument("decimation must be at least 1");
-  if (!config_.gravity_world.allFinite()) throw std::invalid_argument("gravity is not finite");
+  validate(config_);  // what the model cannot tell; links and joints are checked below
   base_channel_ = model_.nq;
   wrench_channel_ = base_channel_ + (model_.floating_base ? 7 : 0);
   sensor_of_segment_.assign(static_cast<std::size_t>(model_.nsegments()), -1);
@@ -89,10 +88,6 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
       have_sensors_ = true;
     }
     input.frame = model_.frameIndex(input.config.link);  // throws naming the link
-    if (!(c.sign == 1.0 || c.sign == -1.0))
-      throw std::invalid_argument("wrench input '" + c.name + "': sign must be +1 or -1");
-    if (!(c.timeout > 0.0))
-      throw std::invalid_argument("wrench input '" + c.name + "': timeout must be positive");
     input.times.assign(kWrenchHistory, 0.0);
     input.values.assign(kWrenchHistory, Eigen::Matrix<double, 6, 1>::Zero());
     inputs_.push_back(input);
@@ -109,11 +104,6 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(what + ": " + e.what());
     }
-    if (!(c.timeout > 0.0)) throw std::invalid_argument(what + ": timeout must be positive");
-    if (!(c.plate.contact_threshold >= 0.0) || !std::isfinite(c.plate.contact_threshold))
-      throw std::invalid_argument(what + ": contact_threshold must be finite and >= 0");
-    if (!std::isfinite(c.plate.surface_height))
-      throw std::invalid_argument(what + ": surface_height is not finite");
     plate.input.config.name = c.plate.name;
     plate.input.config.link = c.plate.link;
     plate.input.config.timeout = c.timeout;

@@ -178,10 +178,12 @@ Outputs::Outputs(const Options& options, const jle::Pipeline& pipeline) : option
     }
     topic_ = options.prefix + "/joint_loads";
   }
-  const std::vector<std::string> names = jle::jointLoadColumns(record.joint, false);
+  const std::vector<std::string> names = jle::jointLoadColumns(record.joint);
   if (!options.csv.empty()) {
+    jle::LoadColumnLayout layout;
+    layout.effort_stddev = !record.effort_stddev.empty();
     csv_ = std::make_unique<jle::CsvWriter>(options.csv);
-    csv_->writeHeader(jle::jointLoadColumns(record.joint, !record.effort_stddev.empty()));
+    csv_->writeHeader(jle::jointLoadColumns(record.joint, layout));
   }
   if (!options.sto.empty()) {
     sto_ = std::make_unique<jle::StoWriter>(options.sto);

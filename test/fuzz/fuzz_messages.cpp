@@ -109,7 +109,11 @@ jle::Settings settingsFrom(Bytes& in) {
       config.differentiator.type = jle::DifferentiatorType::kFiniteDifference;
       config.differentiator.window = 3;
       break;
-    default: config.differentiator.type = jle::DifferentiatorType::kKalman; break;
+    default:
+      config.differentiator.type = jle::DifferentiatorType::kKalman;
+      config.differentiator.kalman_model = jle::KalmanModel::kConstantAcceleration;
+      config.differentiator.process_noise = 1e3;
+      break;
   }
   config.decimation = 1 + (c0 >> 4) % 3;
   config.precision = (c0 & 0x80) ? jle::Precision::kFloat : jle::Precision::kDouble;

@@ -119,6 +119,17 @@ TEST(BadConfig, MisspeltYamlKey) {
   expectRefused("/unknown_key", {"unknown parameter 'decimaton'"});
 }
 
+// The ko file of each key family (test/config, test_settings.cpp): a value out of range,
+// refused by the one validate() with the key named.
+TEST(BadConfig, ValueOutOfRangeInEachKeyFamily) {
+  expectRefused("/ko_top_level", {"parameter 'diagnostic_period'"});
+  expectRefused("/ko_differentiator", {"parameter 'differentiator/order'"});
+  expectRefused("/ko_wrenches", {"parameter 'wrenches[1]/sign'"});
+  expectRefused("/ko_force_plates", {"parameter 'force_plates[1]/name'"});
+  expectRefused("/ko_uncertainty", {"parameter 'uncertainty/position_noise'"});
+  expectRefused("/ko_savings", {"parameter 'savings/static_velocity'"});
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

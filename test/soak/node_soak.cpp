@@ -159,7 +159,7 @@ ros::Time fromNs(std::int64_t ns) {
 class Driver {
 public:
   Driver(const Options &o) : o_(o) {
-    const jle::NodeSettings settings =
+    const jle::Settings settings =
         jle::parseSettings(jle::loadYaml(o.config));
     if (settings.wrenches.empty())
       throw std::runtime_error(
@@ -171,7 +171,7 @@ public:
     delay_ = bank.config().delay;
     jump_back_ns_ =
         static_cast<std::int64_t>(2e9 * settings.time_jump_threshold);
-    wrench_link_ = settings.wrenches[0].input.link;
+    wrench_link_ = settings.estimator.wrenches[0].link;
 
     std::string urdf;
     if (!nh_.getParam(settings.robot_description, urdf))

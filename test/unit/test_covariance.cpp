@@ -77,6 +77,7 @@ TEST(NoiseGain, SavitzkyGolayFivePointCentred) {
   // (-2, -1, 0, 1, 2) / 10h, second derivative (2, -1, -2, -1, 2) / 7h^2.
   const double h = 1e-2;
   jle::DifferentiatorConfig c;
+  c.type = jle::DifferentiatorType::kSavitzkyGolay;
   c.window = 5;
   c.delay = 2;
   Eigen::Matrix3d expected;
@@ -291,6 +292,7 @@ void runMonteCarlo(const Scene& scene, int replays) {
 
 jle::DifferentiatorConfig savitzkyGolay(int window, int delay) {
   jle::DifferentiatorConfig c;
+  c.type = jle::DifferentiatorType::kSavitzkyGolay;
   c.window = window;
   c.delay = delay;
   return c;
@@ -298,7 +300,7 @@ jle::DifferentiatorConfig savitzkyGolay(int window, int delay) {
 
 constexpr int kReplays = 10000;
 
-// The default filter at 1 kHz: q-ddot's noise dominates, wrench noise on top.
+// Savitzky-Golay, 9 samples, causal at 1 kHz: q-ddot's noise dominates, wrench noise on top.
 TEST(CovarianceMonteCarlo, PandaDefaultFilter) {
   Scene s{"panda", "panda.urdf", {"panda_hand"}, savitzkyGolay(9, 0), 1000.0, 1e-4, 0.5, 0.05,
           {12, 20}};
@@ -317,6 +319,7 @@ TEST(CovarianceMonteCarlo, TalosKalman) {
   jle::DifferentiatorConfig k;
   k.type = jle::DifferentiatorType::kKalman;
   k.process_noise = 1e4;
+  k.kalman_model = jle::KalmanModel::kConstantAcceleration;
   k.measurement_noise = 1e-4;
   Scene s{"talos", "talos_reduced.urdf", {"left_sole_link", "right_sole_link", "gripper_left_base_link"},
           k, 1000.0, 1e-4, 1.0, 0.1, {15, 30}};
@@ -346,6 +349,7 @@ void expectMatchesReference(const ReferenceScene& scene, bool linearize_state) {
   const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 23),
                                {wrench});
   jle::EstimatorConfig config;
+  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   config.savings.reuse_unchanged = false;
   jle::WrenchInputConfig w;
   w.name = w.link = scene.wrench_link;
@@ -577,6 +581,7 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
     for (int k = 0; k * h < 2.0 - 1e-9; ++k) stamps.push_back(k * h);
   }
   jle::EstimatorConfig config;
+  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   config.savings.reuse_unchanged = false;
   config.uncertainty.enabled = true;
   config.uncertainty.period = 0.0;
@@ -758,6 +763,7 @@ TEST(CovarianceMonteCarlo, InertialParametersTalos) {
   const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 3),
                                {jle::randomWrench("left_sole_link", 5)});
   jle::EstimatorConfig config;
+  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   config.savings.reuse_unchanged = false;
   jle::WrenchInputConfig w;
   w.name = w.link = "left_sole_link";
@@ -859,6 +865,7 @@ TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
     const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31), {});
     for (double jitter : {0.0, 0.01}) {
       jle::EstimatorConfig config;
+      config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
       config.savings.reuse_unchanged = false;
       config.uncertainty.enabled = true;
       config.uncertainty.position_noise = 1e-4;
@@ -891,7 +898,9 @@ TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
       EXPECT_LE(worst, kExtrapolationBound[robot] + 3.5 * config.uncertainty.gain_tolerance)
           << urdf << " jitter " << jitter;
       // Regular stamps: the guard never fires (one computed sample in 18, and the first).
-      if (jitter == 0.0) EXPECT_LT(equal, published / 10) << urdf;
+      if (jitter == 0.0) {
+        EXPECT_LT(equal, published / 10) << urdf;
+      }
     }
     ++robot;
   }

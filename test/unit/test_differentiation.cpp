@@ -82,6 +82,7 @@ TEST(Differentiator, SavitzkyGolayIsExactForItsOrder) {
   for (int order = 2; order <= 4; ++order)
     for (int window : {order + 1, 9, 15}) {
       DifferentiatorConfig c;
+      c.type = DifferentiatorType::kSavitzkyGolay;
       c.order = order;
       c.window = window;
       SCOPED_TRACE("order " + std::to_string(order) + " window " + std::to_string(window));
@@ -91,6 +92,7 @@ TEST(Differentiator, SavitzkyGolayIsExactForItsOrder) {
 
 TEST(Differentiator, CentredSavitzkyGolayDescribesTheMiddleSample) {
   DifferentiatorConfig c;
+  c.type = DifferentiatorType::kSavitzkyGolay;
   c.window = 11;
   c.order = 3;
   c.delay = 5;
@@ -116,6 +118,7 @@ TEST(Differentiator, CentredFitErrorIsTheTextbookTruncationTerm) {
   double worst[2] = {0, 0};
   for (int delay : {0, 4}) {
     DifferentiatorConfig c;
+    c.type = DifferentiatorType::kSavitzkyGolay;
     c.window = 9;
     c.order = 2;
     c.delay = delay;
@@ -140,6 +143,7 @@ TEST(Differentiator, KalmanTracksConstantAccelerationWithoutBias) {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;
   c.process_noise = 1.0;
+  c.kalman_model = jle::KalmanModel::kConstantAcceleration;
   c.measurement_noise = 1e-3;
   DifferentiatorBank bank(c, 1);
   const Poly p{{0.1, 0.4, 1.5}, 0.0};
@@ -196,6 +200,7 @@ TEST(Differentiator, GapRestartsTheWindow) {
 
 TEST(Differentiator, InvalidConfigurationsNameTheField) {
   DifferentiatorConfig c;
+  c.type = DifferentiatorType::kSavitzkyGolay;
   c.order = 1;
   try {
     DifferentiatorBank bank(c, 1);
@@ -204,6 +209,7 @@ TEST(Differentiator, InvalidConfigurationsNameTheField) {
     EXPECT_NE(std::string(e.what()).find("order"), std::string::npos);
   }
   c = DifferentiatorConfig();
+  c.type = DifferentiatorType::kSavitzkyGolay;
   c.delay = 20;
   EXPECT_THROW(DifferentiatorBank(c, 1), std::invalid_argument);
   c = DifferentiatorConfig();

@@ -195,6 +195,7 @@ TEST(Estimator, FloatingBaseTwistAndAccelerationFromItsPose) {
   options.floating_base = true;
   const jle::Model<double> model = jle::modelFromUrdfString(xml, options);
   jle::EstimatorConfig config;
+  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   config.differentiator.window = 9;
   config.differentiator.order = 4;
   config.differentiator.delay = 4;

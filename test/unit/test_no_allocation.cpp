@@ -51,14 +51,24 @@ TEST(NoAllocation, CorePassesOnTalos) {
   EXPECT_EQ(g_allocations - before, 0);
 }
 
+// Finite differences, Savitzky-Golay, the constant-acceleration Kalman filter and the
+// default (the node's constant-jerk Kalman filter).
+std::vector<jle::DifferentiatorConfig> eachDifferentiator() {
+  std::vector<jle::DifferentiatorConfig> filters(4);
+  filters[0].type = jle::DifferentiatorType::kFiniteDifference;
+  filters[1].type = jle::DifferentiatorType::kSavitzkyGolay;
+  filters[2].kalman_model = jle::KalmanModel::kConstantAcceleration;
+  filters[2].process_noise = 1e3;
+  return filters;
+}
+
 TEST(NoAllocation, EstimatorWithEachDifferentiator) {
   const jle::Model<double> model =
       jle::modelFromUrdfFile(kData + "/urdf/chains/panda_chain.urdf");
-  for (jle::DifferentiatorType type :
-       {jle::DifferentiatorType::kFiniteDifference, jle::DifferentiatorType::kSavitzkyGolay,
-        jle::DifferentiatorType::kKalman}) {
+  const std::vector<jle::DifferentiatorConfig> filters = eachDifferentiator();
+  for (std::size_t f = 0; f < filters.size(); ++f) {
     jle::EstimatorConfig config;
-    config.differentiator.type = type;
+    config.differentiator = filters[f];
     jle::WrenchInputConfig ft;
     ft.name = "ft";
     ft.link = "panda_hand";
@@ -75,7 +85,7 @@ TEST(NoAllocation, EstimatorWithEachDifferentiator) {
       estimator.addWrench(0, t, Eigen::Vector3d(1, 0, -5), Eigen::Vector3d(0, 0.1, 0));
       published += estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished;
     }
-    EXPECT_EQ(g_allocations - before, 0) << "differentiator " << static_cast<int>(type);
+    EXPECT_EQ(g_allocations - before, 0) << "differentiator " << f;
     EXPECT_GT(published, 1800);
   }
 }
@@ -87,6 +97,7 @@ TEST(NoAllocation, EstimatorWithCovariance) {
   for (int variant = 0; variant < 3; ++variant) {
     const bool linearize = variant != 1;
     jle::EstimatorConfig config;
+    config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
     jle::WrenchInputConfig ft;
     ft.name = ft.link = "panda_hand";
     ft.force_noise = 0.5;
@@ -120,6 +131,7 @@ TEST(NoAllocation, EstimatorWithCovariance) {
 TEST(NoAllocation, EstimatorOnThePlanarPath) {
   const jle::Model<double> arm = jle::modelFromUrdfFile(kData + "/urdf/planar_arm.urdf");
   jle::EstimatorConfig c;
+  c.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   c.gravity_world = Eigen::Vector3d(0, -9.80665, 0);
   jle::WrenchInputConfig w;
   w.name = w.link = "tool";

@@ -68,31 +68,32 @@ force_plates:
 )";
 
 TEST_F(PlatesOffline, SettingsParsed) {
-  const jle::NodeSettings s = jle::parseSettings(yaml(kPlate, dir_));
+  const jle::Settings s = jle::parseSettings(yaml(kPlate, dir_));
   ASSERT_EQ(s.force_plates.size(), 1u);
   ASSERT_EQ(s.estimator.plates.size(), 1u);
   const jle::PlateTopicSettings& p = s.force_plates[0];
-  EXPECT_EQ(p.input.plate.name, "plate1");
+  const jle::PlateInputConfig& input = s.estimator.plates[0];
+  EXPECT_EQ(input.plate.name, "plate1");
   EXPECT_EQ(p.topic, "/force_plate_1/wrench");
   EXPECT_EQ(p.frame, "force_plate_1");
-  EXPECT_EQ(p.input.plate.link, "foot");
-  EXPECT_EQ(p.input.plate.surface_height, 0.04);
-  EXPECT_EQ(p.input.plate.contact_threshold, 20.0);
-  EXPECT_EQ(p.input.timeout, 0.5);
-  EXPECT_EQ(p.input.stale_policy, jle::StalePolicy::kHold);
+  EXPECT_EQ(input.plate.link, "foot");
+  EXPECT_EQ(input.plate.surface_height, 0.04);
+  EXPECT_EQ(input.plate.contact_threshold, 20.0);
+  EXPECT_EQ(input.timeout, 0.5);
+  EXPECT_EQ(input.stale_policy, jle::StalePolicy::kHold);
   EXPECT_TRUE(p.pose_configured);
-  EXPECT_EQ(p.input.plate.p_world_plate, Eigen::Vector3d(0.3, 0.2, -0.04));
+  EXPECT_EQ(input.plate.p_world_plate, Eigen::Vector3d(0.3, 0.2, -0.04));
   // [0, 0, 1, 1] normalised: 90 degrees about z, x -> y (exact to rounding, 1e-15).
-  EXPECT_NEAR((p.input.plate.R_world_plate * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY())
+  EXPECT_NEAR((input.plate.R_world_plate * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY())
                   .norm(), 0.0, 1e-15);
   EXPECT_EQ(s.body_mass, 70.0);
 
   // Defaults: zero policy, 20 N, 0.1 s, no pose (tf2), body_mass 0.
-  const jle::NodeSettings d = jle::parseSettings(
+  const jle::Settings d = jle::parseSettings(
       yaml("force_plates: [{name: a, topic: t, link: foot}]", dir_));
-  EXPECT_EQ(d.force_plates[0].input.stale_policy, jle::StalePolicy::kZero);
-  EXPECT_EQ(d.force_plates[0].input.plate.contact_threshold, 20.0);
-  EXPECT_EQ(d.force_plates[0].input.timeout, 0.1);
+  EXPECT_EQ(d.estimator.plates[0].stale_policy, jle::StalePolicy::kZero);
+  EXPECT_EQ(d.estimator.plates[0].plate.contact_threshold, 20.0);
+  EXPECT_EQ(d.estimator.plates[0].timeout, 0.1);
   EXPECT_FALSE(d.force_plates[0].pose_configured);
   EXPECT_EQ(d.body_mass, 0.0);
   EXPECT_EQ(jle::parseSettings(yaml("body_mass: -1", dir_)).body_mass, -1.0);

@@ -51,6 +51,7 @@ std::vector<std::string> movingJoints(const jle::Model<double>& model) {
 
 jle::EstimatorConfig noSavings() {
   jle::EstimatorConfig c;
+  c.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   c.savings.prune = false;
   c.savings.massless_chains = false;
   c.savings.gyroscopic = false;

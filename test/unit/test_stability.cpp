@@ -215,6 +215,7 @@ DifferentiatorConfig kalman(jle::KalmanModel model) {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;
   c.kalman_model = model;
+  c.process_noise = 1e3;
   return c;
 }
 
@@ -293,6 +294,7 @@ Outputs runSine(const DifferentiatorConfig& c, double T0, double h, int samples)
 
 std::vector<DifferentiatorConfig> everyFilter() {
   DifferentiatorConfig sg;
+  sg.type = DifferentiatorType::kSavitzkyGolay;
   sg.window = 9;
   sg.order = 2;
   sg.delay = 4;
@@ -341,6 +343,7 @@ TEST(StabilityFilters, LongRunsHoldNoAccumulatedError) {
   // can go on indefinitely. The stamps are exact (2^-10 s) or irregular (+-40%), where
   // the bank's reuse of its weights cannot tell the two banks apart.
   DifferentiatorConfig sg;
+  sg.type = DifferentiatorType::kSavitzkyGolay;
   sg.window = 9;
   sg.order = 2;
   for (const DifferentiatorConfig& c :

@@ -1,0 +1,234 @@
+// Every setting of the estimator and of its front ends (the node, process_bag, the
+// command-line tools, the bindings), each with its default, once, and their one
+// validation. Readers (rosparam/YAML in ros/settings.hpp, a command line, Python) only
+// map names onto these structures and call validate(). ROS-free.
+//
+// The keys named in the errors are the parameter names of config/default.yaml, with
+// `/` between a map and its key and `[i]` for a list's element: 'wrenches[0]/sign'.
+#pragma once
+
+#include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/force_plate.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace jle {
+
+/// A setting that is missing where required, of the wrong type or out of range; the
+/// message names the parameter ("parameter 'decimation' must be >= 1, it is 0").
+/// Derived from std::invalid_argument, which the Estimator's callers catch.
+class SettingsError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// What to do with a wrench input that has not been heard from for longer than its
+/// timeout.
+enum class StalePolicy : std::uint8_t {
+  kHold,  ///< keep using its last value
+  kZero,  ///< take it as zero (the contact has ended)
+  kStop,  ///< publish no loads while it is stale
+};
+
+/// One measured wrench acting on the robot.
+struct WrenchInputConfig {
+  std::string name;  ///< for messages (the topic)
+  std::string link;  ///< URDF link the wrench acts on; samples are given in its frame
+  double sign = 1.0;  ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies (force plate)
+  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
+  StalePolicy stale_policy = StalePolicy::kHold;
+  /// Non-empty: the input is a force/torque sensor mounted at this FIXED joint of the
+  /// URDF (kept as its own segment; `link` must be empty or the joint's child link). It
+  /// measures the joint wrench: what the proximal side (the joint's parent link) exerts
+  /// on the distal side (its child link); samples are given like any input's, in the
+  /// child link frame, moment about its origin (the joint origin). It is not applied as
+  /// an external load: the joint's wrench is predicted from the model of the distal
+  /// subtree and the other inputs (predictedWrench), and the measurement replaces the
+  /// prediction before it is passed on, so the joints proximal to the sensor carry the
+  /// measured wrench (the sensor knows about unmodelled payloads and contacts).
+  std::string sensor_joint;
+  /// Standard deviation of each sample's components, for the covariance of the loads
+  /// (UncertaintyConfig): force [N] and moment [N m], per component, white.
+  double force_noise = 0.0;
+  double moment_noise = 0.0;
+};
+
+/// The uncertainty of the inputs, propagated to the covariance of every computed joint
+/// wrench (Estimator::covariance; docs/uncertainty.md). All standard deviations are
+/// 1 sigma; the errors are taken as independent, zero-mean and (for the sensors) white.
+struct UncertaintyConfig {
+  bool enabled = false;
+  bool diagonal_only = false;  ///< only the 6 variances per joint (off-diagonal terms left 0)
+  /// [rad or m] noise of each joint position sample (an encoder of step D: D / sqrt(12)).
+  double position_noise = 0.0;
+  double mass_fraction = 0.0;     ///< relative, per link
+  double com_offset = 0.0;        ///< [m] per axis, per link
+  double inertia_fraction = 0.0;  ///< relative (the whole tensor scaled), per link
+  /// Include the (linearised) dependence on q and q-dot; false: only the q-ddot, wrench
+  /// and inertial-parameter parts, which are exact and cheaper.
+  bool linearize_state = true;
+  /// [s] The covariance is computed for a published sample whose stamp is at least
+  /// `period` after the last computed one (and for the first three after a start, a
+  /// reset, a filter restart or a gap of more than 3 periods); the samples in between
+  /// get the quadratic through the last three computed ones at their actual times
+  /// (variances clamped at 0). 0: computed for every published sample. The error depends
+  /// on the period, not on the joint-state rate. docs/uncertainty.md measures the cost
+  /// and the error. 0.018: the propagation costs at most as much as the loads at 1 kHz
+  /// (Panda, Talos), worst sigma error 2.7%.
+  double period = 0.018;
+  /// With period > 0: an extrapolated sample is computed instead when the filter's noise
+  /// gain (the covariance of the estimated q, q-dot, q-ddot per unit measurement
+  /// variance) has moved by more than this fraction since the last computed sample
+  /// (irregular stamps: the gain changes with every spacing, which no extrapolation of
+  /// the past follows). 0.02 bounds the sigma error from that source to ~1%.
+  double gain_tolerance = 0.02;
+};
+
+/// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
+/// frame, moment about the plate origin; its reaction acts on `plate.link`.
+/// The plate's six components are resampled and filtered at the joint stamps like a
+/// wrench input's. The contact threshold acts on each raw sample before filtering (a
+/// sample below it enters the filter as zero) and again on the raw signal at the
+/// estimate's stamp: the reaction is applied only when the plate is in contact at that
+/// stamp, so the filters' memory of a stance never loads a swinging foot. The applied
+/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot.
+struct PlateInputConfig {
+  ForcePlateConfig plate;
+  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
+  StalePolicy stale_policy = StalePolicy::kZero;
+};
+
+/// Arithmetic of the dynamics (the filters always run in double).
+enum class Precision : std::uint8_t { kDouble, kFloat };
+
+/// savings.planar: whether to solve the planar 3x3 system (planar.hpp).
+enum class PlanarMode : std::uint8_t {
+  kAuto,  ///< when the model is detected planar (exact: within 1e-12 relative of 6x6)
+  kOn,    ///< always: the user asserts planarity, out-of-plane parts are dropped
+  kOff,   ///< never
+};
+
+/// Work the estimator skips when a scene does not need it. Each switch exists for
+/// measurement; the exact ones are on by default.
+struct Savings {
+  /// Compute only the segments distal to the published joints, and the kinematics
+  /// they depend on.
+  bool prune = true;
+  /// A chain of massless, unloaded segments passes its distal wrench on unchanged.
+  bool massless_chains = true;
+  /// Skip the gyroscopic term where omega lies along a principal axis of inertia.
+  bool gyroscopic = true;
+  /// Joint velocities and accelerations whose magnitudes are all below these
+  /// thresholds are taken as zero (quasi-static scene). 0 = off (the default: not exact).
+  double static_velocity = 0.0;      ///< [rad/s or m/s]
+  double static_acceleration = 0.0;  ///< [rad/s^2 or m/s^2]
+  /// When the filtered inputs have not changed since the last computation, reuse its
+  /// result instead of recomputing (exact: same inputs, same outputs).
+  bool reuse_unchanged = true;
+  /// With reuse_unchanged: publish the reused result with the new stamp (true) or
+  /// publish nothing for an unchanged sample (false; the node's choice, not the estimator's).
+  bool republish_unchanged = true;
+  /// Solve the planar 3x3 system of the paper's section 6 instead of the 6x6 one when
+  /// every computed joint turns about one normal n, slides across it, gravity and the
+  /// inertias agree (planar.hpp states the exact conditions). The published 6-D
+  /// wrenches are unchanged (within 1e-12 relative). kAuto: detected at construction,
+  /// and a sample whose filtered wrench input leaves the plane takes the 6x6 path.
+  /// kOn: also where detection refuses (not exact there). Precision::kFloat always
+  /// keeps the 6x6 path.
+  PlanarMode planar = PlanarMode::kAuto;
+};
+
+/// The estimator's settings (the keys of config/default.yaml that the Estimator reads).
+struct EstimatorConfig {
+  /// The filter of the joint positions and of the inputs (the node's default: the
+  /// accuracy study's constant-jerk Kalman filter, docs/accuracy.md).
+  DifferentiatorConfig differentiator;
+  Precision precision = Precision::kDouble;
+  Savings savings;
+  /// Joints whose loads are wanted and published (URDF names of moving joints, or of
+  /// fixed joints kept as segments); empty: every moving joint. With savings.prune, only
+  /// what they depend on is computed.
+  std::vector<std::string> joints;
+  Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};  ///< [m/s^2]
+  std::vector<WrenchInputConfig> wrenches;
+  /// Loads are computed for every n-th joint sample (>= 1; the filters see every sample).
+  int decimation = 1;
+  UncertaintyConfig uncertainty;
+  /// Force plates (after the wrench inputs in the filter bank).
+  std::vector<PlateInputConfig> plates;
+};
+
+/// One measured wrench topic of a front end (wrenches[k]): where the messages come
+/// from. Pairs by index with EstimatorConfig::wrenches[k], which holds the input itself
+/// (link, sign, timeout, sensor_joint, noises).
+struct WrenchTopicSettings {
+  std::string topic;  ///< required
+  std::string frame;  ///< expressed-in frame; empty: the message's header.frame_id
+  /// Sensor inputs (sensor_joint set): the residual (measured - predicted) above either
+  /// threshold is a diagnostic warning.
+  double force_threshold = 5.0;   ///< [N], > 0
+  double moment_threshold = 0.5;  ///< [N m], > 0
+};
+
+/// One force plate topic of a front end (force_plates[k]). Pairs by index with
+/// EstimatorConfig::plates[k], which holds the plate itself (name, link, surface_height,
+/// contact_threshold, pose, timeout, stale_policy).
+struct PlateTopicSettings {
+  std::string topic;  ///< required
+  std::string frame;  ///< tf2 frame of the plate; empty: the message's header.frame_id
+  /// The pose (position, orientation) was configured: the estimator holds it, no tf2
+  /// look-up. False: the front end finds it with tf2.
+  bool pose_configured = false;
+};
+
+/// Every setting of the node and of the offline front ends (process_bag), with the
+/// parameter names of config/default.yaml (README, "Parameters").
+struct Settings {
+  std::string robot_description = "robot_description";  ///< parameter holding the URDF
+  std::string joint_states_topic = "joint_states";
+  bool publish_wrench_topics = true;  ///< advertise ~wrench/<joint>
+  bool floating_base = false;
+  std::string world_frame = "world";  ///< tf2 frame of the world (floating base)
+  std::string base_frame;             ///< tf2 frame of the base; empty: the URDF root link
+  double time_jump_threshold = 1.0;   ///< [s] > 0; a stamp older than this is a jump back: reset
+  /// Fixed joints kept as their own segments (their wrench is published). The joints of
+  /// the sensor inputs (estimator.wrenches[k].sensor_joint) are kept too, without being
+  /// listed here (modelOptions()).
+  std::vector<std::string> keep_fixed_joints;
+  /// Floating base: a residual force above this fraction (> 0) of the total weight is a
+  /// diagnostic warning.
+  double base_residual_threshold = 0.1;
+  /// ~calibrate_bias: the robot is still while every estimated |q-dot| stays below this.
+  double still_velocity = 0.02;  ///< [rad/s or m/s], > 0
+  /// YAML file of the sensor biases: loaded at start if it exists, written by
+  /// ~calibrate_bias. Empty: not loaded, and calibrate_bias writes none.
+  std::string bias_file;
+  /// [s] > 0: period of the node's diagnostics (/diagnostics). diagnostic_updater reads
+  /// the same key from the node's private namespace; it is kept here so that it is
+  /// validated, documented and defaulted with the others.
+  double diagnostic_period = 1.0;
+  /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
+  double body_mass = 0.0;
+  /// The estimator's settings; estimator.joints are the joints whose loads are published.
+  EstimatorConfig estimator;
+  std::vector<WrenchTopicSettings> wrenches;     ///< pairs with estimator.wrenches
+  std::vector<PlateTopicSettings> force_plates;  ///< pairs with estimator.plates
+};
+
+/// Checks every model-independent setting of `config` (the differentiator, decimation,
+/// gravity, savings, uncertainty, each wrench input and plate); throws SettingsError
+/// naming the key. What needs the model (links and joints that exist) is checked by the
+/// Estimator.
+void validate(const EstimatorConfig& config);
+
+/// Checks `settings`: validate(settings.estimator), the front end's own settings, and
+/// that wrenches and force_plates pair with estimator.wrenches and estimator.plates.
+/// Throws SettingsError naming the key.
+void validate(const Settings& settings);
+
+}  // namespace jle

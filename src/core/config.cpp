@@ -1,0 +1,134 @@
+#include <joint_load_estimator/config.hpp>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <utility>
+
+namespace jle {
+namespace {
+
+[[noreturn]] void fail(const std::string& key, const std::string& what) {
+  throw SettingsError("parameter '" + key + "' " + what);
+}
+
+std::string number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+void finite(const std::string& key, double v) {
+  if (!std::isfinite(v)) fail(key, "must be finite, it is " + number(v));
+}
+
+void positive(const std::string& key, double v) {
+  if (!(v > 0.0) || !std::isfinite(v)) fail(key, "must be finite and > 0, it is " + number(v));
+}
+
+void nonNegative(const std::string& key, double v) {
+  if (!(v >= 0.0) || !std::isfinite(v)) fail(key, "must be finite and >= 0, it is " + number(v));
+}
+
+void required(const std::string& key, const std::string& v) {
+  if (v.empty()) fail(key, "is required");
+}
+
+// The key of element k of list `list`: "wrenches[0]/sign".
+std::string element(const char* list, std::size_t k, const char* key) {
+  return std::string(list) + "[" + std::to_string(k) + "]/" + key;
+}
+
+void validateSavings(const Savings& s) {
+  nonNegative("savings/static_velocity", s.static_velocity);
+  nonNegative("savings/static_acceleration", s.static_acceleration);
+}
+
+void validateUncertainty(const UncertaintyConfig& u) {
+  const std::pair<const char*, double> values[] = {
+      {"uncertainty/position_noise", u.position_noise}, {"uncertainty/mass_fraction", u.mass_fraction},
+      {"uncertainty/com_offset", u.com_offset},         {"uncertainty/inertia_fraction", u.inertia_fraction},
+      {"uncertainty/period", u.period},                 {"uncertainty/gain_tolerance", u.gain_tolerance}};
+  for (const auto& kv : values) nonNegative(kv.first, kv.second);
+}
+
+void validateWrench(const WrenchInputConfig& w, std::size_t k) {
+  // A sensor's link defaults to its joint's child link (the Estimator fills it in).
+  if (w.sensor_joint.empty()) required(element("wrenches", k, "link"), w.link);
+  if (!(w.sign == 1.0 || w.sign == -1.0))
+    fail(element("wrenches", k, "sign"), "must be +1 or -1, it is " + number(w.sign));
+  positive(element("wrenches", k, "timeout"), w.timeout);
+  nonNegative(element("wrenches", k, "force_noise"), w.force_noise);
+  nonNegative(element("wrenches", k, "moment_noise"), w.moment_noise);
+}
+
+void validatePlate(const PlateInputConfig& p, std::size_t k) {
+  required(element("force_plates", k, "link"), p.plate.link);
+  positive(element("force_plates", k, "timeout"), p.timeout);
+  nonNegative(element("force_plates", k, "contact_threshold"), p.plate.contact_threshold);
+  finite(element("force_plates", k, "surface_height"), p.plate.surface_height);
+  if (!p.plate.p_world_plate.allFinite())
+    fail(element("force_plates", k, "position"), "must be finite");
+  const Eigen::Matrix3d& R = p.plate.R_world_plate;
+  if (!R.allFinite() || !((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-9) ||
+      !(R.determinant() > 0.0))
+    fail(element("force_plates", k, "orientation"), "must be a rotation");
+}
+
+void validateWrenchTopics(const Settings& s) {
+  if (s.wrenches.size() != s.estimator.wrenches.size())
+    fail("wrenches", "holds " + std::to_string(s.wrenches.size()) + " topics for " +
+                         std::to_string(s.estimator.wrenches.size()) + " inputs");
+  for (std::size_t k = 0; k < s.wrenches.size(); ++k) {
+    required(element("wrenches", k, "topic"), s.wrenches[k].topic);
+    positive(element("wrenches", k, "force_threshold"), s.wrenches[k].force_threshold);
+    positive(element("wrenches", k, "moment_threshold"), s.wrenches[k].moment_threshold);
+  }
+}
+
+void validatePlateTopics(const Settings& s) {
+  if (s.force_plates.size() != s.estimator.plates.size())
+    fail("force_plates", "holds " + std::to_string(s.force_plates.size()) + " topics for " +
+                             std::to_string(s.estimator.plates.size()) + " plates");
+  std::set<std::string> names;
+  for (std::size_t k = 0; k < s.force_plates.size(); ++k) {
+    const std::string& name = s.estimator.plates[k].plate.name;
+    required(element("force_plates", k, "name"), name);
+    if (!names.insert(name).second)
+      fail(element("force_plates", k, "name"), "'" + name + "' names another plate too");
+    required(element("force_plates", k, "topic"), s.force_plates[k].topic);
+  }
+}
+
+}  // namespace
+
+void validate(const EstimatorConfig& config) {
+  try {
+    validate(config.differentiator);
+  } catch (const std::invalid_argument& e) {
+    throw SettingsError(e.what());  // it names the key already
+  }
+  if (config.decimation < 1)
+    fail("decimation", "must be >= 1, it is " + std::to_string(config.decimation));
+  if (!config.gravity_world.allFinite()) fail("gravity", "must be finite");
+  validateSavings(config.savings);
+  validateUncertainty(config.uncertainty);
+  for (std::size_t k = 0; k < config.wrenches.size(); ++k) validateWrench(config.wrenches[k], k);
+  for (std::size_t k = 0; k < config.plates.size(); ++k) validatePlate(config.plates[k], k);
+}
+
+void validate(const Settings& settings) {
+  validate(settings.estimator);
+  positive("time_jump_threshold", settings.time_jump_threshold);
+  positive("base_residual_threshold", settings.base_residual_threshold);
+  positive("still_velocity", settings.still_velocity);
+  positive("diagnostic_period", settings.diagnostic_period);
+  const double m = settings.body_mass;
+  if (!((m >= 0.0 && std::isfinite(m)) || m == -1.0))
+    fail("body_mass", "must be a mass > 0 [kg], 0 (off) or -1 (the URDF's total mass), it is " +
+                          number(m));
+  validateWrenchTopics(settings);
+  validatePlateTopics(settings);
+}
+
+}  // namespace jle

@@ -1,0 +1,389 @@
+// The parameter reader (ros/settings.hpp) maps every key onto its field of jle::Settings
+// and refuses what validate() refuses, naming the key: per key family an ok and a ko
+// YAML (test/config/ok_*.yaml, ko_*.yaml), as ros_controllers' joint_state_controller
+// tests do. And the documentation cannot drift: config/default.yaml and the defaults
+// stated by README.md's parameter table parse to Settings{}.
+#include <joint_load_estimator/ros/settings.hpp>
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using jle::Settings;
+
+const std::string kConfig = JLE_TEST_CONFIG;
+
+Settings parseFile(const std::string& path) { return jle::parseSettings(jle::loadYaml(path)); }
+
+// Parses YAML text (through a file, as process_bag reads it).
+Settings parseText(const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / ("jle_settings_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(path) << text;
+  try {
+    Settings s = parseFile(path.string());
+    fs::remove(path);
+    return s;
+  } catch (...) {
+    fs::remove(path);
+    throw;
+  }
+}
+
+// The message of the SettingsError that parsing `path` throws ("" if it parses).
+std::string refusal(const std::string& path) {
+  try {
+    parseFile(path);
+  } catch (const jle::SettingsError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Field by field: a field the reader forgets to map, or maps onto another, differs here.
+// EXPECT_SAME(f) compares a.f and b.f and names f on a failure.
+#define EXPECT_SAME(f) EXPECT_EQ(a.f, b.f) << where << #f
+
+void expectSame(const jle::DifferentiatorConfig& a, const jle::DifferentiatorConfig& b,
+                const std::string& where) {
+  EXPECT_SAME(type);
+  EXPECT_SAME(window);
+  EXPECT_SAME(order);
+  EXPECT_SAME(delay);
+  EXPECT_SAME(kalman_model);
+  EXPECT_SAME(process_noise);
+  EXPECT_SAME(measurement_noise);
+  EXPECT_SAME(max_gap);
+}
+
+void expectSame(const jle::Savings& a, const jle::Savings& b, const std::string& where) {
+  EXPECT_SAME(prune);
+  EXPECT_SAME(massless_chains);
+  EXPECT_SAME(gyroscopic);
+  EXPECT_SAME(static_velocity);
+  EXPECT_SAME(static_acceleration);
+  EXPECT_SAME(reuse_unchanged);
+  EXPECT_SAME(republish_unchanged);
+  EXPECT_SAME(planar);
+}
+
+void expectSame(const jle::UncertaintyConfig& a, const jle::UncertaintyConfig& b,
+                const std::string& where) {
+  EXPECT_SAME(enabled);
+  EXPECT_SAME(diagonal_only);
+  EXPECT_SAME(position_noise);
+  EXPECT_SAME(mass_fraction);
+  EXPECT_SAME(com_offset);
+  EXPECT_SAME(inertia_fraction);
+  EXPECT_SAME(linearize_state);
+  EXPECT_SAME(period);
+  EXPECT_SAME(gain_tolerance);
+}
+
+void expectSame(const jle::WrenchInputConfig& a, const jle::WrenchInputConfig& b,
+                const std::string& where) {
+  EXPECT_SAME(name);
+  EXPECT_SAME(link);
+  EXPECT_SAME(sign);
+  EXPECT_SAME(timeout);
+  EXPECT_SAME(stale_policy);
+  EXPECT_SAME(sensor_joint);
+  EXPECT_SAME(force_noise);
+  EXPECT_SAME(moment_noise);
+}
+
+void expectSame(const jle::PlateInputConfig& a, const jle::PlateInputConfig& b,
+                const std::string& where) {
+  EXPECT_SAME(plate.name);
+  EXPECT_SAME(plate.link);
+  EXPECT_SAME(plate.R_world_plate);
+  EXPECT_SAME(plate.p_world_plate);
+  EXPECT_SAME(plate.surface_height);
+  EXPECT_SAME(plate.contact_threshold);
+  EXPECT_SAME(timeout);
+  EXPECT_SAME(stale_policy);
+}
+
+void expectSame(const jle::WrenchTopicSettings& a, const jle::WrenchTopicSettings& b,
+                const std::string& where) {
+  EXPECT_SAME(topic);
+  EXPECT_SAME(frame);
+  EXPECT_SAME(force_threshold);
+  EXPECT_SAME(moment_threshold);
+}
+
+void expectSame(const jle::PlateTopicSettings& a, const jle::PlateTopicSettings& b,
+                const std::string& where) {
+  EXPECT_SAME(topic);
+  EXPECT_SAME(frame);
+  EXPECT_SAME(pose_configured);
+}
+
+// Element by element, "wrenches[k]/" named on a failure.
+template <typename T>
+void expectSameList(const std::vector<T>& a, const std::vector<T>& b, const std::string& list) {
+  ASSERT_EQ(a.size(), b.size()) << list;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    expectSame(a[k], b[k], list + "[" + std::to_string(k) + "]/");
+}
+
+void expectSame(const jle::EstimatorConfig& a, const jle::EstimatorConfig& b) {
+  const std::string where;
+  expectSame(a.differentiator, b.differentiator, "differentiator/");
+  EXPECT_SAME(precision);
+  expectSame(a.savings, b.savings, "savings/");
+  EXPECT_SAME(joints);
+  EXPECT_SAME(gravity_world);
+  expectSameList(a.wrenches, b.wrenches, "wrenches");
+  EXPECT_SAME(decimation);
+  expectSame(a.uncertainty, b.uncertainty, "uncertainty/");
+  expectSameList(a.plates, b.plates, "force_plates");
+}
+
+void expectSame(const Settings& a, const Settings& b) {
+  const std::string where;
+  EXPECT_SAME(robot_description);
+  EXPECT_SAME(joint_states_topic);
+  EXPECT_SAME(publish_wrench_topics);
+  EXPECT_SAME(floating_base);
+  EXPECT_SAME(world_frame);
+  EXPECT_SAME(base_frame);
+  EXPECT_SAME(time_jump_threshold);
+  EXPECT_SAME(keep_fixed_joints);
+  EXPECT_SAME(base_residual_threshold);
+  EXPECT_SAME(still_velocity);
+  EXPECT_SAME(bias_file);
+  EXPECT_SAME(diagnostic_period);
+  EXPECT_SAME(body_mass);
+  expectSame(a.estimator, b.estimator);
+  expectSameList(a.wrenches, b.wrenches, "wrenches");
+  expectSameList(a.force_plates, b.force_plates, "force_plates");
+}
+
+#undef EXPECT_SAME
+
+// ---------------------------------------------------------------------------------------
+// Per key family: the ok file lands key by key; the ko file is refused, naming the key.
+
+struct Refused {
+  const char* file;
+  const char* key;     // as the message quotes it
+  const char* reason;  // a part of the message after the key
+};
+
+const Refused kRefused[] = {
+    {"ko_top_level.yaml", "'diagnostic_period'", "must be finite and > 0"},
+    {"ko_differentiator.yaml", "'differentiator/order'", "must be 2..5"},
+    {"ko_wrenches.yaml", "'wrenches[1]/sign'", "must be +1 or -1"},
+    {"ko_force_plates.yaml", "'force_plates[1]/name'", "names another plate too"},
+    {"ko_uncertainty.yaml", "'uncertainty/position_noise'", "must be finite and >= 0"},
+    {"ko_savings.yaml", "'savings/static_velocity'", "must be finite and >= 0"},
+};
+
+TEST(SettingsReader, EachKoFileIsRefusedWithItsReason) {
+  for (const Refused& r : kRefused) {
+    const std::string why = refusal(kConfig + "/" + r.file);
+    EXPECT_NE(why.find(std::string("parameter ") + r.key), std::string::npos) << r.file << ": " << why;
+    EXPECT_NE(why.find(r.reason), std::string::npos) << r.file << ": " << why;
+  }
+}
+
+TEST(SettingsReader, TopLevelKeys) {
+  Settings e;
+  e.robot_description = "arm_description";
+  e.joint_states_topic = "/arm/joint_states";
+  e.estimator.joints = {"shoulder_pan_joint", "elbow_joint"};
+  e.publish_wrench_topics = false;
+  e.estimator.gravity_world = Eigen::Vector3d(0.0, -9.81, 0.5);
+  e.estimator.decimation = 3;
+  e.time_jump_threshold = 0.5;
+  e.keep_fixed_joints = {"wrist_3_link-tool0_fixed_joint"};
+  e.estimator.precision = jle::Precision::kFloat;
+  e.floating_base = true;
+  e.world_frame = "odom";
+  e.base_frame = "base_link";
+  e.base_residual_threshold = 0.2;
+  e.still_velocity = 0.05;
+  e.bias_file = "/tmp/ft_bias.yaml";
+  e.diagnostic_period = 0.25;
+  e.body_mass = -1.0;
+  expectSame(parseFile(kConfig + "/ok_top_level.yaml"), e);
+}
+
+TEST(SettingsReader, DifferentiatorKeys) {
+  Settings e;
+  jle::DifferentiatorConfig& d = e.estimator.differentiator;
+  d.type = jle::DifferentiatorType::kSavitzkyGolay;
+  d.window = 11;
+  d.order = 3;
+  d.delay = 5;  // centred
+  d.kalman_model = jle::KalmanModel::kConstantAcceleration;
+  d.process_noise = 1e3;
+  d.measurement_noise = 1e-3;
+  d.max_gap = 0.25;
+  expectSame(parseFile(kConfig + "/ok_differentiator.yaml"), e);
+}
+
+TEST(SettingsReader, WrenchKeys) {
+  Settings e;
+  e.wrenches.resize(2);
+  e.estimator.wrenches.resize(2);
+  e.wrenches[0].topic = e.estimator.wrenches[0].name = "/tool/wrench";
+  e.estimator.wrenches[0].link = "tool0";
+  e.wrenches[0].frame = "tool_sensor";
+  e.estimator.wrenches[0].sign = -1.0;
+  e.estimator.wrenches[0].timeout = 0.25;
+  e.estimator.wrenches[0].stale_policy = jle::StalePolicy::kStop;
+  e.estimator.wrenches[0].force_noise = 0.5;
+  e.estimator.wrenches[0].moment_noise = 0.05;
+  e.wrenches[1].topic = e.estimator.wrenches[1].name = "/ft/wrench";
+  e.estimator.wrenches[1].sensor_joint = "ft_joint";  // link: left to the estimator
+  e.wrenches[1].force_threshold = 10.0;
+  e.wrenches[1].moment_threshold = 1.5;
+  e.estimator.wrenches[1].stale_policy = jle::StalePolicy::kZero;
+  // keep_fixed_joints stays as written (modelOptions() adds the sensor's joint).
+  expectSame(parseFile(kConfig + "/ok_wrenches.yaml"), e);
+}
+
+TEST(SettingsReader, ForcePlateKeys) {
+  Settings e;
+  e.force_plates.resize(2);
+  e.estimator.plates.resize(2);
+  jle::ForcePlateConfig& left = e.estimator.plates[0].plate;
+  left.name = "left";
+  e.force_plates[0].topic = "/plates/left";
+  e.force_plates[0].frame = "plate_left";
+  left.link = "left_foot";
+  left.surface_height = 0.04;
+  left.contact_threshold = 30.0;
+  e.estimator.plates[0].timeout = 0.5;
+  e.estimator.plates[0].stale_policy = jle::StalePolicy::kHold;
+  left.p_world_plate = Eigen::Vector3d(0.3, 0.2, -0.04);
+  // [x, y, z, w] = [1, 0, 0, 0]: pi about x, exact in the quaternion's matrix.
+  left.R_world_plate = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  e.force_plates[0].pose_configured = true;
+  e.estimator.plates[1].plate.name = "right";
+  e.force_plates[1].topic = "/plates/right";
+  e.estimator.plates[1].plate.link = "right_foot";
+  expectSame(parseFile(kConfig + "/ok_force_plates.yaml"), e);
+}
+
+TEST(SettingsReader, UncertaintyKeys) {
+  Settings e;
+  jle::UncertaintyConfig& u = e.estimator.uncertainty;
+  u.enabled = true;
+  u.diagonal_only = true;
+  u.position_noise = 1e-4;
+  u.mass_fraction = 0.05;
+  u.com_offset = 0.005;
+  u.inertia_fraction = 0.1;
+  u.linearize_state = false;
+  u.period = 0.0;
+  u.gain_tolerance = 0.05;
+  expectSame(parseFile(kConfig + "/ok_uncertainty.yaml"), e);
+}
+
+TEST(SettingsReader, SavingsKeys) {
+  Settings e;
+  jle::Savings& v = e.estimator.savings;
+  v.prune = v.massless_chains = v.gyroscopic = false;
+  v.reuse_unchanged = v.republish_unchanged = false;
+  v.static_velocity = 0.01;
+  v.static_acceleration = 0.5;
+  v.planar = jle::PlanarMode::kOn;
+  expectSame(parseFile(kConfig + "/ok_savings.yaml"), e);
+  // rosparam reads YAML 1.1, where a bare on/off is a boolean.
+  XmlRpc::XmlRpcValue params;
+  params["savings"]["planar"] = false;
+  EXPECT_EQ(jle::parseSettings(params).estimator.savings.planar, jle::PlanarMode::kOff);
+}
+
+// What the reader itself refuses (validate() never sees these): a wrong type, an
+// unknown key or name, a missing section shape.
+TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
+  auto expectRefused = [](const std::string& text, const std::string& culprit) {
+    try {
+      parseText(text);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const jle::SettingsError& e) {
+      EXPECT_NE(std::string(e.what()).find(culprit), std::string::npos) << e.what();
+    }
+  };
+  expectRefused("decimation: 1.5", "parameter 'decimation' must be an integer");
+  expectRefused("gravity: [0, 0]", "parameter 'gravity' must be a list of 3 numbers");
+  expectRefused("gravity: [0, 0, g]", "parameter 'gravity[2]' must be a number");
+  expectRefused("precision: half", "parameter 'precision' is 'half'; expected one of double, float");
+  expectRefused("differentiator: {delay: middle}", "'differentiator/delay' must be an integer or");
+  expectRefused("savings: {prune: 1}", "parameter 'savings/prune' must be true or false");
+  expectRefused("uncertainty: {decimation: 4}", "'uncertainty/decimation' is replaced by");
+  expectRefused("wrenches: [{topic: t, link: l, stale_policy: keep}]", "'wrenches[0]/stale_policy'");
+  expectRefused("wrenches: [{topic: t, lnk: l}]", "unknown parameter 'wrenches[0]/lnk'");
+  expectRefused("wrenches: [{topic: t}]", "parameter 'wrenches[0]/link' is required");
+  expectRefused("force_plates: [{name: a, topic: t, link: f, orientation: [0, 0, 0, 0]}]",
+                "'force_plates[0]/orientation' must be a quaternion");
+  expectRefused("savings: [prune]", "parameter 'savings' must be a map");
+  expectRefused("diagnostics_period: 1", "unknown parameter 'diagnostics_period'");
+}
+
+// ---------------------------------------------------------------------------------------
+// The documentation states the defaults of config.hpp.
+
+TEST(SettingsDocs, DefaultYamlIsSettingsDefaults) {
+  expectSame(parseFile(JLE_DEFAULT_YAML), Settings{});
+  // And parsing nothing is Settings{}: the reader writes no default of its own.
+  expectSame(jle::parseSettings(XmlRpc::XmlRpcValue()), Settings{});
+}
+
+// Every key of the ok files (which together hold every key the reader knows) is in
+// config/default.yaml: top-level keys at the top, a map's keys in that map.
+TEST(SettingsDocs, DefaultYamlListsEveryKey) {
+  XmlRpc::XmlRpcValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
+  for (const char* family : {"top_level", "differentiator", "savings", "uncertainty"}) {
+    XmlRpc::XmlRpcValue ok = jle::loadYaml(kConfig + "/ok_" + family + ".yaml");
+    for (auto& kv : ok) {
+      ASSERT_TRUE(defaults.hasMember(kv.first)) << kv.first << " is not in config/default.yaml";
+      if (kv.second.getType() != XmlRpc::XmlRpcValue::TypeStruct) continue;
+      for (auto& sub : kv.second)
+        EXPECT_TRUE(defaults[kv.first].hasMember(sub.first))
+            << kv.first << "/" << sub.first << " is not in config/default.yaml";
+    }
+  }
+}
+
+// The README's parameter table: each row of one key and one stated default, e.g.
+// "| `savings/prune` | `true` | ...", parsed as that key's YAML, is Settings{}; and every
+// key of default.yaml has a row.
+TEST(SettingsDocs, ReadmeTableStatesTheDefaults) {
+  std::ifstream readme(JLE_README);
+  ASSERT_TRUE(readme.good());
+  const std::regex row(R"(^\| `([a-z_]+)(/([a-z_]+))?` \| `([^`]*)`)");
+  std::string line, rows;
+  int checked = 0;
+  while (std::getline(readme, line)) {
+    std::smatch m;
+    if (!std::regex_search(line, m, row)) continue;
+    rows += "`" + m[1].str() + (m[2].matched ? m[2].str() : "") + "`\n";
+    const std::string yaml = m[2].matched ? m[1].str() + ":\n  " + m[3].str() + ": " + m[4].str()
+                                          : m[1].str() + ": " + m[4].str();
+    SCOPED_TRACE("README row " + line.substr(0, 60));
+    expectSame(parseText(yaml + "\n"), Settings{});
+    ++checked;
+  }
+  EXPECT_GE(checked, 35);  // the rows of one key (38 when written)
+  for (auto& kv : jle::loadYaml(JLE_DEFAULT_YAML)) {
+    if (kv.second.getType() == XmlRpc::XmlRpcValue::TypeStruct) continue;  // rows per key
+    EXPECT_NE(rows.find("`" + kv.first + "`"), std::string::npos) << kv.first << ": no README row";
+  }
+}
+
+}  // namespace
