@@ -2,6 +2,8 @@
 
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include <tf2_eigen/tf2_eigen.h>
+
 namespace jle {
 namespace {
 

@@ -230,11 +230,9 @@ TEST(Pipeline, SensorBiasIsRemovedInTheReadingsFrame) {
     clean.onWrench(0, stamp, stamp, "tool0", f, m);
     biased.onWrench(0, stamp, stamp, "tool0", f + bf, m + bt);
     const std::vector<double> p(6, 0.1 * k);
-    if (clean.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone) !=
-        Outcome::kPublished)
-      continue;
-    ASSERT_EQ(biased.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone),
-              Outcome::kPublished);
+    const Outcome a = clean.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone);
+    ASSERT_EQ(biased.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone), a);
+    if (a != Outcome::kPublished) continue;
     ++compared;
     for (std::size_t i = 0; i < clean.record().effort.size(); ++i)
       EXPECT_NEAR(clean.record().effort[i], biased.record().effort[i], 1e-12);  // (x + b) - b
@@ -285,7 +283,7 @@ TEST(Pipeline, TimeJumpsResetAndFarStampsReanchorTheTimeAxis) {
   const Stamp far = kStart + Stamp{100} * 86400 * 1000000000;
   for (int k = 0; k < 3; ++k) feed(far + k * kMs + 1, far + k * kMs + 1);
   EXPECT_EQ(pipeline.counters().resets, 3);
-  EXPECT_EQ(pipeline.record().stamp, far + kMs + 1);
+  EXPECT_EQ(pipeline.record().stamp, far + (2 - pipeline.estimator().delaySamples()) * kMs + 1);
 }
 
 TEST(Pipeline, MalformedMessagesAreCountedAndNamed) {
