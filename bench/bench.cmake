@@ -20,7 +20,7 @@ add_dependencies(bench_node_latency ${PROJECT_NAME}_generate_messages_cpp)
 
 if(CATKIN_ENABLE_TESTING)
   add_executable(bench_speed_messages bench/speed_messages.cpp)
-  target_link_libraries(bench_speed_messages joint_load_estimator_core benchmark::benchmark
+  target_link_libraries(bench_speed_messages joint_load_estimator_ros benchmark::benchmark
     ${catkin_LIBRARIES})
   target_include_directories(bench_speed_messages PRIVATE ${catkin_INCLUDE_DIRS})
   target_compile_definitions(bench_speed_messages PRIVATE

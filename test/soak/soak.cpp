@@ -70,21 +70,25 @@ int main(int argc, char** argv) {
   long injected[kKinds] = {};
   long good = 0, published = 0, warming = 0, late_warming = 0, other = 0;
   long rss_10 = -1;
+  // The clock (the node's ros::Time::now()) goes on at the pace of the good samples; a
+  // bad message's stamp is its own.
+  jle::Stamp now = 0;
   auto message = [&](jle::Stamp stamp, const std::vector<std::string>& n,
                      const std::vector<double>& p) {
-    return pipeline.onJointState(stamp, stamp, n, p, none, none);
+    return pipeline.onJointState(stamp, now, n, p, none, none);
   };
 
   const auto start = std::chrono::steady_clock::now();
   for (long i = 0; i < samples; ++i) {
     if (i == samples / 10) rss_10 = vmRssKb();
     const jle::Stamp stamp = 1700000000000000000 + i * dt;
+    now = stamp;
     const double t = 1.0 + static_cast<double>(i) * 1e-3;
     for (int k = 0; k < nq; ++k)
       position[static_cast<std::size_t>(k)] =
           0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
     const Eigen::Vector3d f(10.0 * std::sin(t), 2.0, -5.0), m(0.1, 0.2 * std::cos(t), 0.0);
-    if (pipeline.onWrench(0, stamp, stamp, frame, f, m) != Outcome::kUsed) ++other;
+    if (pipeline.onWrench(0, stamp, now, frame, f, m) != Outcome::kUsed) ++other;
 
     // The good sample (every 50th carries an unknown joint name besides the 7).
     Outcome s;
@@ -126,12 +130,12 @@ int main(int argc, char** argv) {
         break;
       case 4:
         ++injected[kWrenchNan];
-        pipeline.onWrench(0, stamp + half, stamp + half, frame,
+        pipeline.onWrench(0, stamp + half, now, frame,
                           Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0), m);
         break;
       default:
         ++injected[kWrenchBackward];
-        pipeline.onWrench(0, stamp - half, stamp - half, frame, f, m);
+        pipeline.onWrench(0, stamp - half, now, frame, f, m);
         break;
     }
   }
