@@ -38,9 +38,11 @@ enum class StalePolicy : std::uint8_t {
 /// One measured wrench acting on the robot.
 struct WrenchInputConfig {
   std::string name;  ///< for messages (the topic)
-  std::string link;  ///< URDF link the wrench acts on; samples are given in its frame
+  /// URDF link the wrench acts on; samples are given in its frame. Required, but for a
+  /// sensor input (sensor_joint), whose link defaults to the joint's child link.
+  std::string link;
   double sign = 1.0;  ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies (force plate)
-  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
+  double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale
   StalePolicy stale_policy = StalePolicy::kHold;
   /// Non-empty: the input is a force/torque sensor mounted at this FIXED joint of the
   /// URDF (kept as its own segment; `link` must be empty or the joint's child link). It
@@ -99,7 +101,7 @@ struct UncertaintyConfig {
 /// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot.
 struct PlateInputConfig {
   ForcePlateConfig plate;
-  double timeout = 0.1;  ///< [s] older than this at a joint sample = stale
+  double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale
   StalePolicy stale_policy = StalePolicy::kZero;
 };
 
@@ -208,8 +210,8 @@ struct Settings {
   /// YAML file of the sensor biases: loaded at start if it exists, written by
   /// ~calibrate_bias. Empty: not loaded, and calibrate_bias writes none.
   std::string bias_file;
-  /// [s] > 0: period of the node's diagnostics (/diagnostics). diagnostic_updater reads
-  /// the same key from the node's private namespace; it is kept here so that it is
+  /// [s] > 0: period of the node's diagnostics timer (/diagnostics). diagnostic_updater
+  /// reads the same key from the node's private namespace; it is kept here so that it is
   /// validated, documented and defaulted with the others.
   double diagnostic_period = 1.0;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.

@@ -82,6 +82,11 @@ class Section {
       out.push_back(static_cast<std::string>(const_cast<XmlRpcValue&>(e)));
     }
   }
+  // Several keys of one type, each onto its field: {{"prune", &savings.prune}, ...}.
+  template <typename T>
+  void read(std::initializer_list<std::pair<const char*, T*>> keys) {
+    for (const auto& k : keys) read(k.first, *k.second);
+  }
   // A list of `n` numbers (gravity, a plate's position); false when the key is absent.
   bool read(const std::string& key, double* out, int n) {
     if (!has(key)) return false;
@@ -177,13 +182,12 @@ void readDifferentiator(Section& s, DifferentiatorConfig& c) {
 }
 
 void readSavings(Section& s, Savings& v) {
-  s.read("prune", v.prune);
-  s.read("massless_chains", v.massless_chains);
-  s.read("gyroscopic", v.gyroscopic);
-  s.read("reuse_unchanged", v.reuse_unchanged);
-  s.read("republish_unchanged", v.republish_unchanged);
-  s.read("static_velocity", v.static_velocity);
-  s.read("static_acceleration", v.static_acceleration);
+  s.read<bool>({{"prune", &v.prune},
+                {"massless_chains", &v.massless_chains},
+                {"gyroscopic", &v.gyroscopic},
+                {"reuse_unchanged", &v.reuse_unchanged},
+                {"republish_unchanged", &v.republish_unchanged}});
+  s.read<double>({{"static_velocity", &v.static_velocity}, {"static_acceleration", &v.static_acceleration}});
   // rosparam reads YAML 1.1, where a bare on/off is a boolean: take it as meant.
   if (s.has("planar") && s.get("planar").getType() == XmlRpcValue::TypeBoolean) {
     bool planar = false;
@@ -196,15 +200,15 @@ void readSavings(Section& s, Savings& v) {
 }
 
 void readUncertainty(Section& s, UncertaintyConfig& u) {
-  s.read("enabled", u.enabled);
-  s.read("diagonal_only", u.diagonal_only);
-  s.read("position_noise", u.position_noise);
-  s.read("mass_fraction", u.mass_fraction);
-  s.read("com_offset", u.com_offset);
-  s.read("inertia_fraction", u.inertia_fraction);
-  s.read("linearize_state", u.linearize_state);
-  s.read("period", u.period);
-  s.read("gain_tolerance", u.gain_tolerance);
+  s.read<bool>({{"enabled", &u.enabled},
+                {"diagonal_only", &u.diagonal_only},
+                {"linearize_state", &u.linearize_state}});
+  s.read<double>({{"position_noise", &u.position_noise},
+                  {"mass_fraction", &u.mass_fraction},
+                  {"com_offset", &u.com_offset},
+                  {"inertia_fraction", &u.inertia_fraction},
+                  {"period", &u.period},
+                  {"gain_tolerance", &u.gain_tolerance}});
   if (s.has("decimation"))  // the sample count it replaced
     throw SettingsError("parameter '" + s.name("decimation") + "' is replaced by '" +
                         s.name("period") + "' [s] (docs/uncertainty.md)");
