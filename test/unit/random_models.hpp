@@ -6,6 +6,7 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -14,38 +15,24 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <random>
 #include <string>
 #include <vector>
 
 namespace jle_test {
 
-/// Uniform numbers from std::mt19937, whose sequence the standard fixes (the standard
-/// distributions are implementation-defined): the same seed gives the same model on
-/// every platform.
-class Random {
+/// jle::PortableRandom (the same seed gives the same model on every platform), with
+/// the draws the random models need.
+class Random : public jle::PortableRandom {
  public:
-  explicit Random(std::uint32_t seed) : gen_(seed) {}
-  /// Uniform in [lo, hi), 53 random bits.
-  double uniform(double lo, double hi) {
-    const std::uint64_t a = gen_() >> 5, b = gen_() >> 6;  // 27 + 26 bits
-    const double u =
-        (static_cast<double>(a) * 67108864.0 + static_cast<double>(b)) * (1.0 / 9007199254740992.0);
-    return lo + (hi - lo) * u;
-  }
+  using jle::PortableRandom::PortableRandom;
   /// Log-uniform in [lo, hi] (lo > 0).
   double logUniform(double lo, double hi) { return lo * std::pow(hi / lo, uniform(0.0, 1.0)); }
-  /// Uniform in 0..n-1.
-  int index(int n) { return static_cast<int>(uniform(0.0, 1.0) * n); }
   /// Uniform on the unit sphere.
   Eigen::Vector3d unitVector() {
     const double z = uniform(-1.0, 1.0), phi = uniform(0.0, 2.0 * M_PI);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     return Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
   }
-
- private:
-  std::mt19937 gen_;
 };
 
 /// What randomUrdf() builds. Every link has a mass and an inertia; the base is fixed.
