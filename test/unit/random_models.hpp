@@ -1,6 +1,7 @@
-// Random robot models as URDF strings, deterministic from a seed, and the error of the
-// joint loads computed in one scalar type against a more precise one on the same
-// inputs. Shared by test/unit/test_stability.cpp and bench/stability.cpp.
+// The tests' random numbers (jle::PortableRandom with the draws tests need: vectors,
+// rotations, log-uniform numbers), random robot models as URDF strings, deterministic
+// from a seed, and the error of the joint loads computed in one scalar type against a
+// more precise one on the same inputs. Shared by the unit tests and bench/stability.cpp.
 #pragma once
 
 #include <joint_load_estimator/dynamics.hpp>
@@ -33,6 +34,29 @@ class Random : public jle::PortableRandom {
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     return Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
   }
+  /// Uniform in the cube [-half_range, half_range)^3 (x, y, z drawn in that order).
+  Eigen::Vector3d vector(double half_range) {
+    const double x = uniform(-half_range, half_range), y = uniform(-half_range, half_range),
+                 z = uniform(-half_range, half_range);
+    return Eigen::Vector3d(x, y, z);
+  }
+  /// A uniformly random rotation: the unit quaternion of four normal numbers (w, x, y, z
+  /// drawn in that order).
+  Eigen::Matrix3d rotation() {
+    const double w = gaussian(), x = gaussian(), y = gaussian(), z = gaussian();
+    return Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
+  }
+};
+
+/// Uniform in [lo, hi) from a Random, used like a distribution: UniformIn u(lo, hi);
+/// u(rng).
+class UniformIn {
+ public:
+  UniformIn(double lo, double hi) : lo_(lo), hi_(hi) {}
+  double operator()(Random& rng) const { return rng.uniform(lo_, hi_); }
+
+ private:
+  double lo_, hi_;
 };
 
 /// What randomUrdf() builds. Every link has a mass and an inertia; the base is fixed.
