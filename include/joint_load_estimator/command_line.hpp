@@ -53,6 +53,15 @@ inline std::map<std::string, std::string> optionValues(int argc, char** argv,
   return values;
 }
 
+/// The value of a required option of `values` (optionValues); throws UsageError
+/// "KEY WHAT is required" ("--urdf ROBOT.urdf is required") without it.
+inline std::string requiredValue(const std::map<std::string, std::string>& values,
+                                 const std::string& key, const std::string& what) {
+  const auto it = values.find(key);
+  if (it == values.end()) throw UsageError(key + " " + what + " is required");
+  return it->second;
+}
+
 /// The sign a number option must have (parseNumber).
 enum class Sign { kAny, kNonNegative, kPositive };
 

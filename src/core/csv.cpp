@@ -394,30 +394,31 @@ class StateHeader {
   }
 
   void bind(int c, const std::string& name) {
-    if (name == "t")
+    if (name == "t") {
       out_.t = c;
-    else if (!bindBase(c, name) && !bindPlate(c, name) && !bindWrench(c, name))
+      return;
+    }
+    if (bindBase(c, name)) return;
+    std::string owner;
+    if (name.compare(0, kPlatePrefix.size(), kPlatePrefix) == 0) {
+      const int component = ownedComponent(name, kPlatePrefix, "NAME", owner);
+      if (component >= 0) bindPlate(c, name, owner, component);
+    } else if (name.compare(0, kWrenchPrefix.size(), kWrenchPrefix) == 0) {
+      const int component = ownedComponent(name, kWrenchPrefix, "LINK", owner);
+      if (component >= 0) bindWrench(c, name, owner, component);
+    } else {
       bindJoint(c, name);
+    }
   }
 
   // The columns, or a CsvError at line 1 naming every defect.
   StateColumns finish(const CsvReader& reader) {
     checkJoints();
-    for (const StateColumns::WrenchColumns& w : out_.wrenches) {
-      const std::vector<std::string> absent =
-          absentColumns(w.column, kWrenchPrefix + w.link + ".", kWrenchComponents);
-      if (!absent.empty())
-        problems_.add("wrench@" + w.link + ": missing " + columnList(absent) +
-                      " (all six components are required)");
-    }
+    for (const StateColumns::WrenchColumns& w : out_.wrenches)
+      checkComplete(w.column, kWrenchPrefix + w.link);
     if (extra_.floating_base) checkBase();
-    for (std::size_t p = 0; p < extra_.plates.size(); ++p) {
-      const std::vector<std::string> absent =
-          absentColumns(out_.plates[p], kPlatePrefix + extra_.plates[p] + ".", kWrenchComponents);
-      if (!absent.empty())
-        problems_.add("plate " + extra_.plates[p] + ": missing " + columnList(absent) +
-                      " (all six components are required)");
-    }
+    for (std::size_t p = 0; p < extra_.plates.size(); ++p)
+      checkComplete(out_.plates[p], kPlatePrefix + extra_.plates[p], "plate " + extra_.plates[p]);
     if (!problems_.empty()) reader.failHeader(problems_.message());
     return out_;
   }
@@ -442,37 +443,32 @@ class StateHeader {
     return true;
   }
 
-  bool bindPlate(int c, const std::string& name) {
-    if (name.compare(0, kPlatePrefix.size(), kPlatePrefix) != 0) return false;
-    std::string plate;
-    const int component = prefixedComponent(name, kPlatePrefix, plate);
-    if (component < 0) {
-      problems_.add(name, "expected plate@NAME.fx, .fy, .fz, .mx, .my or .mz");
-      return true;
-    }
+  // PREFIX OWNER.COMPONENT (plate@NAME.fx, wrench@LINK.mz): the component, or -1 with
+  // the problem noted.
+  int ownedComponent(const std::string& name, const std::string& prefix, const char* kind,
+                     std::string& owner) {
+    const int component = prefixedComponent(name, prefix, owner);
+    if (component < 0)
+      problems_.add(name, "expected " + prefix + kind + ".fx, .fy, .fz, .mx, .my or .mz");
+    return component;
+  }
+
+  void bindPlate(int c, const std::string& name, const std::string& plate, int component) {
     const auto p = std::find(extra_.plates.begin(), extra_.plates.end(), plate);
     if (p == extra_.plates.end())
       problems_.add(name, "unknown plate '" + plate + "' (no --plate " + plate + "=...)");
     else
       out_.plates[static_cast<std::size_t>(p - extra_.plates.begin())]
                  [static_cast<std::size_t>(component)] = c;
-    return true;
   }
 
-  bool bindWrench(int c, const std::string& name) {
-    if (name.compare(0, kWrenchPrefix.size(), kWrenchPrefix) != 0) return false;
-    std::string link;
-    const int component = prefixedComponent(name, kWrenchPrefix, link);
-    if (component < 0) {
-      problems_.add(name, "expected wrench@LINK.fx, .fy, .fz, .mx, .my or .mz");
-      return true;
-    }
+  void bindWrench(int c, const std::string& name, const std::string& link, int component) {
     int frame = -1;
     for (int f = 0; f < static_cast<int>(model_.frames.size()); ++f)
       if (model_.frames[f].name == link) frame = f;
     if (frame < 0) {
       problems_.add(name, "unknown link '" + link + "'");
-      return true;
+      return;
     }
     auto w = std::find_if(out_.wrenches.begin(), out_.wrenches.end(),
                           [&](const StateColumns::WrenchColumns& x) { return x.link == link; });
@@ -485,7 +481,6 @@ class StateHeader {
       w = out_.wrenches.end() - 1;
     }
     w->column[static_cast<std::size_t>(component)] = c;
-    return true;
   }
 
   // JOINT.q, JOINT.qd, JOINT.qdd.
@@ -526,6 +521,15 @@ class StateHeader {
         if (coordinateColumns(kind)[k] < 0)
           missing.push_back(model_.coordinate_names[k] + "." + kStateSuffixes[kind]);
     if (!missing.empty()) problems_.add("missing " + columnList(missing));
+  }
+
+  // The six columns of OWNER (wrench@LINK, plate@NAME): all of them (`what` names it).
+  void checkComplete(const std::array<int, 6>& cols, const std::string& owner,
+                     const std::string& what = "") {
+    const std::vector<std::string> absent = absentColumns(cols, owner + ".", kWrenchComponents);
+    if (!absent.empty())
+      problems_.add((what.empty() ? owner : what) + ": missing " + columnList(absent) +
+                    " (all six components are required)");
   }
 
   void checkBase() {

@@ -115,6 +115,14 @@ std::string requiredName(const tinyxml2::XMLElement* e, const char* attribute,
   return text;
 }
 
+// The child element `name` of e; a model error `message` (with e's line) without it.
+const tinyxml2::XMLElement* requiredChild(const tinyxml2::XMLElement* e, const char* name,
+                                          const std::string& message) {
+  const tinyxml2::XMLElement* child = e->FirstChildElement(name);
+  if (!child) fail(message + where(e));
+  return child;
+}
+
 LinkDesc parseLink(const tinyxml2::XMLElement* e) {
   LinkDesc link;
   link.name = requiredName(e, "name", "<link>");
@@ -124,11 +132,10 @@ LinkDesc parseLink(const tinyxml2::XMLElement* e) {
   if (!in) return link;
   link.has_inertial = true;
   link.inertial_origin = origin(in, what + " inertial");
-  const tinyxml2::XMLElement* m = in->FirstChildElement("mass");
-  if (!m) fail(what + ": <inertial> without <mass>" + where(in));
+  const tinyxml2::XMLElement* m = requiredChild(in, "mass", what + ": <inertial> without <mass>");
   link.mass = number(m, "value", what + " mass", true, 0.0);
-  const tinyxml2::XMLElement* i = in->FirstChildElement("inertia");
-  if (!i) fail(what + ": <inertial> without <inertia>" + where(in));
+  const tinyxml2::XMLElement* i =
+      requiredChild(in, "inertia", what + ": <inertial> without <inertia>");
   const std::string wi = what + " inertia";
   const double ixx = number(i, "ixx", wi, true, 0.0), ixy = number(i, "ixy", wi, true, 0.0),
                ixz = number(i, "ixz", wi, true, 0.0), iyy = number(i, "iyy", wi, true, 0.0),
@@ -143,10 +150,8 @@ JointDesc parseJoint(const tinyxml2::XMLElement* e) {
   joint.line = e->GetLineNum();
   const std::string what = "joint '" + joint.name + "'";
   joint.type = requiredName(e, "type", what);
-  const tinyxml2::XMLElement* parent = e->FirstChildElement("parent");
-  const tinyxml2::XMLElement* child = e->FirstChildElement("child");
-  if (!parent) fail(what + ": missing <parent>" + where(e));
-  if (!child) fail(what + ": missing <child>" + where(e));
+  const tinyxml2::XMLElement* parent = requiredChild(e, "parent", what + ": missing <parent>");
+  const tinyxml2::XMLElement* child = requiredChild(e, "child", what + ": missing <child>");
   joint.parent = requiredName(parent, "link", what + " <parent>");
   joint.child = requiredName(child, "link", what + " <child>");
   joint.origin = origin(e, what);

@@ -30,6 +30,7 @@ using jle::cli::UsageError;
 using jle::cli::optionValues;
 using jle::cli::parseNumber;
 using jle::cli::parseNumberList;
+using jle::cli::requiredValue;
 
 const char* const kUsage =
     R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS]
@@ -199,10 +200,8 @@ Options parseOptions(int argc, char** argv) {
        "--body-mass", "--format"},
       {"--floating-base", "--per-kg"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
-  if (!v.count("--input")) throw UsageError("--input STATES.csv is required");
-  options.urdf = v["--urdf"];
-  options.input = v["--input"];
+  options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
+  options.input = requiredValue(v, "--input", "STATES.csv");
   if (v.count("--output")) options.output = v["--output"];
   if (v.count("--gravity")) options.gravity_world = parseGravity(v["--gravity"]);
   if (v.count("--frame")) options.frame = parseFrame(v["--frame"]);

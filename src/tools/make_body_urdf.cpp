@@ -26,6 +26,7 @@ namespace {
 using jle::cli::UsageError;
 using jle::cli::optionValues;
 using jle::cli::parseNumberIn;
+using jle::cli::requiredValue;
 
 const char* const kUsage =
     R"(usage: make_body_urdf --mass KG --height M [--subtalar] [--name NAME] [--output FILE]
@@ -167,11 +168,11 @@ Options parseOptions(int argc, char** argv) {
       {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
        "--foot-height", "--pelvis-width", "--hat-length", "--name", "--output"},
       {"--subtalar"});
-  if (!v.count("--mass")) throw UsageError("--mass KG is required");
-  if (!v.count("--height")) throw UsageError("--height M is required");
+  const std::string mass = requiredValue(v, "--mass", "KG");
+  const std::string height = requiredValue(v, "--height", "M");
   Options o;
-  o.mass = parseNumberIn("--mass", v["--mass"], 1.0, 500.0);
-  o.height = parseNumberIn("--height", v["--height"], 0.5, 2.7);
+  o.mass = parseNumberIn("--mass", mass, 1.0, 500.0);
+  o.height = parseNumberIn("--height", height, 0.5, 2.7);
   o.subtalar = v.count("--subtalar") > 0;
   const double h = o.height;
   const auto length = [&](const char* key, double fraction) {

@@ -31,6 +31,7 @@ using jle::cli::UsageError;
 using jle::cli::optionValues;
 using jle::cli::parseInteger;
 using jle::cli::parseNumber;
+using jle::cli::requiredValue;
 
 const char* const kUsage =
     R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]
@@ -107,10 +108,8 @@ Options parseOptions(int argc, char** argv) {
                     "--sensor-frame", "--tcp-frame"},
                    {"--effort"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
-  if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
-  options.urdf = v["--urdf"];
-  options.output = v["--output"];
+  options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
+  options.output = requiredValue(v, "--output", "OUT.bag");
   options.effort = v.count("--effort") > 0;
   if (v.count("--sensor-frame")) options.sensor_frame = v["--sensor-frame"];
   if (v.count("--tcp-frame")) options.tcp_frame = v["--tcp-frame"];

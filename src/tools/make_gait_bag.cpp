@@ -39,6 +39,7 @@ namespace {
 using jle::cli::UsageError;
 using jle::cli::parseInteger;
 using jle::cli::parseNumber;
+using jle::cli::requiredValue;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
@@ -158,10 +159,8 @@ Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = jle::cli::optionValues(
       argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf BODY.urdf is required");
-  if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
-  options.urdf = v["--urdf"];
-  options.output = v["--output"];
+  options.urdf = requiredValue(v, "--urdf", "BODY.urdf");
+  options.output = requiredValue(v, "--output", "OUT.bag");
   if (v.count("--csv")) options.csv = v["--csv"];
   if (v.count("--strides")) {
     options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 1, 100));

@@ -21,6 +21,7 @@ using jle::cli::UsageError;
 using jle::cli::optionValues;
 using jle::cli::parseInteger;
 using jle::cli::parseNumber;
+using jle::cli::requiredValue;
 
 const char* const kUsage =
     R"(usage: make_trajectory --urdf ROBOT.urdf [--duration 2.0] [--rate 1000] [--seed 1]
@@ -73,8 +74,7 @@ Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = optionValues(
       argc, argv, {"--urdf", "--duration", "--rate", "--seed", "--wrench", "--output"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
-  options.urdf = v["--urdf"];
+  options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   if (v.count("--output")) options.output = v["--output"];
   if (v.count("--wrench")) options.wrench_link = v["--wrench"];
   if (v.count("--duration")) options.duration = parseNumber("--duration", v["--duration"]);

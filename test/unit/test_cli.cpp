@@ -689,6 +689,13 @@ TEST(CommandLine, IntegersAndTheirMessages) {
   EXPECT_EQ(parseInteger("--strides", "100", 1, 100), 100u);
 }
 
+TEST(CommandLine, RequiredValues) {
+  const std::map<std::string, std::string> values = {{"--urdf", "a.urdf"}};
+  EXPECT_EQ(jle::cli::requiredValue(values, "--urdf", "ROBOT.urdf"), "a.urdf");
+  EXPECT_EQ(usageError([&] { jle::cli::requiredValue(values, "--input", "STATES.csv"); }),
+            "--input STATES.csv is required");
+}
+
 TEST(CommandLine, NumberLists) {
   double v[3] = {0, 0, 0};
   ASSERT_TRUE(jle::cli::parseNumberList("0.5, -1.25 ,-9.7", 3, v));
