@@ -147,14 +147,21 @@ inline std::string randomUrdf(const RandomModelSpec& spec) {
   return xml;
 }
 
-/// A joint state: q uniform in [-pi, pi] (prismatic: [-length, length]), qd in
-/// [-qd_scale, qd_scale], qdd in [-qdd_scale, qdd_scale].
+/// A joint state, coordinates in model.coordinate_names order.
 struct State {
   Eigen::VectorXd q, qd, qdd;
 };
 
-inline State randomState(const jle::Model<double>& model, Random& rng, double qd_scale,
-                         double qdd_scale, double length = 0.3) {
+/// Where randomState draws: each quantity uniform in centre +- half-width, revolute and
+/// prismatic coordinates apart [rad or m, /s, /s^2].
+struct StateRanges {
+  double q = M_PI, qd = 1.0, qdd = 5.0;  ///< revolute: q in [-q, q)
+  double prismatic_centre = 0.0;          ///< prismatic: q in prismatic_centre +- prismatic_q
+  double prismatic_q = 0.3, prismatic_qd = 1.0, prismatic_qdd = 5.0;
+};
+
+/// A random joint state; per coordinate q, qd, qdd drawn in that order.
+inline State randomState(const jle::Model<double>& model, Random& rng, const StateRanges& r) {
   State s;
   s.q.resize(model.nq);
   s.qd.resize(model.nq);
@@ -163,11 +170,40 @@ inline State randomState(const jle::Model<double>& model, Random& rng, double qd
   for (int i : model.moving_segments)
     if (model.joint_type[i] == jle::JointType::kPrismatic) prismatic[model.coordinate[i]] = 1;
   for (int k = 0; k < model.nq; ++k) {
-    s.q[k] = prismatic[k] ? rng.uniform(-length, length) : rng.uniform(-M_PI, M_PI);
-    s.qd[k] = rng.uniform(-qd_scale, qd_scale);
-    s.qdd[k] = rng.uniform(-qdd_scale, qdd_scale);
+    s.q[k] = prismatic[k] ? r.prismatic_centre + rng.uniform(-r.prismatic_q, r.prismatic_q)
+                          : rng.uniform(-r.q, r.q);
+    const double qd = prismatic[k] ? r.prismatic_qd : r.qd;
+    const double qdd = prismatic[k] ? r.prismatic_qdd : r.qdd;
+    s.qd[k] = rng.uniform(-qd, qd);
+    s.qdd[k] = rng.uniform(-qdd, qdd);
   }
   return s;
+}
+
+/// q uniform in [-pi, pi) (prismatic: [-length, length)), qd in [-qd_scale, qd_scale),
+/// qdd in [-qdd_scale, qdd_scale).
+inline State randomState(const jle::Model<double>& model, Random& rng, double qd_scale,
+                         double qdd_scale, double length = 0.3) {
+  StateRanges r;
+  r.qd = r.prismatic_qd = qd_scale;
+  r.qdd = r.prismatic_qdd = qdd_scale;
+  r.prismatic_q = length;
+  return randomState(model, rng, r);
+}
+
+/// A random floating-base state: a uniformly random rotation, then the position,
+/// velocity, angular velocity, acceleration and angular acceleration each uniform in a
+/// cube of the given half-width [m, m/s, rad/s, m/s^2, rad/s^2], in that order.
+inline jle::BaseState<double> randomBase(Random& rng, double p, double v, double omega, double a,
+                                         double alpha) {
+  jle::BaseState<double> base;
+  base.R_world_base = rng.rotation();
+  base.p_world_base = rng.vector(p);
+  base.v_world = rng.vector(v);
+  base.omega_world = rng.vector(omega);
+  base.a_world = rng.vector(a);
+  base.alpha_world = rng.vector(alpha);
+  return base;
 }
 
 /// A wrench applied to the robot (dynamics.hpp's addExternalWrench), given in double.

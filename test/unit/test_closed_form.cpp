@@ -359,13 +359,7 @@ TEST(FreeBody, ResidualIsNewtonEulerMinusAppliedWrenchAndWeight) {
     const int handle = model.frameIndex("handle");
     jle_test::Random rng(31);
     for (int trial = 0; trial < 30; ++trial) {
-      jle::BaseState<double> base;
-      base.R_world_base = rng.rotation();
-      base.p_world_base = rng.vector(2.0);
-      base.v_world = rng.vector(1.0);
-      base.omega_world = rng.vector(4.0);
-      base.a_world = rng.vector(10.0);
-      base.alpha_world = rng.vector(20.0);
+      const jle::BaseState<double> base = jle_test::randomBase(rng, 2.0, 1.0, 4.0, 10.0, 20.0);
       const Vec3 F = rng.vector(50.0), M = rng.vector(10.0);  // world, at handle
       jle::forwardKinematics(model, data, VecX(), VecX(), VecX(), gravity, base);
       jle::addExternalWrench(model, data, handle, F, M, jle::WrenchFrame::kWorld);
@@ -401,13 +395,7 @@ TEST(FreeBody, MotionCausedByTheAppliedWrenchLeavesNoResidual) {
     const int handle = model.frameIndex("handle");
     jle_test::Random rng(32);
     for (int trial = 0; trial < 30; ++trial) {
-      jle::BaseState<double> base;
-      base.R_world_base = rng.rotation();
-      base.p_world_base = rng.vector(2.0);
-      base.v_world = rng.vector(1.0);
-      base.omega_world = rng.vector(4.0);
-      base.a_world = rng.vector(10.0);
-      base.alpha_world = rng.vector(20.0);
+      const jle::BaseState<double> base = jle_test::randomBase(rng, 2.0, 1.0, 4.0, 10.0, 20.0);
 
       // The wrench that, with gravity, causes exactly this motion: Newton and Euler
       // about O, moved to the handle and expressed in the handle frame.

@@ -48,29 +48,19 @@ std::string readFile(const std::string& path) {
 // ---------------------------------------------------------------------------------
 // Random states and wrenches.
 
-struct State {
-  VecX q, qd, qdd;
-};
+using jle_test::State;
 
 // Joint angles over a full turn, rates and accelerations of a fast arm motion; sliders
 // (the panda's fingers) within their 4 cm stroke.
 State randomState(const jle::Model<double>& model, jle_test::Random& rng) {
-  State s{VecX(model.nq), VecX(model.nq), VecX(model.nq)};
-  jle_test::UniformIn u(-1.0, 1.0);
-  for (int k = 0; k < model.nq; ++k) {
-    const int seg = static_cast<int>(
-        std::find(model.coordinate.begin(), model.coordinate.end(), k) - model.coordinate.begin());
-    if (model.joint_type[seg] == jle::JointType::kPrismatic) {
-      s.q[k] = 0.02 + 0.02 * u(rng);
-      s.qd[k] = 0.1 * u(rng);
-      s.qdd[k] = 1.0 * u(rng);
-    } else {
-      s.q[k] = M_PI * u(rng);
-      s.qd[k] = 3.0 * u(rng);
-      s.qdd[k] = 20.0 * u(rng);
-    }
-  }
-  return s;
+  jle_test::StateRanges r;
+  r.q = M_PI;
+  r.qd = 3.0;
+  r.qdd = 20.0;
+  r.prismatic_centre = r.prismatic_q = 0.02;
+  r.prismatic_qd = 0.1;
+  r.prismatic_qdd = 1.0;
+  return jle_test::randomState(model, rng, r);
 }
 
 // `x` ordered like from.coordinate_names, reordered like to.coordinate_names.
@@ -85,14 +75,7 @@ VecX byName(const VecX& x, const jle::Model<double>& from, const jle::Model<doub
 }
 
 jle::BaseState<double> randomBase(jle_test::Random& rng) {
-  jle::BaseState<double> base;
-  base.R_world_base = rng.rotation();
-  base.p_world_base = rng.vector(2.0);
-  base.v_world = rng.vector(1.0);
-  base.omega_world = rng.vector(2.0);
-  base.a_world = rng.vector(5.0);
-  base.alpha_world = rng.vector(10.0);
-  return base;
+  return jle_test::randomBase(rng, 2.0, 1.0, 2.0, 5.0, 10.0);
 }
 
 // A wrench applied at a named link, in that link's frame or the world.
@@ -496,13 +479,7 @@ template <typename Scalar>
 Loads loadsIn(const jle::Model<double>& model_double, const State& s, const Vec3& gravity,
               const jle::BaseState<double>& base_double, const std::vector<Applied>& wrenches) {
   const jle::Model<Scalar> model = model_double.template cast<Scalar>();
-  jle::BaseState<Scalar> base;
-  base.R_world_base = base_double.R_world_base.cast<Scalar>();
-  base.p_world_base = base_double.p_world_base.cast<Scalar>();
-  base.v_world = base_double.v_world.cast<Scalar>();
-  base.omega_world = base_double.omega_world.cast<Scalar>();
-  base.a_world = base_double.a_world.cast<Scalar>();
-  base.alpha_world = base_double.alpha_world.cast<Scalar>();
+  const jle::BaseState<Scalar> base = jle_test::castBase<Scalar>(base_double);
   jle::Data<Scalar> data(model);
   solve(model, data, jle::VectorX<Scalar>(s.q.cast<Scalar>()),
         jle::VectorX<Scalar>(s.qd.cast<Scalar>()), jle::VectorX<Scalar>(s.qdd.cast<Scalar>()),

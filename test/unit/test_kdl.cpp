@@ -144,32 +144,19 @@ KDL::Tree kdlTree(const std::string& xml) {
 // ---------------------------------------------------------------------------------------
 // Random states and loads.
 
-/// Coordinates in the library's order (model.coordinate_names).
-struct State {
-  VectorX<double> q, qd, qdd;
-};
+using jle_test::State;
 
 /// q, qd, qdd uniform in ranges a real arm sees (revolute: +-pi rad, +-3 rad/s,
 /// +-10 rad/s^2; prismatic fingers: 0..4 cm, +-0.2 m/s, +-2 m/s^2).
-State randomState(const jle::Model<double>& model,
-                  const std::map<std::string, KdlJoint>& kdl_joints, jle_test::Random& rng) {
-  jle_test::UniformIn u(-1.0, 1.0);
-  State s;
-  s.q.resize(model.nq);
-  s.qd.resize(model.nq);
-  s.qdd.resize(model.nq);
-  for (int k = 0; k < model.nq; ++k) {
-    if (kdl_joints.at(model.coordinate_names[k]).prismatic) {
-      s.q[k] = 0.02 + 0.02 * u(rng);
-      s.qd[k] = 0.2 * u(rng);
-      s.qdd[k] = 2.0 * u(rng);
-    } else {
-      s.q[k] = M_PI * u(rng);
-      s.qd[k] = 3.0 * u(rng);
-      s.qdd[k] = 10.0 * u(rng);
-    }
-  }
-  return s;
+State randomState(const jle::Model<double>& model, jle_test::Random& rng) {
+  jle_test::StateRanges r;
+  r.q = M_PI;
+  r.qd = 3.0;
+  r.qdd = 10.0;
+  r.prismatic_centre = r.prismatic_q = 0.02;
+  r.prismatic_qd = 0.2;
+  r.prismatic_qdd = 2.0;
+  return jle_test::randomState(model, rng, r);
 }
 
 /// The same state as KDL arrays: each KDL joint takes its coordinate by name, a mimic
@@ -375,7 +362,7 @@ Worst treeEffortDisagreement(const std::string& xml, int states, unsigned int se
   KDL::JntArray tau(tree.getNrOfJoints());
   jle_test::Random rng(seed);
   for (int n = 0; n < states; ++n) {
-    const State s = randomState(model, kdl_joints, rng);
+    const State s = randomState(model, rng);
     const std::vector<Load> loads = randomLoads(leaves, rng);
     const KdlState k = toKdlState(model, tree, kdl_joints, mimics, s);
     if (solver.CartToJnt(k.q, k.qd, k.qdd, toKdlWrenches(loads), tau) < 0) {
@@ -445,7 +432,7 @@ TEST_P(KdlTree, LinkPosesAgreeWithTreeFkSolverPos) {
     }
   };
   for (int n = 0; n < 100; ++n) {
-    const State s = randomState(model, kdl_joints, rng);
+    const State s = randomState(model, rng);
     const KdlState k = toKdlState(model, tree, kdl_joints, mimics, s);
     jle::forwardKinematics(model, data, s.q, s.qd, s.qdd, kGravity);
     KDL::Frame X;
@@ -525,7 +512,7 @@ TEST_P(KdlChain, EffortsAgreeWithChainIdSolverRne) {
   jle_test::Random rng(4242u);
   Worst worst;
   for (int n = 0; n < 1000; ++n) {
-    const State s = randomState(model, chain_joints, rng);
+    const State s = randomState(model, rng);
     const std::vector<Load> loads = randomLoads({c.tip}, rng);
     for (int k = 0; k < model.nq; ++k) {
       const unsigned int j = chain_joints.at(model.coordinate_names[k]).q_nr;
@@ -652,7 +639,7 @@ TEST_P(KdlWrenchGauge, SixComponentsAgreeWithTreeIdSolverRne) {
   jle_test::Random rng(99u);
   Worst worst;
   for (int n = 0; n < 200; ++n) {
-    const State s = randomState(model, kdl_joints, rng);
+    const State s = randomState(model, rng);
     const std::vector<Load> loads = randomLoads(leaves, rng);
     const KdlState k = toKdlState(model, tree, kdl_joints, mimics, s, gauge);
     ASSERT_GE(solver.CartToJnt(k.q, k.qd, k.qdd, toKdlWrenches(loads), tau), 0);
