@@ -123,11 +123,17 @@ const tinyxml2::XMLElement* requiredChild(const tinyxml2::XMLElement* e, const c
   return child;
 }
 
+// A <tag> element's name and line into `desc`; returns how messages name it ("link 'a'").
+template <typename Desc>
+std::string nameOf(const tinyxml2::XMLElement* e, const char* tag, Desc& desc) {
+  desc.name = requiredName(e, "name", std::string("<") + tag + ">");
+  desc.line = e->GetLineNum();
+  return std::string(tag) + " '" + desc.name + "'";
+}
+
 LinkDesc parseLink(const tinyxml2::XMLElement* e) {
   LinkDesc link;
-  link.name = requiredName(e, "name", "<link>");
-  link.line = e->GetLineNum();
-  const std::string what = "link '" + link.name + "'";
+  const std::string what = nameOf(e, "link", link);
   const tinyxml2::XMLElement* in = e->FirstChildElement("inertial");
   if (!in) return link;
   link.has_inertial = true;
@@ -146,9 +152,7 @@ LinkDesc parseLink(const tinyxml2::XMLElement* e) {
 
 JointDesc parseJoint(const tinyxml2::XMLElement* e) {
   JointDesc joint;
-  joint.name = requiredName(e, "name", "<joint>");
-  joint.line = e->GetLineNum();
-  const std::string what = "joint '" + joint.name + "'";
+  const std::string what = nameOf(e, "joint", joint);
   joint.type = requiredName(e, "type", what);
   const tinyxml2::XMLElement* parent = requiredChild(e, "parent", what + ": missing <parent>");
   const tinyxml2::XMLElement* child = requiredChild(e, "child", what + ": missing <child>");

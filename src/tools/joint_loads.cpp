@@ -25,12 +25,7 @@
 
 namespace {
 
-using jle::cli::Sign;
-using jle::cli::UsageError;
-using jle::cli::optionValues;
-using jle::cli::parseNumber;
-using jle::cli::parseNumberList;
-using jle::cli::requiredValue;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS]

@@ -23,10 +23,7 @@
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
-using jle::cli::parseNumberIn;
-using jle::cli::requiredValue;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: make_body_urdf --mass KG --height M [--subtalar] [--name NAME] [--output FILE]

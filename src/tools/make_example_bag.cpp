@@ -27,11 +27,7 @@
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
-using jle::cli::parseInteger;
-using jle::cli::parseNumber;
-using jle::cli::requiredValue;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]

@@ -36,10 +36,7 @@
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::parseInteger;
-using jle::cli::parseNumber;
-using jle::cli::requiredValue;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
@@ -156,18 +153,15 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v = jle::cli::optionValues(
+  std::map<std::string, std::string> v = optionValues(
       argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "BODY.urdf");
   options.output = requiredValue(v, "--output", "OUT.bag");
   if (v.count("--csv")) options.csv = v["--csv"];
-  if (v.count("--strides")) {
+  if (v.count("--strides"))
     options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 1, 100));
-  }
-  if (v.count("--noise")) {
-    options.noise = parseNumber("--noise", v["--noise"], jle::cli::Sign::kNonNegative);
-  }
+  if (v.count("--noise")) options.noise = parseNumber("--noise", v["--noise"], Sign::kNonNegative);
   if (v.count("--seed"))
     options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;

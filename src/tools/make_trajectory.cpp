@@ -17,11 +17,7 @@
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
-using jle::cli::parseInteger;
-using jle::cli::parseNumber;
-using jle::cli::requiredValue;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: make_trajectory --urdf ROBOT.urdf [--duration 2.0] [--rate 1000] [--seed 1]

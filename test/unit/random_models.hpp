@@ -153,7 +153,8 @@ struct State {
 };
 
 /// Where randomState draws: each quantity uniform in centre +- half-width, revolute and
-/// prismatic coordinates apart [rad or m, /s, /s^2].
+/// prismatic coordinates apart [rad or m, /s, /s^2], in the order
+/// {q, qd, qdd, prismatic_centre, prismatic_q, prismatic_qd, prismatic_qdd}.
 struct StateRanges {
   double q = M_PI, qd = 1.0, qdd = 5.0;  ///< revolute: q in [-q, q)
   double prismatic_centre = 0.0;          ///< prismatic: q in prismatic_centre +- prismatic_q

@@ -53,14 +53,7 @@ using jle_test::State;
 // Joint angles over a full turn, rates and accelerations of a fast arm motion; sliders
 // (the panda's fingers) within their 4 cm stroke.
 State randomState(const jle::Model<double>& model, jle_test::Random& rng) {
-  jle_test::StateRanges r;
-  r.q = M_PI;
-  r.qd = 3.0;
-  r.qdd = 20.0;
-  r.prismatic_centre = r.prismatic_q = 0.02;
-  r.prismatic_qd = 0.1;
-  r.prismatic_qdd = 1.0;
-  return jle_test::randomState(model, rng, r);
+  return jle_test::randomState(model, rng, {M_PI, 3.0, 20.0, 0.02, 0.02, 0.1, 1.0});
 }
 
 // `x` ordered like from.coordinate_names, reordered like to.coordinate_names.

@@ -149,14 +149,7 @@ using jle_test::State;
 /// q, qd, qdd uniform in ranges a real arm sees (revolute: +-pi rad, +-3 rad/s,
 /// +-10 rad/s^2; prismatic fingers: 0..4 cm, +-0.2 m/s, +-2 m/s^2).
 State randomState(const jle::Model<double>& model, jle_test::Random& rng) {
-  jle_test::StateRanges r;
-  r.q = M_PI;
-  r.qd = 3.0;
-  r.qdd = 10.0;
-  r.prismatic_centre = r.prismatic_q = 0.02;
-  r.prismatic_qd = 0.2;
-  r.prismatic_qdd = 2.0;
-  return jle_test::randomState(model, rng, r);
+  return jle_test::randomState(model, rng, {M_PI, 3.0, 10.0, 0.02, 0.02, 0.2, 2.0});
 }
 
 /// The same state as KDL arrays: each KDL joint takes its coordinate by name, a mimic
