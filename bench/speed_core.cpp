@@ -5,6 +5,7 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include "../test/unit/random_models.hpp"
@@ -15,7 +16,6 @@
 #include <kdl_parser/kdl_parser.hpp>
 
 #include <map>
-#include <random>
 #include <string>
 
 namespace {
@@ -27,19 +27,15 @@ struct States {
   std::vector<Eigen::VectorXd> q, qd, qdd;
 };
 
-double uniform(std::mt19937& gen, double lo, double hi) {
-  return lo + (hi - lo) * (gen() >> 5) * (1.0 / 134217728.0);
-}
-
 States randomStates(int nq) {
-  std::mt19937 gen(42);
+  jle::PortableRandom random(42);
   States s;
   for (int k = 0; k < kStates; ++k) {
     Eigen::VectorXd q(nq), qd(nq), qdd(nq);
     for (int i = 0; i < nq; ++i) {
-      q[i] = uniform(gen, -3.0, 3.0);
-      qd[i] = uniform(gen, -2.0, 2.0);
-      qdd[i] = uniform(gen, -5.0, 5.0);
+      q[i] = random.uniform(-3.0, 3.0);
+      qd[i] = random.uniform(-2.0, 2.0);
+      qdd[i] = random.uniform(-5.0, 5.0);
     }
     s.q.push_back(q);
     s.qd.push_back(qd);

@@ -1,8 +1,12 @@
 // Command-line options of the package's tools: --key value or --key=value, each known
-// key at most once; a defect of the command line is a UsageError (exit status 2).
+// key at most once, and their values as numbers; a defect of the command line is a
+// UsageError (exit status 2).
 #pragma once
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -47,6 +51,75 @@ inline std::map<std::string, std::string> optionValues(int argc, char** argv,
     if (!values.emplace(key, value).second) throw UsageError(key + " is given twice");
   }
   return values;
+}
+
+/// The value of a required option of `values` (optionValues); throws UsageError
+/// "KEY WHAT is required" ("--urdf ROBOT.urdf is required") without it.
+inline std::string requiredValue(const std::map<std::string, std::string>& values,
+                                 const std::string& key, const std::string& what) {
+  const auto it = values.find(key);
+  if (it == values.end()) throw UsageError(key + " " + what + " is required");
+  return it->second;
+}
+
+/// The sign a number option must have (parseNumber).
+enum class Sign { kAny, kNonNegative, kPositive };
+
+/// `text` (an option's value) as a finite number: strtod must read all of it. Throws
+/// UsageError "KEY: 'TEXT' is not a finite number", ending " >= 0" or " > 0" with a
+/// `sign` it does not have.
+inline double parseNumber(const std::string& key, const std::string& text,
+                          Sign sign = Sign::kAny) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  const bool ok = end != text.c_str() && *end == '\0' && std::isfinite(v) &&
+                  (sign == Sign::kAny || (sign == Sign::kNonNegative ? v >= 0.0 : v > 0.0));
+  if (!ok)
+    throw UsageError(key + ": '" + text + "' is not a finite number" +
+                     (sign == Sign::kAny ? "" : sign == Sign::kNonNegative ? " >= 0" : " > 0"));
+  return v;
+}
+
+/// parseNumber, within [lo, hi]: beyond, throws UsageError "KEY: TEXT is outside LO .. HI"
+/// (the bounds with 4 significant digits).
+inline double parseNumberIn(const std::string& key, const std::string& text, double lo,
+                            double hi) {
+  const double v = parseNumber(key, text);
+  if (v < lo || v > hi) {
+    char range[64];
+    std::snprintf(range, sizeof range, "%.4g .. %.4g", lo, hi);
+    throw UsageError(key + ": " + text + " is outside " + range);
+  }
+  return v;
+}
+
+/// `text` as a decimal integer in lo .. hi (digits only: no sign, no blank). Throws
+/// UsageError "KEY: 'TEXT' is not an integer in LO .. HI".
+inline unsigned long long parseInteger(const std::string& key, const std::string& text,
+                                       unsigned long long lo, unsigned long long hi) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (text.empty() || text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || v < lo ||
+      v > hi)
+    throw UsageError(key + ": '" + text + "' is not an integer in " + std::to_string(lo) +
+                     " .. " + std::to_string(hi));
+  return v;
+}
+
+/// "A,B,C..." as exactly `count` finite numbers into out[0 .. count) (blanks after each
+/// number accepted, strtod before it). False if `text` is not that.
+inline bool parseNumberList(const std::string& text, int count, double* out) {
+  const char* s = text.c_str();
+  for (int i = 0; i < count; ++i) {
+    char* end = nullptr;
+    out[i] = std::strtod(s, &end);
+    while (end != s && (*end == ' ' || *end == '\t')) ++end;
+    const char expected = i + 1 < count ? ',' : '\0';
+    if (end == s || *end != expected || !std::isfinite(out[i])) return false;
+    s = end + (i + 1 < count ? 1 : 0);
+  }
+  return true;
 }
 
 /// The main() of a tool: --help/-h prints `usage`; then run(parse(argc, argv)). A

@@ -167,13 +167,45 @@ struct ExtraStateInputs {
 StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader,
                               const ExtraStateInputs& extra = {});
 
-/// Header of a joint-state CSV: t, JOINT.q, JOINT.qd, JOINT.qdd per coordinate (the
-/// order of model.coordinate_names), then the six columns of each wrench link.
+/// Header of a joint-state CSV, the columns bindStateColumns reads: t, JOINT.q, JOINT.qd,
+/// JOINT.qdd per coordinate (the order of model.coordinate_names), the six columns of each
+/// wrench link; with extra.floating_base the base's pose, twist and acceleration
+/// (base.x ... base.qw, base.vx ... base.wz, base.ax ... base.alz); the six columns of each
+/// plate of extra.plates.
 std::vector<std::string> stateColumnNames(const Model<double>& model,
-                                          const std::vector<std::string>& wrench_links);
+                                          const std::vector<std::string>& wrench_links,
+                                          const ExtraStateInputs& extra = {});
 
-/// Header of a joint-load CSV: t, then JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort for
-/// each moving joint in model.moving_segments order.
-std::vector<std::string> jointLoadColumns(const Model<double>& model);
+/// The six components of a wrench column (wrench@LINK.*, plate@NAME.*, JOINT.*, base.*).
+inline constexpr std::array<const char*, 6> kWrenchComponents = {"fx", "fy", "fz",
+                                                                 "mx", "my", "mz"};
+/// The columns of a force plate in a joint-load file: plate@NAME.contact (1 or 0) and the
+/// centre of pressure in the world, plate@NAME.cop_x, .cop_y, .cop_z [m].
+inline constexpr std::array<const char*, 4> kPlateOutputs = {"contact", "cop_x", "cop_y",
+                                                             "cop_z"};
+
+/// What a joint-load file holds beside t and the seven columns of each joint.
+struct LoadColumnLayout {
+  /// A floating base: base.fx, .fy, .fz, .mx, .my, .mz (what the world applies to the root
+  /// link) after t.
+  bool base = false;
+  /// JOINT.effort_per_kg after each joint's JOINT.effort.
+  bool per_kg = false;
+  /// JOINT.effort_stddev of every joint, after the last joint's columns.
+  bool effort_stddev = false;
+  /// Force plates: plate@NAME.contact, .cop_x, .cop_y, .cop_z for each NAME, last.
+  std::vector<std::string> plates;
+};
+
+/// Header of a joint-load file (joint_loads, process_bag; docs/joint_loads.md), in this
+/// order: t; base.fx ... base.mz (layout.base); for each of `joints` JOINT.fx, .fy, .fz,
+/// .mx, .my, .mz, .effort (and JOINT.effort_per_kg with layout.per_kg); JOINT.effort_stddev
+/// for each of `joints` (layout.effort_stddev); the plates' columns (layout.plates).
+std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints,
+                                          const LoadColumnLayout& layout = {});
+
+/// jointLoadColumns of the joints of model.moving_segments, in that order.
+std::vector<std::string> jointLoadColumns(const Model<double>& model,
+                                          const LoadColumnLayout& layout = {});
 
 }  // namespace jle

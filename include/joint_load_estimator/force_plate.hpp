@@ -1,5 +1,5 @@
 // Force plates: what a plate measures, its centre of pressure, and the reaction it
-// applies to the foot standing on it. ROS-free.
+// applies to the foot standing on it (as the estimator and joint_loads apply it). ROS-free.
 //
 // Conventions (README, "Force plates"):
 // - The plate frame's z axis is the outward normal of the contact surface (pointing
@@ -10,6 +10,10 @@
 //   surface_height is the surface's z in the plate frame).
 // - The foot receives the opposite wrench (the ground reaction).
 #pragma once
+
+#include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
@@ -70,6 +74,11 @@ inline PlateReading readForcePlate(const ForcePlateConfig& plate, const Eigen::V
   return r;
 }
 
+/// The centre of pressure of a reading in the world [m] (the plate origin without contact).
+inline Eigen::Vector3d copInWorld(const ForcePlateConfig& plate, const PlateReading& reading) {
+  return plate.p_world_plate + plate.R_world_plate * reading.cop_plate;
+}
+
 /// The ground reaction of a plate reading in the world frame, moment about the world
 /// point `point_world` [m] (e.g. the foot link's origin). Exact: the moment is carried
 /// from the COP, so no large lever arm about a far origin enters.
@@ -82,10 +91,29 @@ inline void plateReactionInWorld(const ForcePlateConfig& plate, const PlateReadi
     return;
   }
   force_world.noalias() = plate.R_world_plate * reading.force_on_foot_plate;
-  const Eigen::Vector3d cop_world = plate.p_world_plate + plate.R_world_plate * reading.cop_plate;
+  const Eigen::Vector3d cop_world = copInWorld(plate, reading);
   // On the foot: the reaction force at the COP plus the opposite free moment about the normal.
   const Eigen::Vector3d free_world = plate.R_world_plate.col(2) * (-reading.free_moment);
   moment_world = (cop_world - point_world).cross(force_world) + free_world;
+}
+
+/// Applies the ground reaction of `reading` (nothing without contact) to the foot standing
+/// on `plate`: frame `foot_frame` (an index into model.frames, the frame of plate.link),
+/// as a world-frame wrench about its origin. Call after forwardKinematics and before
+/// inverseDynamics. The reaction is worked in double whatever Scalar is.
+template <typename Scalar>
+void applyPlateReaction(const Model<Scalar>& model, Data<Scalar>& data, int foot_frame,
+                        const ForcePlateConfig& plate, const PlateReading& reading) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  if (!reading.contact) return;
+  const Frame<Scalar>& foot = model.frames[static_cast<std::size_t>(foot_frame)];
+  const int s = foot.segment;
+  const Eigen::Vector3d foot_world =
+      (data.p_world[s] + data.R_world[s] * foot.p_segment_frame).template cast<double>();
+  Eigen::Vector3d force_world, moment_world;
+  plateReactionInWorld(plate, reading, foot_world, force_world, moment_world);
+  addExternalWrench(model, data, foot_frame, Vector3(force_world.cast<Scalar>()),
+                    Vector3(moment_world.cast<Scalar>()), WrenchFrame::kWorld);
 }
 
 }  // namespace jle

@@ -4,45 +4,21 @@
 // jitter, dropped samples, force/torque sensor bias). ROS-free.
 //
 // Everything is deterministic from a seed, and the same with every standard library:
-// the random numbers come from std::mt19937_64 (whose output the standard fixes)
-// through the mappings written out below, never through <random>'s distributions
-// (whose algorithms each library chooses). The values then depend only on the libm's
-// sin, cos, log and sqrt, which agree to the last bit or two across platforms.
+// the random numbers are jle::PortableRandom's (portable_random.hpp).
 #pragma once
 
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 
 #include <Eigen/Core>
 
 #include <cstdint>
-#include <random>
 #include <string>
 #include <vector>
 
 namespace jle {
-
-/// Random numbers that are the same with every standard library.
-class PortableRandom {
- public:
-  explicit PortableRandom(std::uint64_t seed) : engine_(seed) {}
-
-  /// Uniform in [0, 1): the top 53 bits of one 64-bit draw, times 2^-53.
-  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-  /// Uniform in [lo, hi): lo + (hi - lo) * uniform().
-  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  /// Integer in [0, n) for n > 0: floor(n * uniform()).
-  int index(int n);
-  /// Standard normal by Box-Muller: u1 = 1 - uniform() (in (0, 1]), u2 = uniform(),
-  /// r = sqrt(-2 ln u1); returns r cos(2 pi u2), and r sin(2 pi u2) at the next call.
-  double gaussian();
-
- private:
-  std::mt19937_64 engine_;
-  double spare_ = 0.0;
-  bool has_spare_ = false;
-};
 
 /// Seed of an independent stream number `stream` derived from `seed` (SplitMix64 of
 /// seed + (stream + 1) * 0x9E3779B97F4A7C15), so that the motion and each sensor draw

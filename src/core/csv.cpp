@@ -90,9 +90,7 @@ class HeaderProblems {
 
 std::string errnoText() { return std::strerror(errno); }
 
-constexpr std::array<const char*, 6> kWrenchComponents = {"fx", "fy", "fz", "mx", "my", "mz"};
 constexpr std::array<const char*, 3> kStateSuffixes = {"q", "qd", "qdd"};
-constexpr std::array<const char*, 7> kLoadSuffixes = {"fx", "fy", "fz", "mx", "my", "mz", "effort"};
 const std::string kWrenchPrefix = "wrench@";
 const std::string kBasePrefix = "base.";
 const std::string kPlatePrefix = "plate@";
@@ -358,175 +356,257 @@ void CsvWriter::commit() {
 
 // ---------------------------------------------------------------------------- layout
 
-StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader,
-                              const ExtraStateInputs& extra) {
-  StateColumns out;
-  out.plates.assign(extra.plates.size(), {-1, -1, -1, -1, -1, -1});
-  out.q.assign(static_cast<std::size_t>(model.nq), -1);
-  out.qd.assign(static_cast<std::size_t>(model.nq), -1);
-  out.qdd.assign(static_cast<std::size_t>(model.nq), -1);
-  HeaderProblems problems;
+namespace {
 
-  for (int c = 0; c < reader.columns(); ++c) {
-    const std::string& name = reader.header()[c];
+// "column 'a'" or "columns 'a', 'b'".
+std::string columnList(const std::vector<std::string>& names) {
+  return (names.size() == 1 ? "column " : "columns ") + nameList(names);
+}
+
+// The names prefix + names[i] of the columns not found (cols[i] < 0).
+template <std::size_t N>
+std::vector<std::string> absentColumns(const std::array<int, N>& cols, const std::string& prefix,
+                                       const std::array<const char*, N>& names) {
+  std::vector<std::string> absent;
+  for (std::size_t i = 0; i < N; ++i)
+    if (cols[i] < 0) absent.push_back(prefix + names[i]);
+  return absent;
+}
+
+// PREFIX OWNER.COMPONENT (plate@NAME.fx, wrench@LINK.mz): the index of the wrench
+// component, -1 if there is none or no owner; the owner into `owner`.
+int prefixedComponent(const std::string& name, const std::string& prefix, std::string& owner) {
+  const std::size_t dot = name.rfind('.');
+  if (dot == std::string::npos || dot <= prefix.size()) return -1;
+  owner = name.substr(prefix.size(), dot - prefix.size());
+  return indexOf(kWrenchComponents, std::string_view(name).substr(dot + 1));
+}
+
+// Maps the columns of one header onto a model (bindStateColumns), collecting its defects.
+class StateHeader {
+ public:
+  StateHeader(const Model<double>& model, const ExtraStateInputs& extra)
+      : model_(model), extra_(extra) {
+    out_.plates.assign(extra.plates.size(), {-1, -1, -1, -1, -1, -1});
+    out_.q.assign(static_cast<std::size_t>(model.nq), -1);
+    out_.qd.assign(static_cast<std::size_t>(model.nq), -1);
+    out_.qdd.assign(static_cast<std::size_t>(model.nq), -1);
+  }
+
+  void bind(int c, const std::string& name) {
     if (name == "t") {
-      out.t = c;
-      continue;
+      out_.t = c;
+      return;
     }
-    const std::size_t dot = name.rfind('.');
-    const std::string suffix = dot == std::string::npos ? "" : name.substr(dot + 1);
-    // base.x ... base.alz (never base.q, base.qd, base.qdd: a joint may be named "base").
-    const std::string part =
-        name.compare(0, kBasePrefix.size(), kBasePrefix) == 0 ? name.substr(kBasePrefix.size()) : "";
-    const int pose_index = indexOf(kBasePose, part);
-    const int twist_index = indexOf(kBaseTwist, part);
-    const int acceleration_index = indexOf(kBaseAcceleration, part);
-    if (pose_index >= 0 || twist_index >= 0 || acceleration_index >= 0) {
-      if (!extra.floating_base)
-        problems.add(name, "a floating-base column, but the base is fixed (see --floating-base)");
-      else if (pose_index >= 0)
-        out.base_pose[static_cast<std::size_t>(pose_index)] = c;
-      else if (twist_index >= 0)
-        out.base_twist[static_cast<std::size_t>(twist_index)] = c;
-      else
-        out.base_acceleration[static_cast<std::size_t>(acceleration_index)] = c;
-      continue;
-    }
+    if (bindBase(c, name)) return;
+    std::string owner;
     if (name.compare(0, kPlatePrefix.size(), kPlatePrefix) == 0) {
-      const int component = indexOf(kWrenchComponents, suffix);
-      if (dot == std::string::npos || dot <= kPlatePrefix.size() || component < 0) {
-        problems.add(name, "expected plate@NAME.fx, .fy, .fz, .mx, .my or .mz");
-        continue;
-      }
-      const std::string plate = name.substr(kPlatePrefix.size(), dot - kPlatePrefix.size());
-      const auto p = std::find(extra.plates.begin(), extra.plates.end(), plate);
-      if (p == extra.plates.end()) {
-        problems.add(name, "unknown plate '" + plate + "' (no --plate " + plate + "=...)");
-        continue;
-      }
-      out.plates[static_cast<std::size_t>(p - extra.plates.begin())]
-                [static_cast<std::size_t>(component)] = c;
-      continue;
+      const int component = ownedComponent(name, kPlatePrefix, "NAME", owner);
+      if (component >= 0) bindPlate(c, name, owner, component);
+    } else if (name.compare(0, kWrenchPrefix.size(), kWrenchPrefix) == 0) {
+      const int component = ownedComponent(name, kWrenchPrefix, "LINK", owner);
+      if (component >= 0) bindWrench(c, name, owner, component);
+    } else {
+      bindJoint(c, name);
     }
-    if (name.compare(0, kWrenchPrefix.size(), kWrenchPrefix) == 0) {
-      const int component = indexOf(kWrenchComponents, suffix);
-      if (dot == std::string::npos || dot <= kWrenchPrefix.size() || component < 0) {
-        problems.add(name, "expected wrench@LINK.fx, .fy, .fz, .mx, .my or .mz");
-        continue;
-      }
-      const std::string link = name.substr(kWrenchPrefix.size(), dot - kWrenchPrefix.size());
-      int frame = -1;
-      for (int f = 0; f < static_cast<int>(model.frames.size()); ++f)
-        if (model.frames[f].name == link) frame = f;
-      if (frame < 0) {
-        problems.add(name, "unknown link '" + link + "'");
-        continue;
-      }
-      auto w = std::find_if(out.wrenches.begin(), out.wrenches.end(),
-                            [&](const StateColumns::WrenchColumns& x) { return x.link == link; });
-      if (w == out.wrenches.end()) {
-        StateColumns::WrenchColumns added;
-        added.link = link;
-        added.frame = frame;
-        added.column.fill(-1);
-        out.wrenches.push_back(added);
-        w = out.wrenches.end() - 1;
-      }
-      w->column[static_cast<std::size_t>(component)] = c;
-      continue;
+  }
+
+  // The columns, or a CsvError at line 1 naming every defect.
+  StateColumns finish(const CsvReader& reader) {
+    checkJoints();
+    for (const StateColumns::WrenchColumns& w : out_.wrenches)
+      checkComplete(w.column, kWrenchPrefix + w.link);
+    if (extra_.floating_base) checkBase();
+    for (std::size_t p = 0; p < extra_.plates.size(); ++p)
+      checkComplete(out_.plates[p], kPlatePrefix + extra_.plates[p], "plate " + extra_.plates[p]);
+    if (!problems_.empty()) reader.failHeader(problems_.message());
+    return out_;
+  }
+
+ private:
+  // base.x ... base.alz (never base.q, base.qd, base.qdd: a joint may be named "base").
+  bool bindBase(int c, const std::string& name) {
+    const std::string part = name.compare(0, kBasePrefix.size(), kBasePrefix) == 0
+                                 ? name.substr(kBasePrefix.size())
+                                 : "";
+    const int pose = indexOf(kBasePose, part), twist = indexOf(kBaseTwist, part),
+              acceleration = indexOf(kBaseAcceleration, part);
+    if (pose < 0 && twist < 0 && acceleration < 0) return false;
+    if (!extra_.floating_base)
+      problems_.add(name, "a floating-base column, but the base is fixed (see --floating-base)");
+    else if (pose >= 0)
+      out_.base_pose[static_cast<std::size_t>(pose)] = c;
+    else if (twist >= 0)
+      out_.base_twist[static_cast<std::size_t>(twist)] = c;
+    else
+      out_.base_acceleration[static_cast<std::size_t>(acceleration)] = c;
+    return true;
+  }
+
+  // PREFIX OWNER.COMPONENT (plate@NAME.fx, wrench@LINK.mz): the component, or -1 with
+  // the problem noted.
+  int ownedComponent(const std::string& name, const std::string& prefix, const char* kind,
+                     std::string& owner) {
+    const int component = prefixedComponent(name, prefix, owner);
+    if (component < 0)
+      problems_.add(name, "expected " + prefix + kind + ".fx, .fy, .fz, .mx, .my or .mz");
+    return component;
+  }
+
+  void bindPlate(int c, const std::string& name, const std::string& plate, int component) {
+    const auto p = std::find(extra_.plates.begin(), extra_.plates.end(), plate);
+    if (p == extra_.plates.end())
+      problems_.add(name, "unknown plate '" + plate + "' (no --plate " + plate + "=...)");
+    else
+      out_.plates[static_cast<std::size_t>(p - extra_.plates.begin())]
+                 [static_cast<std::size_t>(component)] = c;
+  }
+
+  void bindWrench(int c, const std::string& name, const std::string& link, int component) {
+    int frame = -1;
+    for (int f = 0; f < static_cast<int>(model_.frames.size()); ++f)
+      if (model_.frames[f].name == link) frame = f;
+    if (frame < 0) {
+      problems_.add(name, "unknown link '" + link + "'");
+      return;
     }
-    const int kind = indexOf(kStateSuffixes, suffix);
-    if (dot == std::string::npos || kind < 0) {
-      problems.add(name,
-                   "unknown column (expected t, JOINT.q, JOINT.qd, JOINT.qdd or "
-                   "wrench@LINK.fx ... .mz)");
-      continue;
+    auto w = std::find_if(out_.wrenches.begin(), out_.wrenches.end(),
+                          [&](const StateColumns::WrenchColumns& x) { return x.link == link; });
+    if (w == out_.wrenches.end()) {
+      StateColumns::WrenchColumns added;
+      added.link = link;
+      added.frame = frame;
+      added.column.fill(-1);
+      out_.wrenches.push_back(added);
+      w = out_.wrenches.end() - 1;
+    }
+    w->column[static_cast<std::size_t>(component)] = c;
+  }
+
+  // JOINT.q, JOINT.qd, JOINT.qdd.
+  void bindJoint(int c, const std::string& name) {
+    const std::size_t dot = name.rfind('.');
+    const int kind =
+        dot == std::string::npos ? -1 : indexOf(kStateSuffixes, std::string_view(name).substr(dot + 1));
+    if (kind < 0) {
+      problems_.add(name,
+                    "unknown column (expected t, JOINT.q, JOINT.qd, JOINT.qdd or "
+                    "wrench@LINK.fx ... .mz)");
+      return;
     }
     const std::string joint = name.substr(0, dot);
     int segment = -1;
-    for (int s : model.moving_segments)
-      if (model.joint_name[s] == joint) segment = s;
+    for (int s : model_.moving_segments)
+      if (model_.joint_name[s] == joint) segment = s;
     if (segment < 0) {
-      problems.add(name,
-                   "unknown joint (no revolute, continuous or prismatic joint of that "
-                   "name in the model)");
-      continue;
+      problems_.add(name,
+                    "unknown joint (no revolute, continuous or prismatic joint of that "
+                    "name in the model)");
+      return;
     }
-    const int k = model.coordinate[segment];
-    if (model.coordinate_names[k] != joint) continue;  // a mimic: follows its leader
-    std::vector<int>& slot = kind == 0 ? out.q : kind == 1 ? out.qd : out.qdd;
-    slot[k] = c;
+    const int k = model_.coordinate[segment];
+    if (model_.coordinate_names[k] != joint) return;  // a mimic: follows its leader
+    coordinateColumns(kind)[k] = c;
   }
 
-  std::vector<std::string> missing;
-  if (out.t < 0) missing.push_back("t");
-  for (int k = 0; k < model.nq; ++k)
-    for (int kind = 0; kind < 3; ++kind) {
-      const std::vector<int>& slot = kind == 0 ? out.q : kind == 1 ? out.qd : out.qdd;
-      if (slot[k] < 0) missing.push_back(model.coordinate_names[k] + "." + kStateSuffixes[kind]);
-    }
-  if (!missing.empty())
-    problems.add((missing.size() == 1 ? "missing column " : "missing columns ") +
-                 nameList(missing));
-  for (const StateColumns::WrenchColumns& w : out.wrenches) {
-    std::vector<std::string> absent;
-    for (std::size_t i = 0; i < 6; ++i)
-      if (w.column[i] < 0) absent.push_back(kWrenchPrefix + w.link + "." + kWrenchComponents[i]);
-    if (!absent.empty())
-      problems.add("wrench@" + w.link + ": missing " +
-                   (absent.size() == 1 ? "column " : "columns ") + nameList(absent) +
-                   " (all six components are required)");
+  std::vector<int>& coordinateColumns(int kind) {
+    return kind == 0 ? out_.q : kind == 1 ? out_.qd : out_.qdd;
   }
-  if (extra.floating_base) {
-    std::vector<std::string> absent;
-    for (std::size_t i = 0; i < kBasePose.size(); ++i)
-      if (out.base_pose[i] < 0) absent.push_back(kBasePrefix + kBasePose[i]);
+
+  void checkJoints() {
+    std::vector<std::string> missing;
+    if (out_.t < 0) missing.push_back("t");
+    for (int k = 0; k < model_.nq; ++k)
+      for (int kind = 0; kind < 3; ++kind)
+        if (coordinateColumns(kind)[k] < 0)
+          missing.push_back(model_.coordinate_names[k] + "." + kStateSuffixes[kind]);
+    if (!missing.empty()) problems_.add("missing " + columnList(missing));
+  }
+
+  // The six columns of OWNER (wrench@LINK, plate@NAME): all of them (`what` names it).
+  void checkComplete(const std::array<int, 6>& cols, const std::string& owner,
+                     const std::string& what = "") {
+    const std::vector<std::string> absent = absentColumns(cols, owner + ".", kWrenchComponents);
     if (!absent.empty())
-      problems.add("floating base: missing " + std::string(absent.size() == 1 ? "column " : "columns ") +
-                   nameList(absent) + " (the root link's pose is required)");
-    const auto group = [&](const std::array<int, 6>& cols, const std::array<const char*, 6>& names,
-                           const char* what) {
-      std::vector<std::string> missing_part, present;
-      for (std::size_t i = 0; i < 6; ++i)
-        (cols[i] < 0 ? missing_part : present).push_back(kBasePrefix + names[i]);
-      if (!present.empty() && !missing_part.empty())
-        problems.add(std::string("floating base ") + what + ": missing " +
-                     (missing_part.size() == 1 ? "column " : "columns ") + nameList(missing_part) +
-                     " (all six or none)");
-    };
-    group(out.base_twist, kBaseTwist, "twist");
-    group(out.base_acceleration, kBaseAcceleration, "acceleration");
+      problems_.add((what.empty() ? owner : what) + ": missing " + columnList(absent) +
+                    " (all six components are required)");
+  }
+
+  void checkBase() {
+    const std::vector<std::string> absent = absentColumns(out_.base_pose, kBasePrefix, kBasePose);
+    if (!absent.empty())
+      problems_.add("floating base: missing " + columnList(absent) +
+                    " (the root link's pose is required)");
     // A group given in part counts as absent for the caller; the header is refused anyway.
+    checkBaseGroup(out_.base_twist, kBaseTwist, "twist");
+    checkBaseGroup(out_.base_acceleration, kBaseAcceleration, "acceleration");
   }
-  for (std::size_t p = 0; p < extra.plates.size(); ++p) {
-    std::vector<std::string> absent;
-    for (std::size_t i = 0; i < 6; ++i)
-      if (out.plates[p][i] < 0) absent.push_back(kPlatePrefix + extra.plates[p] + "." + kWrenchComponents[i]);
-    if (!absent.empty())
-      problems.add("plate " + extra.plates[p] + ": missing " +
-                   (absent.size() == 1 ? "column " : "columns ") + nameList(absent) +
-                   " (all six components are required)");
+
+  void checkBaseGroup(const std::array<int, 6>& cols, const std::array<const char*, 6>& names,
+                      const char* what) {
+    const std::vector<std::string> absent = absentColumns(cols, kBasePrefix, names);
+    if (!absent.empty() && absent.size() < cols.size())
+      problems_.add(std::string("floating base ") + what + ": missing " + columnList(absent) +
+                    " (all six or none)");
   }
-  if (!problems.empty()) reader.failHeader(problems.message());
-  return out;
+
+  const Model<double>& model_;
+  const ExtraStateInputs& extra_;
+  StateColumns out_;
+  HeaderProblems problems_;
+};
+
+}  // namespace
+
+StateColumns bindStateColumns(const Model<double>& model, const CsvReader& reader,
+                              const ExtraStateInputs& extra) {
+  StateHeader header(model, extra);
+  for (int c = 0; c < reader.columns(); ++c) header.bind(c, reader.header()[c]);
+  return header.finish(reader);
 }
 
 std::vector<std::string> stateColumnNames(const Model<double>& model,
-                                          const std::vector<std::string>& wrench_links) {
+                                          const std::vector<std::string>& wrench_links,
+                                          const ExtraStateInputs& extra) {
   std::vector<std::string> names{"t"};
   for (const std::string& joint : model.coordinate_names)
     for (const char* suffix : kStateSuffixes) names.push_back(joint + "." + suffix);
   for (const std::string& link : wrench_links)
     for (const char* component : kWrenchComponents)
       names.push_back(kWrenchPrefix + link + "." + component);
+  if (extra.floating_base) {
+    for (const char* part : kBasePose) names.push_back(kBasePrefix + part);
+    for (const char* part : kBaseTwist) names.push_back(kBasePrefix + part);
+    for (const char* part : kBaseAcceleration) names.push_back(kBasePrefix + part);
+  }
+  for (const std::string& plate : extra.plates)
+    for (const char* component : kWrenchComponents)
+      names.push_back(kPlatePrefix + plate + "." + component);
   return names;
 }
 
-std::vector<std::string> jointLoadColumns(const Model<double>& model) {
+std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints,
+                                          const LoadColumnLayout& layout) {
   std::vector<std::string> names{"t"};
-  for (int s : model.moving_segments)
-    for (const char* suffix : kLoadSuffixes) names.push_back(model.joint_name[s] + "." + suffix);
+  if (layout.base)
+    for (const char* component : kWrenchComponents) names.push_back(kBasePrefix + component);
+  for (const std::string& joint : joints) {
+    for (const char* component : kWrenchComponents) names.push_back(joint + "." + component);
+    names.push_back(joint + ".effort");
+    if (layout.per_kg) names.push_back(joint + ".effort_per_kg");
+  }
+  if (layout.effort_stddev)
+    for (const std::string& joint : joints) names.push_back(joint + ".effort_stddev");
+  for (const std::string& plate : layout.plates)
+    for (const char* column : kPlateOutputs) names.push_back(kPlatePrefix + plate + "." + column);
   return names;
+}
+
+std::vector<std::string> jointLoadColumns(const Model<double>& model,
+                                          const LoadColumnLayout& layout) {
+  std::vector<std::string> joints;
+  for (int s : model.moving_segments) joints.push_back(model.joint_name[s]);
+  return jointLoadColumns(joints, layout);
 }
 
 }  // namespace jle

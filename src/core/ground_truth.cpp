@@ -38,24 +38,6 @@ std::vector<bool> prismaticCoordinates(const Model<double>& model) {
 
 }  // namespace
 
-int PortableRandom::index(int n) {
-  const int i = static_cast<int>(uniform() * n);
-  return std::min(i, n - 1);
-}
-
-double PortableRandom::gaussian() {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
-  }
-  const double u1 = 1.0 - uniform();  // (0, 1]: the logarithm stays finite
-  const double u2 = uniform();
-  const double r = std::sqrt(-2.0 * std::log(u1));
-  spare_ = r * std::sin(kTwoPi * u2);
-  has_spare_ = true;
-  return r * std::cos(kTwoPi * u2);
-}
-
 std::uint64_t deriveSeed(std::uint64_t seed, std::uint64_t stream) {
   std::uint64_t z = seed + (stream + 1) * 0x9E3779B97F4A7C15ULL;
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;

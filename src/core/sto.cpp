@@ -11,6 +11,65 @@ namespace {
 
 std::string errnoText() { return std::strerror(errno); }
 
+[[noreturn]] void noStoName(const std::string& name) {
+  throw std::invalid_argument("no .sto name for column '" + name + "'");
+}
+
+int componentIndex(const std::string& suffix) {
+  for (std::size_t i = 0; i < kWrenchComponents.size(); ++i)
+    if (suffix == kWrenchComponents[i]) return static_cast<int>(i);
+  return -1;
+}
+
+// base.fx ... base.mz: the root's ROOT_tx_force ... ROOT_mz_moment.
+std::string baseName(const Model<double>& model, const std::string& name,
+                     const std::string& suffix) {
+  static const char* const kBase[] = {"tx_force",  "ty_force",  "tz_force",
+                                      "mx_moment", "my_moment", "mz_moment"};
+  const int i = componentIndex(suffix);
+  if (i < 0) noStoName(name);
+  return model.link_name[0] + "_" + kBase[i];
+}
+
+// plate@P.contact, .cop_x, .cop_y, .cop_z: P_contact, P_ground_force_px, _py, _pz.
+std::string plateName(const std::string& name, const std::string& plate,
+                      const std::string& suffix) {
+  static const char* const kPlate[] = {"_contact", "_ground_force_px", "_ground_force_py",
+                                       "_ground_force_pz"};
+  for (std::size_t i = 0; i < kPlateOutputs.size(); ++i)
+    if (suffix == kPlateOutputs[i]) return plate + kPlate[i];
+  noStoName(name);
+}
+
+// J.effort, J.effort_per_kg, J.fx ... J.mz of a moving joint, or of a fixed one kept as a
+// segment (process_bag).
+std::string jointName(const Model<double>& model, const std::string& name,
+                      const std::string& joint, const std::string& suffix, WrenchFrame frame) {
+  int segment = -1;
+  for (int s = 1; s < model.nsegments(); ++s)
+    if (model.joint_name[s] == joint) segment = s;
+  if (segment < 0) noStoName(name);
+  const bool prismatic = model.joint_type[segment] == JointType::kPrismatic;
+  const std::string generalized = joint + (prismatic ? "_force" : "_moment");
+  if (suffix == "effort") return generalized;
+  if (suffix == "effort_per_kg") return generalized + "_per_kg";
+  if (componentIndex(suffix) < 0) noStoName(name);
+  const std::string in = frame == WrenchFrame::kWorld    ? std::string("ground")
+                         : frame == WrenchFrame::kParent ? model.parent_link_name[segment]
+                                                         : model.link_name[segment];
+  return joint + "_on_" + model.link_name[segment] + "_in_" + in + "_" + suffix;
+}
+
+std::string stoName(const Model<double>& model, const std::string& name, WrenchFrame frame) {
+  if (name == "t") return "time";
+  const std::size_t dot = name.rfind('.');
+  if (dot == std::string::npos) noStoName(name);
+  const std::string head = name.substr(0, dot), suffix = name.substr(dot + 1);
+  if (head == "base") return baseName(model, name, suffix);
+  if (head.compare(0, 6, "plate@") == 0) return plateName(name, head.substr(6), suffix);
+  return jointName(model, name, head, suffix, frame);
+}
+
 }  // namespace
 
 StoWriter::StoWriter(const std::string& path, std::string name)
@@ -71,63 +130,9 @@ void StoWriter::commit() {
 std::vector<std::string> stoColumnNames(const Model<double>& model,
                                         const std::vector<std::string>& csv_names,
                                         WrenchFrame frame) {
-  static const char* const kComponents[] = {"fx", "fy", "fz", "mx", "my", "mz"};
-  static const char* const kBase[] = {"tx_force", "ty_force", "tz_force",
-                                      "mx_moment", "my_moment", "mz_moment"};
   std::vector<std::string> out;
   out.reserve(csv_names.size());
-  for (const std::string& name : csv_names) {
-    if (name == "t") {
-      out.push_back("time");
-      continue;
-    }
-    const std::size_t dot = name.rfind('.');
-    if (dot == std::string::npos) throw std::invalid_argument("no .sto name for column '" + name + "'");
-    const std::string head = name.substr(0, dot), suffix = name.substr(dot + 1);
-    if (head == "base") {
-      bool found = false;
-      for (int i = 0; i < 6; ++i)
-        if (suffix == kComponents[i]) {
-          out.push_back(model.link_name[0] + "_" + kBase[i]);
-          found = true;
-        }
-      if (!found) throw std::invalid_argument("no .sto name for column '" + name + "'");
-      continue;
-    }
-    if (head.compare(0, 6, "plate@") == 0) {
-      const std::string plate = head.substr(6);
-      if (suffix == "contact") out.push_back(plate + "_contact");
-      else if (suffix == "cop_x") out.push_back(plate + "_ground_force_px");
-      else if (suffix == "cop_y") out.push_back(plate + "_ground_force_py");
-      else if (suffix == "cop_z") out.push_back(plate + "_ground_force_pz");
-      else throw std::invalid_argument("no .sto name for column '" + name + "'");
-      continue;
-    }
-    int segment = -1;  // a moving joint, or a fixed one kept as a segment (process_bag)
-    for (int s = 1; s < model.nsegments(); ++s)
-      if (model.joint_name[s] == head) segment = s;
-    if (segment < 0) throw std::invalid_argument("no .sto name for column '" + name + "'");
-    const bool prismatic = model.joint_type[segment] == JointType::kPrismatic;
-    const std::string generalized = head + (prismatic ? "_force" : "_moment");
-    if (suffix == "effort") {
-      out.push_back(generalized);
-      continue;
-    }
-    if (suffix == "effort_per_kg") {
-      out.push_back(generalized + "_per_kg");
-      continue;
-    }
-    const std::string in = frame == WrenchFrame::kWorld    ? std::string("ground")
-                           : frame == WrenchFrame::kParent ? model.parent_link_name[segment]
-                                                           : model.link_name[segment];
-    bool found = false;
-    for (const char* c : kComponents)
-      if (suffix == c) {
-        out.push_back(head + "_on_" + model.link_name[segment] + "_in_" + in + "_" + c);
-        found = true;
-      }
-    if (!found) throw std::invalid_argument("no .sto name for column '" + name + "'");
-  }
+  for (const std::string& name : csv_names) out.push_back(stoName(model, name, frame));
   return out;
 }
 

@@ -115,20 +115,33 @@ std::string requiredName(const tinyxml2::XMLElement* e, const char* attribute,
   return text;
 }
 
+// The child element `name` of e; a model error `message` (with e's line) without it.
+const tinyxml2::XMLElement* requiredChild(const tinyxml2::XMLElement* e, const char* name,
+                                          const std::string& message) {
+  const tinyxml2::XMLElement* child = e->FirstChildElement(name);
+  if (!child) fail(message + where(e));
+  return child;
+}
+
+// A <tag> element's name and line into `desc`; returns how messages name it ("link 'a'").
+template <typename Desc>
+std::string nameOf(const tinyxml2::XMLElement* e, const char* tag, Desc& desc) {
+  desc.name = requiredName(e, "name", std::string("<") + tag + ">");
+  desc.line = e->GetLineNum();
+  return std::string(tag) + " '" + desc.name + "'";
+}
+
 LinkDesc parseLink(const tinyxml2::XMLElement* e) {
   LinkDesc link;
-  link.name = requiredName(e, "name", "<link>");
-  link.line = e->GetLineNum();
-  const std::string what = "link '" + link.name + "'";
+  const std::string what = nameOf(e, "link", link);
   const tinyxml2::XMLElement* in = e->FirstChildElement("inertial");
   if (!in) return link;
   link.has_inertial = true;
   link.inertial_origin = origin(in, what + " inertial");
-  const tinyxml2::XMLElement* m = in->FirstChildElement("mass");
-  if (!m) fail(what + ": <inertial> without <mass>" + where(in));
+  const tinyxml2::XMLElement* m = requiredChild(in, "mass", what + ": <inertial> without <mass>");
   link.mass = number(m, "value", what + " mass", true, 0.0);
-  const tinyxml2::XMLElement* i = in->FirstChildElement("inertia");
-  if (!i) fail(what + ": <inertial> without <inertia>" + where(in));
+  const tinyxml2::XMLElement* i =
+      requiredChild(in, "inertia", what + ": <inertial> without <inertia>");
   const std::string wi = what + " inertia";
   const double ixx = number(i, "ixx", wi, true, 0.0), ixy = number(i, "ixy", wi, true, 0.0),
                ixz = number(i, "ixz", wi, true, 0.0), iyy = number(i, "iyy", wi, true, 0.0),
@@ -139,14 +152,10 @@ LinkDesc parseLink(const tinyxml2::XMLElement* e) {
 
 JointDesc parseJoint(const tinyxml2::XMLElement* e) {
   JointDesc joint;
-  joint.name = requiredName(e, "name", "<joint>");
-  joint.line = e->GetLineNum();
-  const std::string what = "joint '" + joint.name + "'";
+  const std::string what = nameOf(e, "joint", joint);
   joint.type = requiredName(e, "type", what);
-  const tinyxml2::XMLElement* parent = e->FirstChildElement("parent");
-  const tinyxml2::XMLElement* child = e->FirstChildElement("child");
-  if (!parent) fail(what + ": missing <parent>" + where(e));
-  if (!child) fail(what + ": missing <child>" + where(e));
+  const tinyxml2::XMLElement* parent = requiredChild(e, "parent", what + ": missing <parent>");
+  const tinyxml2::XMLElement* child = requiredChild(e, "child", what + ": missing <child>");
   joint.parent = requiredName(parent, "link", what + " <parent>");
   joint.child = requiredName(child, "link", what + " <child>");
   joint.origin = origin(e, what);
@@ -345,92 +354,124 @@ struct Builder {
   }
 };
 
-}  // namespace
+// The links and joints of a <robot>, each name once, linked into a tree (parent_joint,
+// child_joints).
+struct Description {
+  std::vector<LinkDesc> links;
+  std::vector<JointDesc> joints;
+  std::map<std::string, int> link_index, joint_index;
+};
 
-Model<double> modelFromUrdfString(const std::string& xml, const ModelOptions& options) {
+// Every <tag> child of `robot`, parsed, into `out`; its name into `index`.
+template <typename Desc, typename Parse>
+void parseElements(const tinyxml2::XMLElement* robot, const char* tag, Parse parse,
+                   std::vector<Desc>& out, std::map<std::string, int>& index) {
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement(tag); e;
+       e = e->NextSiblingElement(tag)) {
+    out.push_back(parse(e));
+    if (!index.emplace(out.back().name, static_cast<int>(out.size()) - 1).second)
+      fail(std::string(tag) + " '" + out.back().name + "' is defined twice" + where(e));
+  }
+}
+
+// Each joint's links: known, and every link the child of one joint at most.
+void linkJoints(Description& d) {
+  for (int j = 0; j < static_cast<int>(d.joints.size()); ++j) {
+    const JointDesc& joint = d.joints[j];
+    for (const std::string* l : {&joint.parent, &joint.child})
+      if (!d.link_index.count(*l))
+        fail("joint '" + joint.name + "': unknown link '" + *l + "' (line " +
+             std::to_string(joint.line) + ")");
+    LinkDesc& child = d.links[d.link_index[joint.child]];
+    if (child.parent_joint >= 0)
+      fail("link '" + child.name + "' is the child of two joints, '" +
+           d.joints[child.parent_joint].name + "' and '" + joint.name + "' (a loop)");
+    child.parent_joint = j;
+    d.links[d.link_index[joint.parent]].child_joints.push_back(j);
+  }
+}
+
+Description parseRobot(const std::string& xml, const ModelOptions& options) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS)
     fail(std::string("malformed XML: ") + doc.ErrorStr());
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) fail("no <robot> element");
-
-  std::vector<LinkDesc> links;
-  std::vector<JointDesc> joints;
-  std::map<std::string, int> link_index, joint_index;
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e;
-       e = e->NextSiblingElement("link")) {
-    links.push_back(parseLink(e));
-    if (!link_index.emplace(links.back().name, static_cast<int>(links.size()) - 1).second)
-      fail("link '" + links.back().name + "' is defined twice" + where(e));
-  }
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e;
-       e = e->NextSiblingElement("joint")) {
-    joints.push_back(parseJoint(e));
-    if (!joint_index.emplace(joints.back().name, static_cast<int>(joints.size()) - 1).second)
-      fail("joint '" + joints.back().name + "' is defined twice" + where(e));
-  }
-  if (links.empty()) fail("robot has no <link>");
+  Description d;
+  parseElements(robot, "link", parseLink, d.links, d.link_index);
+  parseElements(robot, "joint", parseJoint, d.joints, d.joint_index);
+  if (d.links.empty()) fail("robot has no <link>");
   for (const std::string& name : options.keep_fixed_joints) {
-    auto it = joint_index.find(name);
-    if (it == joint_index.end()) fail("keep_fixed_joints: unknown joint '" + name + "'");
-    if (joints[it->second].type != "fixed")
+    auto it = d.joint_index.find(name);
+    if (it == d.joint_index.end()) fail("keep_fixed_joints: unknown joint '" + name + "'");
+    if (d.joints[it->second].type != "fixed")
       fail("keep_fixed_joints: joint '" + name + "' is not fixed");
   }
+  linkJoints(d);
+  return d;
+}
 
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
-    const JointDesc& joint = joints[j];
-    for (const std::string* l : {&joint.parent, &joint.child})
-      if (!link_index.count(*l))
-        fail("joint '" + joint.name + "': unknown link '" + *l + "' (line " +
-             std::to_string(joint.line) + ")");
-    LinkDesc& child = links[link_index[joint.child]];
-    if (child.parent_joint >= 0)
-      fail("link '" + child.name + "' is the child of two joints, '" +
-           joints[child.parent_joint].name + "' and '" + joint.name + "' (a loop)");
-    child.parent_joint = j;
-    links[link_index[joint.parent]].child_joints.push_back(j);
-  }
+// The one link without a parent joint.
+int rootLink(const Description& d) {
   std::vector<int> roots;
-  for (int l = 0; l < static_cast<int>(links.size()); ++l)
-    if (links[l].parent_joint < 0) roots.push_back(l);
+  for (int l = 0; l < static_cast<int>(d.links.size()); ++l)
+    if (d.links[l].parent_joint < 0) roots.push_back(l);
   if (roots.empty()) fail("no root link: every link has a parent joint (a loop)");
   if (roots.size() > 1) {
     std::string names;
-    for (int r : roots) names += (names.empty() ? "'" : ", '") + links[r].name + "'";
+    for (int r : roots) names += (names.empty() ? "'" : ", '") + d.links[r].name + "'";
     fail("several root links: " + names + "; a URDF is a single tree");
   }
+  return roots[0];
+}
 
-  Builder b{links, joints, options, link_index, {}, {}, {}, {}};
-  const int root = roots[0];
-  const LinkDesc& root_link = links[root];
-  const bool root_floats =
-      root_link.child_joints.size() == 1 && joints[root_link.child_joints[0]].type == "floating";
+// Segment 0 and the tree below it. A root whose only joint floats (world --floating-->
+// base) is left out: the base link is segment 0 and its pose is an input. Returns
+// whether the root was left out so.
+bool buildTree(Builder& b, const Description& d, int root) {
+  const LinkDesc& root_link = d.links[root];
+  const bool root_floats = root_link.child_joints.size() == 1 &&
+                           d.joints[root_link.child_joints[0]].type == "floating";
   if (root_floats) {
-    // world --floating--> base: the base link is segment 0 and its pose is an input.
-    const JointDesc& j = joints[root_link.child_joints[0]];
+    const JointDesc& j = d.joints[root_link.child_joints[0]];
     if (root_link.has_inertial && root_link.mass != 0.0)
       fail("link '" + root_link.name + "': the parent of floating joint '" + j.name +
            "' must be massless");
     b.model.floating_base = true;
     b.addSegment(-1, JointType::kFloating, j.child, "");
-    b.visit(link_index.at(j.child), 0, Pose());
+    b.visit(d.link_index.at(j.child), 0, Pose());
   } else {
-    b.model.floating_base = options.floating_base;
-    b.addSegment(-1, options.floating_base ? JointType::kFloating : JointType::kRoot,
+    b.model.floating_base = b.options.floating_base;
+    b.addSegment(-1, b.options.floating_base ? JointType::kFloating : JointType::kRoot,
                  root_link.name, "");
     b.visit(root, 0, Pose());
   }
-  const std::size_t reached = b.model.frames.size() + (root_floats ? 1 : 0);
-  if (reached != links.size()) {
-    std::string names;
-    for (const LinkDesc& l : links) {
-      bool seen = root_floats && l.name == root_link.name;
-      for (const Frame<double>& f : b.model.frames) seen = seen || f.name == l.name;
-      if (!seen) names += (names.empty() ? "'" : ", '") + l.name + "'";
-    }
-    fail("links " + names + " are not reachable from the root '" + root_link.name +
-         "' (a loop)");
+  return root_floats;
+}
+
+// Every link placed (the tree from the root reaches them all).
+void checkReached(const Builder& b, const Description& d, int root, bool root_left_out) {
+  const std::size_t reached = b.model.frames.size() + (root_left_out ? 1 : 0);
+  if (reached == d.links.size()) return;
+  const LinkDesc& root_link = d.links[root];
+  std::string names;
+  for (const LinkDesc& l : d.links) {
+    bool seen = root_left_out && l.name == root_link.name;
+    for (const Frame<double>& f : b.model.frames) seen = seen || f.name == l.name;
+    if (!seen) names += (names.empty() ? "'" : ", '") + l.name + "'";
   }
+  fail("links " + names + " are not reachable from the root '" + root_link.name +
+       "' (a loop)");
+}
+
+}  // namespace
+
+Model<double> modelFromUrdfString(const std::string& xml, const ModelOptions& options) {
+  const Description d = parseRobot(xml, options);
+  const int root = rootLink(d);
+  Builder b{d.links, d.joints, options, d.link_index, {}, {}, {}, {}};
+  const bool root_left_out = buildTree(b, d, root);
+  checkReached(b, d, root, root_left_out);
   b.resolveMimics();
   b.finish();
   return b.model;

@@ -13,22 +13,19 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
-#include <memory>
-
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <exception>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS]
@@ -116,22 +113,9 @@ struct Options {
   bool sto = false;
 };
 
-// Parses "A,B,C..." into `count` finite numbers (blanks around them accepted).
-bool parseNumbers(const char* s, int count, double* out) {
-  for (int i = 0; i < count; ++i) {
-    char* end = nullptr;
-    out[i] = std::strtod(s, &end);
-    while (end != s && (*end == ' ' || *end == '\t')) ++end;
-    const char expected = i + 1 < count ? ',' : '\0';
-    if (end == s || *end != expected || !std::isfinite(out[i])) return false;
-    s = end + (i + 1 < count ? 1 : 0);
-  }
-  return true;
-}
-
 Eigen::Vector3d parseGravity(const std::string& text) {
   Eigen::Vector3d g;
-  if (!parseNumbers(text.c_str(), 3, g.data()))
+  if (!parseNumberList(text, 3, g.data()))
     throw UsageError("--gravity: '" + text + "' is not GX,GY,GZ (three finite numbers, m/s^2)");
   return g;
 }
@@ -141,16 +125,6 @@ jle::WrenchFrame parseFrame(const std::string& text) {
   if (text == "parent") return jle::WrenchFrame::kParent;
   if (text == "world") return jle::WrenchFrame::kWorld;
   throw UsageError("--frame: '" + text + "' is not child, parent or world");
-}
-
-double parsePositive(const std::string& key, const std::string& text, bool zero_allowed) {
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(value) || value < 0.0 ||
-      (!zero_allowed && value == 0.0))
-    throw UsageError(key + ": '" + text + "' is not a " +
-                     (zero_allowed ? "finite number >= 0" : "finite number > 0"));
-  return value;
 }
 
 // NAME=LINK,x,y,z[,yaw_deg]: a plate frame (z up) at (x, y, z) in the world, turned by
@@ -171,19 +145,18 @@ jle::ForcePlateConfig parsePlate(const std::string& text) {
   const std::string numbers = text.substr(comma + 1);
   double v[4] = {0, 0, 0, 0};
   const int count = static_cast<int>(std::count(numbers.begin(), numbers.end(), ',')) + 1;
-  if ((count != 3 && count != 4) || !parseNumbers(numbers.c_str(), count, v))
-    throw UsageError(what);
+  if ((count != 3 && count != 4) || !parseNumberList(numbers, count, v)) throw UsageError(what);
   plate.p_world_plate = Eigen::Vector3d(v[0], v[1], v[2]);
   plate.R_world_plate =
       Eigen::AngleAxisd(v[3] * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   return plate;
 }
 
-Options parseOptions(int argc, char** argv) {
-  // --plate may be repeated: collect its values before the shared parser (each other
-  // option once).
-  std::vector<std::string> plates;
-  std::vector<char*> rest{argv[0]};
+// --plate may be repeated: its values are taken out of argv (into `plates`) before the
+// shared parser, which allows each other option once; the rest stays in `rest`.
+void takePlateOptions(int argc, char** argv, std::vector<std::string>& plates,
+                      std::vector<char*>& rest) {
+  rest.assign(1, argv[0]);
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--plate") {
@@ -195,42 +168,51 @@ Options parseOptions(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
+}
+
+// The plates of the --plate values, each with the contact threshold; a name once.
+std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& values,
+                                            double contact_threshold) {
+  std::vector<jle::ForcePlateConfig> plates;
+  for (const std::string& text : values) {
+    if (text.empty()) throw UsageError("--plate: empty value");
+    jle::ForcePlateConfig plate = parsePlate(text);
+    for (const jle::ForcePlateConfig& other : plates)
+      if (other.name == plate.name) throw UsageError("--plate: plate '" + plate.name + "' is given twice");
+    plate.contact_threshold = contact_threshold;
+    plates.push_back(plate);
+  }
+  return plates;
+}
+
+Options parseOptions(int argc, char** argv) {
+  std::vector<std::string> plates;
+  std::vector<char*> rest;
+  takePlateOptions(argc, argv, plates, rest);
   std::map<std::string, std::string> v = optionValues(
       static_cast<int>(rest.size()), rest.data(),
       {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
        "--body-mass", "--format"},
       {"--floating-base", "--per-kg"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
-  if (!v.count("--input")) throw UsageError("--input STATES.csv is required");
-  options.urdf = v["--urdf"];
-  options.input = v["--input"];
+  options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
+  options.input = requiredValue(v, "--input", "STATES.csv");
   if (v.count("--output")) options.output = v["--output"];
   if (v.count("--gravity")) options.gravity_world = parseGravity(v["--gravity"]);
   if (v.count("--frame")) options.frame = parseFrame(v["--frame"]);
   options.floating_base = v.count("--floating-base") > 0;
   if (v.count("--contact-threshold"))
     options.contact_threshold =
-        parsePositive("--contact-threshold", v["--contact-threshold"], true);
-  for (const std::string& text : plates) {
-    if (text.empty()) throw UsageError("--plate: empty value");
-    jle::ForcePlateConfig plate = parsePlate(text);
-    for (const jle::ForcePlateConfig& other : options.plates)
-      if (other.name == plate.name) throw UsageError("--plate: plate '" + plate.name + "' is given twice");
-    plate.contact_threshold = options.contact_threshold;
-    options.plates.push_back(plate);
-  }
+        parseNumber("--contact-threshold", v["--contact-threshold"], Sign::kNonNegative);
+  options.plates = platesOf(plates, options.contact_threshold);
   options.per_kg = v.count("--per-kg") > 0;
   if (v.count("--body-mass")) {
     if (!options.per_kg) throw UsageError("--body-mass is only used with --per-kg");
-    options.body_mass = parsePositive("--body-mass", v["--body-mass"], false);
+    options.body_mass = parseNumber("--body-mass", v["--body-mass"], Sign::kPositive);
   }
-  if (v.count("--format")) {
-    if (v["--format"] == "sto")
-      options.sto = true;
-    else if (v["--format"] != "csv")
-      throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
-  }
+  if (v.count("--format") && v["--format"] != "csv" && v["--format"] != "sto")
+    throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
+  options.sto = v.count("--format") && v["--format"] == "sto";
   return options;
 }
 
@@ -270,159 +252,10 @@ struct Row {
   jle::BasePoseSample pose;
 };
 
-class Processor {
- public:
-  Processor(const Options& options, const jle::Model<double>& model, const jle::StateColumns& columns,
-            std::size_t cells)
-      : options_(options),
-        model_(model),
-        columns_(columns),
-        data_(model),
-        q_(model.nq),
-        qd_(model.nq),
-        qdd_(model.nq),
-        mass_(options.body_mass > 0.0 ? options.body_mass : model.totalMass()) {
-    for (Row& r : window_) r.cells.resize(cells);
-    for (const jle::ForcePlateConfig& plate : options.plates) {
-      const int frame = model.frameIndex(plate.link);
-      plate_frames_.push_back(frame);
-    }
-    names_ = outputColumns();
-    loads_.resize(names_.size());
-  }
-
-  const std::vector<std::string>& names() const { return names_; }
-
-  // The next input row's slot (its cells are read into it by the caller).
-  Row& slot(long index) { return window_[static_cast<std::size_t>(index % 3)]; }
-
-  // Row `index` (its window: the rows index - m ... index - m + 2) to the output.
-  void emit(long index, int m, Output& out) {
-    const Row& row = slot(index);
-    const std::vector<double>& cells = row.cells;
-    for (int k = 0; k < model_.nq; ++k) {
-      q_[k] = cells[columns_.q[k]];
-      qd_[k] = cells[columns_.qd[k]];
-      qdd_[k] = cells[columns_.qdd[k]];
-    }
-    jle::BaseState<double> base;
-    if (model_.floating_base) {
-      base.R_world_base = row.pose.R_world_base;
-      base.p_world_base = row.pose.p_world_base;
-      const auto& tw = columns_.base_twist;
-      const auto& ac = columns_.base_acceleration;
-      if (columns_.hasBaseTwist()) {
-        base.v_world = Eigen::Vector3d(cells[tw[0]], cells[tw[1]], cells[tw[2]]);
-        base.omega_world = Eigen::Vector3d(cells[tw[3]], cells[tw[4]], cells[tw[5]]);
-      }
-      if (columns_.hasBaseAcceleration()) {
-        base.a_world = Eigen::Vector3d(cells[ac[0]], cells[ac[1]], cells[ac[2]]);
-        base.alpha_world = Eigen::Vector3d(cells[ac[3]], cells[ac[4]], cells[ac[5]]);
-      }
-      if (m >= 0) {
-        const long first = index - m;
-        if (!columns_.hasBaseTwist()) {
-          const jle::BasePoseSample s[3] = {slot(first).pose, slot(first + 1).pose,
-                                            slot(first + 2).pose};
-          jle::BaseState<double> estimate;
-          jle::baseMotionFromPoses(s, m, estimate, !columns_.hasBaseAcceleration());
-          base.v_world = estimate.v_world;
-          base.omega_world = estimate.omega_world;
-          if (!columns_.hasBaseAcceleration()) {
-            base.a_world = estimate.a_world;
-            base.alpha_world = estimate.alpha_world;
-          }
-        } else if (!columns_.hasBaseAcceleration()) {
-          double t[3];
-          Eigen::Vector3d v[3], w[3];
-          for (int j = 0; j < 3; ++j) {
-            const std::vector<double>& c = slot(first + j).cells;
-            t[j] = c[columns_.t];
-            v[j] = Eigen::Vector3d(c[tw[0]], c[tw[1]], c[tw[2]]);
-            w[j] = Eigen::Vector3d(c[tw[3]], c[tw[4]], c[tw[5]]);
-          }
-          jle::baseAccelerationFromTwists(t, m, v, w, base);
-        }
-      }
-    }
-    jle::forwardKinematics(model_, data_, q_, qd_, qdd_, options_.gravity_world, base);
-    for (const jle::StateColumns::WrenchColumns& w : columns_.wrenches) {
-      const auto& c = w.column;
-      jle::addExternalWrench(
-          model_, data_, w.frame, Eigen::Vector3d(cells[c[0]], cells[c[1]], cells[c[2]]),
-          Eigen::Vector3d(cells[c[3]], cells[c[4]], cells[c[5]]), jle::WrenchFrame::kLocal);
-    }
-    double* cop = cop_.data();
-    for (std::size_t p = 0; p < options_.plates.size(); ++p) {
-      const jle::ForcePlateConfig& plate = options_.plates[p];
-      const auto& c = columns_.plates[p];
-      const jle::PlateReading reading =
-          jle::readForcePlate(plate, Eigen::Vector3d(cells[c[0]], cells[c[1]], cells[c[2]]),
-                              Eigen::Vector3d(cells[c[3]], cells[c[4]], cells[c[5]]));
-      *cop++ = reading.contact ? 1.0 : 0.0;
-      if (!reading.contact) {
-        for (int i = 0; i < 3; ++i) *cop++ = 0.0;
-        continue;
-      }
-      const jle::Frame<double>& foot = model_.frames[plate_frames_[p]];
-      const Eigen::Vector3d foot_world =
-          data_.p_world[foot.segment] + data_.R_world[foot.segment] * foot.p_segment_frame;
-      Eigen::Vector3d force_world, moment_world;
-      jle::plateReactionInWorld(plate, reading, foot_world, force_world, moment_world);
-      jle::addExternalWrench(model_, data_, plate_frames_[p], force_world, moment_world,
-                             jle::WrenchFrame::kWorld);
-      const Eigen::Vector3d cop_world = plate.p_world_plate + plate.R_world_plate * reading.cop_plate;
-      for (int i = 0; i < 3; ++i) *cop++ = cop_world[i];
-    }
-    jle::inverseDynamics(model_, data_);
-
-    double* o = loads_.data();
-    *o++ = cells[columns_.t];
-    if (model_.floating_base) {
-      const jle::Wrench<double> w = jle::jointWrench(model_, data_, 0, jle::WrenchFrame::kWorld);
-      for (int i = 0; i < 3; ++i) *o++ = w.force[i];
-      for (int i = 0; i < 3; ++i) *o++ = w.moment[i];
-    }
-    for (int s : model_.moving_segments) {
-      const jle::Wrench<double> w = jle::jointWrench(model_, data_, s, options_.frame);
-      for (int i = 0; i < 3; ++i) *o++ = w.force[i];
-      for (int i = 0; i < 3; ++i) *o++ = w.moment[i];
-      *o++ = data_.effort[s];
-      if (options_.per_kg) *o++ = data_.effort[s] / mass_;
-    }
-    for (double x : cop_) *o++ = x;
-    assert(static_cast<std::size_t>(o - loads_.data()) == loads_.size());
-    out.row(loads_);
-  }
-
- private:
-  std::vector<std::string> outputColumns() {
-    std::vector<std::string> names{"t"};
-    if (model_.floating_base)
-      for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) names.push_back(std::string("base.") + c);
-    for (int s : model_.moving_segments) {
-      for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz", "effort"})
-        names.push_back(model_.joint_name[s] + "." + c);
-      if (options_.per_kg) names.push_back(model_.joint_name[s] + ".effort_per_kg");
-    }
-    for (const jle::ForcePlateConfig& plate : options_.plates)
-      for (const char* c : {"contact", "cop_x", "cop_y", "cop_z"})
-        names.push_back("plate@" + plate.name + "." + c);
-    cop_.assign(4 * options_.plates.size(), 0.0);
-    return names;
-  }
-
-  const Options& options_;
-  const jle::Model<double>& model_;
-  const jle::StateColumns& columns_;
-  jle::Data<double> data_;
-  jle::VectorX<double> q_, qd_, qdd_;
-  double mass_;
-  Row window_[3];
-  std::vector<int> plate_frames_;
-  std::vector<std::string> names_;
-  std::vector<double> loads_, cop_;
-};
+// Three cells of a row: columns c[first], c[first + 1], c[first + 2].
+Eigen::Vector3d triple(const std::vector<double>& cells, const std::array<int, 6>& c, int first) {
+  return Eigen::Vector3d(cells[c[first]], cells[c[first + 1]], cells[c[first + 2]]);
+}
 
 std::string shortest(double x) {
   char buffer[32];
@@ -445,10 +278,197 @@ void readBasePose(const jle::CsvReader& reader, const jle::StateColumns& columns
   row.pose.R_world_base = q.toRotationMatrix();
 }
 
-void run(const Options& options) {
+// The loads of each input row. A floating base whose twist or acceleration the CSV does
+// not hold has them estimated from a window of three rows: a row is emitted once the
+// next one is read (the first two with the third, the last at the end).
+class Processor {
+ public:
+  Processor(const Options& options, const jle::Model<double>& model, const jle::StateColumns& columns,
+            std::size_t cells)
+      : options_(options),
+        model_(model),
+        columns_(columns),
+        data_(model),
+        q_(model.nq),
+        qd_(model.nq),
+        qdd_(model.nq),
+        mass_(options.body_mass > 0.0 ? options.body_mass : model.totalMass()),
+        estimate_(model.floating_base &&
+                  !(columns.hasBaseTwist() && columns.hasBaseAcceleration())),
+        cop_(4 * options.plates.size(), 0.0) {
+    for (Row& r : window_) r.cells.resize(cells);
+    jle::LoadColumnLayout layout;
+    layout.base = model.floating_base;
+    layout.per_kg = options.per_kg;
+    for (const jle::ForcePlateConfig& plate : options.plates) {
+      plate_frames_.push_back(model.frameIndex(plate.link));
+      layout.plates.push_back(plate.name);
+    }
+    names_ = jle::jointLoadColumns(model, layout);
+    loads_.resize(names_.size());
+  }
+
+  const std::vector<std::string>& names() const { return names_; }
+
+  // Reads the current record of `reader` as row n.
+  void read(const jle::CsvReader& reader, long n) {
+    Row& row = slot(n);
+    reader.numbers(row.cells.data());
+    row.line = reader.line();
+    if (model_.floating_base) readBasePose(reader, columns_, row);
+    if (estimate_ && n > 0 && !(row.cells[columns_.t] > slot(n - 1).cells[columns_.t]))
+      reader.failAt(columns_.t, "time does not increase (the previous row's is " +
+                                    shortest(slot(n - 1).cells[columns_.t]) +
+                                    "): the base motion is estimated from the times");
+  }
+
+  // Emits what row n, just read, completes.
+  void emitReady(long n, Output& out) {
+    if (!estimate_) {
+      emit(n, -1, out);
+    } else if (n == 2) {
+      emit(0, 0, out);
+      emit(1, 1, out);
+    } else if (n > 2) {
+      emit(n - 1, 1, out);
+    }
+  }
+
+  // Emits the last row, after `n` rows in all.
+  void finish(long n, Output& out) {
+    if (!estimate_) return;
+    if (n > 0 && n < 3)
+      throw std::runtime_error(options_.input + ": " + std::to_string(n) +
+                               " rows; estimating the base twist and acceleration from the "
+                               "pose needs at least 3 (or give base.vx ... base.alz)");
+    if (n >= 3) emit(n - 1, 2, out);
+  }
+
+ private:
+  Row& slot(long index) { return window_[static_cast<std::size_t>(index % 3)]; }
+
+  // Row `index` (its window: the rows index - m ... index - m + 2; m < 0: none) to the
+  // output.
+  void emit(long index, int m, Output& out) {
+    const std::vector<double>& cells = slot(index).cells;
+    for (int k = 0; k < model_.nq; ++k) {
+      q_[k] = cells[columns_.q[k]];
+      qd_[k] = cells[columns_.qd[k]];
+      qdd_[k] = cells[columns_.qdd[k]];
+    }
+    const jle::BaseState<double> base =
+        model_.floating_base ? baseState(index, m) : jle::BaseState<double>();
+    jle::forwardKinematics(model_, data_, q_, qd_, qdd_, options_.gravity_world, base);
+    for (const jle::StateColumns::WrenchColumns& w : columns_.wrenches)
+      jle::addExternalWrench(model_, data_, w.frame, triple(cells, w.column, 0),
+                             triple(cells, w.column, 3), jle::WrenchFrame::kLocal);
+    applyPlates(cells);
+    jle::inverseDynamics(model_, data_);
+    writeLoads(cells, out);
+  }
+
+  // The root's motion at row `index`: its pose, and its twist and acceleration from the
+  // row or estimated from the window (m >= 0).
+  jle::BaseState<double> baseState(long index, int m) {
+    const Row& row = slot(index);
+    jle::BaseState<double> base;
+    base.R_world_base = row.pose.R_world_base;
+    base.p_world_base = row.pose.p_world_base;
+    if (columns_.hasBaseTwist()) {
+      base.v_world = triple(row.cells, columns_.base_twist, 0);
+      base.omega_world = triple(row.cells, columns_.base_twist, 3);
+    }
+    if (columns_.hasBaseAcceleration()) {
+      base.a_world = triple(row.cells, columns_.base_acceleration, 0);
+      base.alpha_world = triple(row.cells, columns_.base_acceleration, 3);
+    }
+    if (m >= 0) estimateBaseMotion(index - m, m, base);
+    return base;
+  }
+
+  // What the row does not hold of the root's motion, from the rows first .. first + 2
+  // (the row itself is first + m).
+  void estimateBaseMotion(long first, int m, jle::BaseState<double>& base) {
+    if (!columns_.hasBaseTwist()) {
+      const jle::BasePoseSample s[3] = {slot(first).pose, slot(first + 1).pose,
+                                        slot(first + 2).pose};
+      jle::BaseState<double> estimate;
+      jle::baseMotionFromPoses(s, m, estimate, !columns_.hasBaseAcceleration());
+      base.v_world = estimate.v_world;
+      base.omega_world = estimate.omega_world;
+      if (!columns_.hasBaseAcceleration()) {
+        base.a_world = estimate.a_world;
+        base.alpha_world = estimate.alpha_world;
+      }
+    } else if (!columns_.hasBaseAcceleration()) {
+      double t[3];
+      Eigen::Vector3d v[3], w[3];
+      for (int j = 0; j < 3; ++j) {
+        const std::vector<double>& c = slot(first + j).cells;
+        t[j] = c[columns_.t];
+        v[j] = triple(c, columns_.base_twist, 0);
+        w[j] = triple(c, columns_.base_twist, 3);
+      }
+      jle::baseAccelerationFromTwists(t, m, v, w, base);
+    }
+  }
+
+  // Each plate's reaction on its foot (force_plate.hpp, as the estimator applies it), and
+  // its contact and centre of pressure in the world for the output.
+  void applyPlates(const std::vector<double>& cells) {
+    double* cop = cop_.data();
+    for (std::size_t p = 0; p < options_.plates.size(); ++p) {
+      const jle::ForcePlateConfig& plate = options_.plates[p];
+      const std::array<int, 6>& c = columns_.plates[p];
+      const jle::PlateReading reading =
+          jle::readForcePlate(plate, triple(cells, c, 0), triple(cells, c, 3));
+      jle::applyPlateReaction(model_, data_, plate_frames_[p], plate, reading);
+      const Eigen::Vector3d cop_world =
+          reading.contact ? jle::copInWorld(plate, reading) : Eigen::Vector3d::Zero();
+      *cop++ = reading.contact ? 1.0 : 0.0;
+      for (int i = 0; i < 3; ++i) *cop++ = cop_world[i];
+    }
+  }
+
+  // One output row, in the order of names().
+  void writeLoads(const std::vector<double>& cells, Output& out) {
+    const auto put = [](const jle::Wrench<double>& w, double* o) {
+      for (int i = 0; i < 3; ++i) *o++ = w.force[i];
+      for (int i = 0; i < 3; ++i) *o++ = w.moment[i];
+      return o;
+    };
+    double* o = loads_.data();
+    *o++ = cells[columns_.t];
+    if (model_.floating_base)
+      o = put(jle::jointWrench(model_, data_, 0, jle::WrenchFrame::kWorld), o);
+    for (int s : model_.moving_segments) {
+      o = put(jle::jointWrench(model_, data_, s, options_.frame), o);
+      *o++ = data_.effort[s];
+      if (options_.per_kg) *o++ = data_.effort[s] / mass_;
+    }
+    for (double x : cop_) *o++ = x;
+    assert(static_cast<std::size_t>(o - loads_.data()) == loads_.size());
+    out.row(loads_);
+  }
+
+  const Options& options_;
+  const jle::Model<double>& model_;
+  const jle::StateColumns& columns_;
+  jle::Data<double> data_;
+  jle::VectorX<double> q_, qd_, qdd_;
+  double mass_;
+  bool estimate_;  // the base twist or acceleration estimated from the neighbouring rows
+  Row window_[3];
+  std::vector<int> plate_frames_;
+  std::vector<std::string> names_;
+  std::vector<double> loads_, cop_;
+};
+
+// The robot, with every --plate's link checked.
+jle::Model<double> loadModel(const Options& options) {
   jle::ModelOptions model_options;
   model_options.floating_base = options.floating_base;
-  const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
+  jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
   for (const jle::ForcePlateConfig& plate : options.plates) {
     bool known = false;
     for (const jle::Frame<double>& f : model.frames) known = known || f.name == plate.link;
@@ -456,47 +476,26 @@ void run(const Options& options) {
       throw UsageError("--plate " + plate.name + ": unknown link '" + plate.link + "' (not in " +
                        options.urdf + ")");
   }
+  return model;
+}
+
+void run(const Options& options) {
+  const jle::Model<double> model = loadModel(options);
   jle::CsvReader reader(options.input);
   jle::ExtraStateInputs extra;
   extra.floating_base = model.floating_base;
   for (const jle::ForcePlateConfig& plate : options.plates) extra.plates.push_back(plate.name);
   const jle::StateColumns columns = jle::bindStateColumns(model, reader, extra);
-  // The base twist or acceleration estimated from the neighbouring rows.
-  const bool estimate =
-      model.floating_base && !(columns.hasBaseTwist() && columns.hasBaseAcceleration());
 
   // Everything the loop touches is allocated here, once.
   Processor processor(options, model, columns, static_cast<std::size_t>(reader.columns()));
   Output out(options, model, processor.names());
   long n = 0;
-  while (reader.next()) {
-    Row& row = processor.slot(n);
-    reader.numbers(row.cells.data());
-    row.line = reader.line();
-    if (model.floating_base) readBasePose(reader, columns, row);
-    if (estimate && n > 0 && !(row.cells[columns.t] > processor.slot(n - 1).cells[columns.t]))
-      reader.failAt(columns.t, "time does not increase (the previous row's is " +
-                                   shortest(processor.slot(n - 1).cells[columns.t]) +
-                                   "): the base motion is estimated from the times");
-    if (!estimate) {
-      processor.emit(n, -1, out);
-    } else if (n == 2) {
-      processor.emit(0, 0, out);
-      processor.emit(1, 1, out);
-    } else if (n > 2) {
-      processor.emit(n - 1, 1, out);
-    }
-    ++n;
+  for (; reader.next(); ++n) {
+    processor.read(reader, n);
+    processor.emitReady(n, out);
   }
-  if (estimate) {
-    if (n > 0 && n < 3)
-      throw std::runtime_error(options.input + ": " + std::to_string(n) +
-                               " rows; estimating the base twist and acceleration from the "
-                               "pose needs at least 3 (or give base.vx ... base.alz)");
-    if (n >= 3) {
-      processor.emit(n - 1, 2, out);
-    }
-  }
+  processor.finish(n, out);
   out.commit();
 }
 

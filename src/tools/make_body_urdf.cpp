@@ -23,8 +23,7 @@
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: make_body_urdf --mass KG --height M [--subtalar] [--name NAME] [--output FILE]
@@ -160,36 +159,23 @@ struct Options {
   std::string command;  // how the file was made, for its header comment
 };
 
-double parseNumber(const std::string& key, const std::string& text, double lo, double hi) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
-    throw UsageError(key + ": '" + text + "' is not a finite number");
-  if (v < lo || v > hi) {
-    char range[64];
-    std::snprintf(range, sizeof range, "%.4g .. %.4g", lo, hi);
-    throw UsageError(key + ": " + text + " is outside " + range);
-  }
-  return v;
-}
-
 Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = optionValues(
       argc, argv,
       {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
        "--foot-height", "--pelvis-width", "--hat-length", "--name", "--output"},
       {"--subtalar"});
-  if (!v.count("--mass")) throw UsageError("--mass KG is required");
-  if (!v.count("--height")) throw UsageError("--height M is required");
+  const std::string mass = requiredValue(v, "--mass", "KG");
+  const std::string height = requiredValue(v, "--height", "M");
   Options o;
-  o.mass = parseNumber("--mass", v["--mass"], 1.0, 500.0);
-  o.height = parseNumber("--height", v["--height"], 0.5, 2.7);
+  o.mass = parseNumberIn("--mass", mass, 1.0, 500.0);
+  o.height = parseNumberIn("--height", height, 0.5, 2.7);
   o.subtalar = v.count("--subtalar") > 0;
   const double h = o.height;
   const auto length = [&](const char* key, double fraction) {
     // A measured length may differ from the table's by a factor of 2 either way.
     const double table = fraction * h;
-    return v.count(key) ? parseNumber(key, v[key], 0.5 * table, 2.0 * table) : table;
+    return v.count(key) ? parseNumberIn(key, v[key], 0.5 * table, 2.0 * table) : table;
   };
   o.thigh_length = length("--thigh-length", kThighLength);
   o.shank_length = length("--shank-length", kShankLength);

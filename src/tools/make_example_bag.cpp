@@ -1,11 +1,13 @@
 // make_example_bag: a deterministic example bag of an arm with a wrist force/torque
 // sensor, for the demo and for process_bag's tests and benchmarks. The formulas are in
 // kUsage and docs/demo.md.
-#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include "bag_writing.hpp"
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <rosbag/bag.h>
@@ -13,22 +15,19 @@
 
 #include <Eigen/Core>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <map>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: make_example_bag --urdf ROBOT.urdf --output OUT.bag [--duration 10] [--rate 1000]
@@ -98,25 +97,6 @@ struct Options {
   bool effort = false;
 };
 
-
-double parseNumber(const std::string& key, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
-    throw UsageError(key + ": '" + text + "' is not a finite number");
-  return v;
-}
-
-unsigned long long parseInteger(const std::string& key, const std::string& text,
-                                unsigned long long max) {
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-  if (text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || v > max)
-    throw UsageError(key + ": '" + text + "' is not an integer in 0 .. " + std::to_string(max));
-  return v;
-}
-
 Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v =
       optionValues(argc, argv,
@@ -124,10 +104,8 @@ Options parseOptions(int argc, char** argv) {
                     "--sensor-frame", "--tcp-frame"},
                    {"--effort"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
-  if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
-  options.urdf = v["--urdf"];
-  options.output = v["--output"];
+  options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
+  options.output = requiredValue(v, "--output", "OUT.bag");
   options.effort = v.count("--effort") > 0;
   if (v.count("--sensor-frame")) options.sensor_frame = v["--sensor-frame"];
   if (v.count("--tcp-frame")) options.tcp_frame = v["--tcp-frame"];
@@ -137,18 +115,16 @@ Options parseOptions(int argc, char** argv) {
   if (!(options.rate > 0.0)) throw UsageError("--rate: must be > 0");
   if (v.count("--samples")) {
     if (v.count("--duration")) throw UsageError("--samples and --duration exclude each other");
-    options.samples = static_cast<long long>(parseInteger("--samples", v["--samples"], 1000000000));
-    if (options.samples < 1) throw UsageError("--samples: must be >= 1");
+    options.samples =
+        static_cast<long long>(parseInteger("--samples", v["--samples"], 1, 1000000000));
   } else {
     if (options.duration * options.rate > 1e9) throw UsageError("--duration * --rate: over 1e9");
     options.samples = std::max(1LL, std::llround(options.duration * options.rate));
   }
   if (v.count("--seed"))
-    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 4294967295ULL));
+    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;
 }
-
-using jle::Uniform;
 
 double homePosition(const std::string& joint) {
   static const std::map<std::string, double> kReady = {
@@ -166,116 +142,153 @@ int frameOf(const jle::Model<double>& model, const std::string& option, const st
   throw UsageError(option + ": no link '" + link + "' in " + urdf);
 }
 
+// The sensor's and the TCP's frames (indices into model.frames), checked: the payload is
+// rigid to the sensor.
+struct SensorFrames {
+  int sensor = -1, tcp = -1;
+};
+
+SensorFrames sensorFrames(const jle::Model<double>& model, const Options& options) {
+  SensorFrames frames;
+  frames.sensor = frameOf(model, "--sensor-frame", options.sensor_frame, options.urdf);
+  frames.tcp = frameOf(model, "--tcp-frame", options.tcp_frame, options.urdf);
+  if (model.frames[static_cast<std::size_t>(frames.sensor)].segment !=
+      model.frames[static_cast<std::size_t>(frames.tcp)].segment)
+    throw UsageError("--tcp-frame: '" + options.tcp_frame + "' moves relative to '" +
+                     options.sensor_frame + "'; the payload must be rigid to the sensor");
+  return frames;
+}
+
+// The trajectory, the payload and the push, drawn in the documented order (kUsage).
+struct Scenario {
+  std::vector<double> home, amplitude, omega, phase;  // per coordinate
+  double payload_mass = 0.0, push = 0.0, push_omega = 0.0, push_phase = 0.0;
+  Eigen::Vector3d push_direction = Eigen::Vector3d::Zero();
+};
+
+Scenario randomScenario(const jle::Model<double>& model, std::uint32_t seed) {
+  jle::PortableRandom random(seed);
+  const std::size_t nq = static_cast<std::size_t>(model.nq);
+  Scenario out;
+  out.home.resize(nq);
+  out.amplitude.resize(nq);
+  out.omega.resize(nq);
+  out.phase.resize(nq);
+  for (std::size_t k = 0; k < nq; ++k) {
+    const std::string& name = model.coordinate_names[k];
+    const int s = model.segmentOfJoint(name);
+    const bool prismatic =
+        model.joint_type[static_cast<std::size_t>(s)] == jle::JointType::kPrismatic;
+    out.home[k] = homePosition(name);
+    out.amplitude[k] = prismatic ? random.uniform(0.005, 0.015) : random.uniform(0.15, 0.45);
+    out.omega[k] = kTwoPi * random.uniform(0.1, 0.4);
+    out.phase[k] = random.uniform(0.0, kTwoPi);
+  }
+  out.payload_mass = random.uniform(0.5, 2.0);
+  out.push = random.uniform(5.0, 15.0);
+  out.push_omega = kTwoPi * random.uniform(0.2, 0.6);
+  out.push_phase = random.uniform(0.0, kTwoPi);
+  const double push_bearing = random.uniform(0.0, kTwoPi);
+  out.push_direction = Eigen::Vector3d(std::cos(push_bearing), std::sin(push_bearing), 0.0);
+  return out;
+}
+
+// Positions, velocities and accelerations of the coordinates at t [s].
+void coordinatesAt(const Scenario& scenario, double t, jle::VectorX<double>& q,
+                   jle::VectorX<double>& qd, jle::VectorX<double>& qdd) {
+  for (std::size_t k = 0; k < scenario.home.size(); ++k) {
+    const double angle = scenario.omega[k] * t + scenario.phase[k];
+    const double sin = std::sin(angle), cos = std::cos(angle);
+    const double a = scenario.amplitude[k], w = scenario.omega[k];
+    q[static_cast<int>(k)] = scenario.home[k] + a * sin;
+    qd[static_cast<int>(k)] = a * w * cos;
+    qdd[static_cast<int>(k)] = -a * w * w * sin;
+  }
+}
+
+// What the payload and the push apply to the robot at t, at the sensor (its frame,
+// moment about its origin), after forwardKinematics.
+void sensorWrench(const jle::Model<double>& model, const jle::Data<double>& data,
+                  const SensorFrames& frames, const Scenario& scenario, double t,
+                  Eigen::Vector3d& f_sensor, Eigen::Vector3d& m_sensor) {
+  const jle::Frame<double>& sensor = model.frames[static_cast<std::size_t>(frames.sensor)];
+  const std::size_t s = static_cast<std::size_t>(sensor.segment);
+  // TCP in the segment frame; the sensor's pose in the segment frame.
+  const Eigen::Vector3d& r_tcp = model.frames[static_cast<std::size_t>(frames.tcp)].p_segment_frame;
+  const Eigen::Matrix3d& R_segment_sensor = sensor.R_segment_frame;
+  const Eigen::Vector3d& p_segment_sensor = sensor.p_segment_frame;
+  // The payload's acceleration minus gravity at the TCP, segment frame (data.acc is the
+  // origin's, gravity included as an upward acceleration of the base).
+  const Eigen::Vector3d& w = data.omega[s];
+  const Eigen::Vector3d a_minus_g =
+      data.acc[s] + data.alpha[s].cross(r_tcp) + w.cross(w.cross(r_tcp));
+  const Eigen::Vector3d f_segment =
+      -scenario.payload_mass * a_minus_g +
+      data.R_world[s].transpose() *
+          (scenario.push * std::sin(scenario.push_omega * t + scenario.push_phase) *
+           scenario.push_direction);
+  f_sensor = R_segment_sensor.transpose() * f_segment;
+  m_sensor = R_segment_sensor.transpose() * (r_tcp - p_segment_sensor).cross(f_segment);
+}
+
+// The joint-state message of every moving joint, sized once.
+sensor_msgs::JointState jointStateMessage(const jle::Model<double>& model, bool effort) {
+  sensor_msgs::JointState joints;
+  for (int s : model.moving_segments)
+    joints.name.push_back(model.joint_name[static_cast<std::size_t>(s)]);
+  joints.position.resize(joints.name.size());
+  if (effort) joints.effort.resize(joints.name.size());
+  return joints;
+}
+
+void fillJointState(const jle::Model<double>& model, const jle::Data<double>& data,
+                    long long i, const ros::Time& stamp, sensor_msgs::JointState& joints) {
+  joints.header.stamp = stamp;
+  joints.header.seq = static_cast<std::uint32_t>(i);
+  for (std::size_t j = 0; j < model.moving_segments.size(); ++j) {
+    const std::size_t seg = static_cast<std::size_t>(model.moving_segments[j]);
+    joints.position[j] = data.q[seg];
+    if (!joints.effort.empty()) joints.effort[j] = data.effort[seg];
+  }
+}
+
 void run(const Options& options) {
   const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf);
   if (model.floating_base)
     throw std::runtime_error(options.urdf +
                              ": a floating-base model; make_example_bag moves "
                              "fixed-base arms only");
-  const int sensor = frameOf(model, "--sensor-frame", options.sensor_frame, options.urdf);
-  const int tcp = frameOf(model, "--tcp-frame", options.tcp_frame, options.urdf);
-  const jle::Frame<double>& sensor_frame = model.frames[static_cast<std::size_t>(sensor)];
-  const jle::Frame<double>& tcp_frame = model.frames[static_cast<std::size_t>(tcp)];
-  if (sensor_frame.segment != tcp_frame.segment)
-    throw UsageError("--tcp-frame: '" + options.tcp_frame + "' moves relative to '" +
-                     options.sensor_frame + "'; the payload must be rigid to the sensor");
-
-  Uniform uniform(options.seed);
-  const std::size_t nq = static_cast<std::size_t>(model.nq);
-  std::vector<double> home(nq), amplitude(nq), omega(nq), phase(nq);
-  for (std::size_t k = 0; k < nq; ++k) {
-    const std::string& name = model.coordinate_names[k];
-    const int s = model.segmentOfJoint(name);
-    const bool prismatic =
-        model.joint_type[static_cast<std::size_t>(s)] == jle::JointType::kPrismatic;
-    home[k] = homePosition(name);
-    amplitude[k] = prismatic ? uniform(0.005, 0.015) : uniform(0.15, 0.45);
-    omega[k] = kTwoPi * uniform(0.1, 0.4);
-    phase[k] = uniform(0.0, kTwoPi);
-  }
-  const double payload_mass = uniform(0.5, 2.0);
-  const double push = uniform(5.0, 15.0);
-  const double push_omega = kTwoPi * uniform(0.2, 0.6);
-  const double push_phase = uniform(0.0, kTwoPi);
-  const double push_bearing = uniform(0.0, kTwoPi);
-  const Eigen::Vector3d push_direction(std::cos(push_bearing), std::sin(push_bearing), 0.0);
+  const SensorFrames frames = sensorFrames(model, options);
+  const Scenario scenario = randomScenario(model, options.seed);
   const Eigen::Vector3d gravity_world(0.0, 0.0, -9.80665);
 
   // Everything the loop touches is allocated here, once.
   jle::Data<double> data(model);
   jle::VectorX<double> q(model.nq), qd(model.nq), qdd(model.nq);
-  sensor_msgs::JointState joints;
-  for (int s : model.moving_segments)
-    joints.name.push_back(model.joint_name[static_cast<std::size_t>(s)]);
-  joints.position.resize(joints.name.size());
-  if (options.effort) joints.effort.resize(joints.name.size());
+  sensor_msgs::JointState joints = jointStateMessage(model, options.effort);
   geometry_msgs::WrenchStamped wrench;
   wrench.header.frame_id = options.sensor_frame;
-
-  const std::string temporary = options.output + ".partial";
-  try {
-    rosbag::Bag bag(temporary, rosbag::bagmode::Write);
-    const std::size_t s = static_cast<std::size_t>(sensor_frame.segment);
-    // TCP in the segment frame; the sensor's pose in the segment frame.
-    const Eigen::Vector3d r_tcp = tcp_frame.p_segment_frame;
-    const Eigen::Matrix3d& R_segment_sensor = sensor_frame.R_segment_frame;
-    const Eigen::Vector3d& p_segment_sensor = sensor_frame.p_segment_frame;
-    for (long long i = 0; i < options.samples; ++i) {
-      const std::int64_t ns = kEpochNs + std::llround(static_cast<double>(i) * 1e9 / options.rate);
-      const ros::Time stamp(static_cast<std::uint32_t>(ns / 1000000000),
-                            static_cast<std::uint32_t>(ns % 1000000000));
-      const double t = static_cast<double>(ns - kEpochNs) * 1e-9;
-      for (std::size_t k = 0; k < nq; ++k) {
-        const double angle = omega[k] * t + phase[k];
-        const double sin = std::sin(angle), cos = std::cos(angle);
-        q[static_cast<int>(k)] = home[k] + amplitude[k] * sin;
-        qd[static_cast<int>(k)] = amplitude[k] * omega[k] * cos;
-        qdd[static_cast<int>(k)] = -amplitude[k] * omega[k] * omega[k] * sin;
-      }
-      jle::forwardKinematics(model, data, q, qd, qdd, gravity_world);
-
-      // The payload's acceleration minus gravity at the TCP, segment frame (data.acc
-      // is the origin's, gravity included as an upward acceleration of the base).
-      const Eigen::Vector3d& w = data.omega[s];
-      const Eigen::Vector3d a_minus_g =
-          data.acc[s] + data.alpha[s].cross(r_tcp) + w.cross(w.cross(r_tcp));
-      const Eigen::Vector3d f_segment =
-          -payload_mass * a_minus_g +
-          data.R_world[s].transpose() *
-              (push * std::sin(push_omega * t + push_phase) * push_direction);
-      const Eigen::Vector3d f_sensor = R_segment_sensor.transpose() * f_segment;
-      const Eigen::Vector3d m_sensor =
-          R_segment_sensor.transpose() * (r_tcp - p_segment_sensor).cross(f_segment);
-
-      wrench.header.stamp = stamp;
-      wrench.wrench.force.x = f_sensor.x();
-      wrench.wrench.force.y = f_sensor.y();
-      wrench.wrench.force.z = f_sensor.z();
-      wrench.wrench.torque.x = m_sensor.x();
-      wrench.wrench.torque.y = m_sensor.y();
-      wrench.wrench.torque.z = m_sensor.z();
-      bag.write("/ft_sensor/wrench", stamp - ros::Duration(0, 1000), wrench);
-
-      if (options.effort) {
-        jle::addExternalWrench(model, data, sensor, f_sensor, m_sensor, jle::WrenchFrame::kLocal);
-        jle::inverseDynamics(model, data);
-      }
-      joints.header.stamp = stamp;
-      joints.header.seq = static_cast<std::uint32_t>(i);
-      for (std::size_t j = 0; j < model.moving_segments.size(); ++j) {
-        const std::size_t seg = static_cast<std::size_t>(model.moving_segments[j]);
-        joints.position[j] = data.q[seg];
-        if (options.effort) joints.effort[j] = data.effort[seg];
-      }
-      bag.write("/joint_states", stamp, joints);
+  jle_tools::PartialBag out(options.output);
+  for (long long i = 0; i < options.samples; ++i) {
+    const std::int64_t ns = kEpochNs + std::llround(static_cast<double>(i) * 1e9 / options.rate);
+    const ros::Time stamp = jle_tools::stampOf(ns);
+    const double t = static_cast<double>(ns - kEpochNs) * 1e-9;
+    coordinatesAt(scenario, t, q, qd, qdd);
+    jle::forwardKinematics(model, data, q, qd, qdd, gravity_world);
+    Eigen::Vector3d f_sensor, m_sensor;
+    sensorWrench(model, data, frames, scenario, t, f_sensor, m_sensor);
+    wrench.header.stamp = stamp;
+    jle_tools::setWrench(wrench, f_sensor, m_sensor);
+    out.bag().write("/ft_sensor/wrench", stamp - ros::Duration(0, 1000), wrench);
+    if (options.effort) {
+      jle::addExternalWrench(model, data, frames.sensor, f_sensor, m_sensor,
+                             jle::WrenchFrame::kLocal);
+      jle::inverseDynamics(model, data);
     }
-    bag.close();
-    if (std::rename(temporary.c_str(), options.output.c_str()) != 0)
-      throw std::runtime_error(options.output + ": cannot rename " + temporary + " onto it");
-  } catch (...) {
-    std::remove(temporary.c_str());
-    throw;
+    fillJointState(model, data, i, stamp, joints);
+    out.bag().write("/joint_states", stamp, joints);
   }
+  out.commit();
 }
 
 }  // namespace

@@ -4,10 +4,13 @@
 // floating-base residual of the estimate is filter error only. The formulas are in
 // kUsage and docs/gait_demo.md.
 #include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include "bag_writing.hpp"
 
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/WrenchStamped.h>
@@ -21,19 +24,19 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace {
 
-using jle::cli::UsageError;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
@@ -89,7 +92,8 @@ strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
           to the leading foot, each foot's centre of pressure the nominal point (toe of
           the trailing foot, heel of the leading) shifted by the same vector, so that
           the two sum to the whole wrench; free moment split like the force
-  noise   with --noise SIGMA: Gaussian noise (Box-Muller on jle::Uniform(seed)) of SIGMA
+  noise   with --noise SIGMA: Gaussian noise (Box-Muller on jle::PortableRandom(seed), the
+          cosine of each pair) of SIGMA
           N on each force component, 0.01 SIGMA N m on each moment component
 
   --urdf PATH    the body (root link pelvis, the joints and links above, heel_s and
@@ -148,43 +152,18 @@ struct Options {
   std::uint32_t seed = 1;
 };
 
-double parseNumber(const std::string& key, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
-    throw UsageError(key + ": '" + text + "' is not a finite number");
-  return v;
-}
-
-unsigned long long parseInteger(const std::string& key, const std::string& text,
-                                unsigned long long max) {
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-  if (text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || v > max)
-    throw UsageError(key + ": '" + text + "' is not an integer in 0 .. " + std::to_string(max));
-  return v;
-}
-
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v = jle::cli::optionValues(
+  std::map<std::string, std::string> v = optionValues(
       argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf BODY.urdf is required");
-  if (!v.count("--output")) throw UsageError("--output OUT.bag is required");
-  options.urdf = v["--urdf"];
-  options.output = v["--output"];
+  options.urdf = requiredValue(v, "--urdf", "BODY.urdf");
+  options.output = requiredValue(v, "--output", "OUT.bag");
   if (v.count("--csv")) options.csv = v["--csv"];
-  if (v.count("--strides")) {
-    options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 100));
-    if (options.strides < 1) throw UsageError("--strides: must be >= 1");
-  }
-  if (v.count("--noise")) {
-    options.noise = parseNumber("--noise", v["--noise"]);
-    if (options.noise < 0.0) throw UsageError("--noise: must be >= 0");
-  }
+  if (v.count("--strides"))
+    options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 1, 100));
+  if (v.count("--noise")) options.noise = parseNumber("--noise", v["--noise"], Sign::kNonNegative);
   if (v.count("--seed"))
-    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 4294967295ULL));
+    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;
 }
 
@@ -389,11 +368,6 @@ int frameIndex(const jle::Model<double>& model, const std::string& name, const s
                            "' (make_gait_bag needs the body model of docs/gait_demo.md)");
 }
 
-ros::Time stampOf(std::int64_t ns) {
-  return ros::Time(static_cast<std::uint32_t>(ns / 1000000000),
-                   static_cast<std::uint32_t>(ns % 1000000000));
-}
-
 geometry_msgs::TransformStamped transform(const std::string& child, const ros::Time& stamp,
                                           const Vector3d& p, const Matrix3d& R) {
   geometry_msgs::TransformStamped t;
@@ -409,15 +383,6 @@ geometry_msgs::TransformStamped transform(const std::string& child, const ros::T
   t.transform.rotation.z = o.z();
   t.transform.rotation.w = o.w();
   return t;
-}
-
-void setWrench(geometry_msgs::WrenchStamped& msg, const Vector3d& f, const Vector3d& m) {
-  msg.wrench.force.x = f.x();
-  msg.wrench.force.y = f.y();
-  msg.wrench.force.z = f.z();
-  msg.wrench.torque.x = m.x();
-  msg.wrench.torque.y = m.y();
-  msg.wrench.torque.z = m.z();
 }
 
 // One foot's share of the ground reaction: force [N] at the centre of pressure [m] on
@@ -452,6 +417,66 @@ Eigen::Vector2d plannedCop(const std::array<FootState, 2>& feet) {
   return p.head<2>();
 }
 
+// Velocities and accelerations at point c of a grid of positions (spacing h [s]) by
+// 5-point central differences.
+void fivePoint(const std::vector<jle::VectorX<double>>& grid, std::size_t c, double h,
+               jle::VectorX<double>& qd, jle::VectorX<double>& qdd) {
+  for (int j = 0; j < qd.size(); ++j) {
+    const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j],
+                 p2 = grid[c + 2][j], z = grid[c][j];
+    qd[j] = (m2 - 8.0 * m1 + 8.0 * p1 - p2) / (12.0 * h);
+    qdd[j] = (-m2 + 16.0 * m1 - 30.0 * z + 16.0 * p1 - p2) / (12.0 * h * h);
+  }
+}
+
+// What the world must apply to the pelvis for the motion (the model's floating-base
+// inverse dynamics): force F [N] and moment M [N m] in world axes, about the world origin.
+void pelvisWrench(const jle::Model<double>& model, jle::Data<double>& data,
+                  const jle::VectorX<double>& q, const jle::VectorX<double>& qd,
+                  const jle::VectorX<double>& qdd, const jle::BaseState<double>& base,
+                  Vector3d& F, Vector3d& M) {
+  jle::forwardKinematics(model, data, q, qd, qdd, Vector3d(0.0, 0.0, -kGravity), base);
+  jle::inverseDynamics(model, data);
+  F = base.R_world_base * data.force[0];
+  M = base.R_world_base * data.moment[0] + base.p_world_base.cross(F);
+}
+
+// One step of solvePelvis: the harmonics of the error (on the stride's grid from gait
+// time g0, step h) corrected by the inverted pendulum's response.
+void correctPelvis(const std::vector<Eigen::Vector2d>& error, double g0, double h, double z_com,
+                   Pelvis& pelvis) {
+  const double w = 2.0 * kPi / kStride;
+  const int n = static_cast<int>(error.size());
+  for (int m = 0; m <= kHarmonics; ++m) {
+    Eigen::Vector2d A = Eigen::Vector2d::Zero(), B = Eigen::Vector2d::Zero();
+    for (int k = 0; k < n; ++k) {
+      const double g = g0 + k * h;
+      A += error[static_cast<std::size_t>(k)] * std::cos(m * w * g);
+      B += error[static_cast<std::size_t>(k)] * std::sin(m * w * g);
+    }
+    const double response = 1.0 + z_com / kGravity * (m * w) * (m * w);
+    pelvis.correction.a[m] += kRelaxation * (m == 0 ? 1.0 : 2.0) / n * A / response;
+    pelvis.correction.b[m] += kRelaxation * (m == 0 ? 0.0 : 2.0) / n * B / response;
+  }
+}
+
+// Puts the feet of both legs where the gait has them at every point of a grid (gait
+// times g0 + k h, k = first .. first + grid.size() - 1); each point starts from its own
+// q, or with warm from the previous point's solution.
+void solveGridLegs(const jle::Model<double>& model, jle::Data<double>& data,
+                   const std::array<Leg, 2>& legs, const Gait& gait, const Pelvis& pelvis,
+                   double g0, double h, int first, bool warm,
+                   std::vector<jle::VectorX<double>>& grid) {
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const double g = g0 + (first + static_cast<int>(i)) * h;
+    if (warm && i > 0) grid[i] = grid[i - 1];
+    for (const Leg& leg : legs) {
+      const FootState foot = gait.at(leg, g);
+      solveLeg(model, data, leg, pelvis.at(g), foot.heel, foot.toe, grid[i]);
+    }
+  }
+}
+
 // Solves the pelvis path's horizontal correction so that the whole-body centre of
 // pressure (from the model's floating-base inverse dynamics, as the plates get it)
 // follows plannedCop over a stride. The trial repeats every stride (translated), so the
@@ -463,41 +488,25 @@ Eigen::Vector2d plannedCop(const std::array<FootState, 2>& feet) {
 double solvePelvis(const jle::Model<double>& model, jle::Data<double>& data,
                    const std::array<Leg, 2>& legs, const Gait& gait, Pelvis& pelvis,
                    const jle::VectorX<double>& q_start, int iterations) {
-  const double T = kStride, h = 1.0 / (kJointRate * kPlateDivisor), w = 2.0 * kPi / T;
-  const int n = static_cast<int>(std::lround(T / h));
-  const double g0 = kStartPhase * T;
-  const Vector3d gravity(0.0, 0.0, -kGravity);
+  const double h = 1.0 / (kJointRate * kPlateDivisor);
+  const int n = static_cast<int>(std::lround(kStride / h));
+  const double g0 = kStartPhase * kStride;
   const double mass = model.totalMass();
   std::vector<jle::VectorX<double>> grid(static_cast<std::size_t>(n + 4), q_start);
   std::vector<Eigen::Vector2d> error(static_cast<std::size_t>(n));
   jle::VectorX<double> qd(model.nq), qdd(model.nq);
   double largest = 0.0;
   for (int iteration = 0;; ++iteration) {
-    for (int k = -2; k < n + 2; ++k) {  // warm start: from the last solution (first: the
-      const double g = g0 + k * h;       // previous sample's)
-      jle::VectorX<double>& qk = grid[static_cast<std::size_t>(k + 2)];
-      if (iteration == 0 && k > -2) qk = grid[static_cast<std::size_t>(k + 1)];
-      for (const Leg& leg : legs) {
-        const FootState foot = gait.at(leg, g);
-        solveLeg(model, data, leg, pelvis.at(g), foot.heel, foot.toe, qk);
-      }
-    }
+    // Warm start: from the last solution (first: the previous sample's).
+    solveGridLegs(model, data, legs, gait, pelvis, g0, h, -2, iteration == 0, grid);
     largest = 0.0;
     double z_com = 0.0;
     for (int k = 0; k < n; ++k) {
       const std::size_t c = static_cast<std::size_t>(k + 2);
-      for (int j = 0; j < model.nq; ++j) {
-        const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j],
-                     p2 = grid[c + 2][j], z = grid[c][j];
-        qd[j] = (m2 - 8.0 * m1 + 8.0 * p1 - p2) / (12.0 * h);
-        qdd[j] = (-m2 + 16.0 * m1 - 30.0 * z + 16.0 * p1 - p2) / (12.0 * h * h);
-      }
+      fivePoint(grid, c, h, qd, qdd);
       const double g = g0 + k * h;
-      const jle::BaseState<double> base = pelvis.at(g);
-      jle::forwardKinematics(model, data, grid[c], qd, qdd, gravity, base);
-      jle::inverseDynamics(model, data);
-      const Vector3d F = base.R_world_base * data.force[0];
-      const Vector3d M = base.R_world_base * data.moment[0] + base.p_world_base.cross(F);
+      Vector3d F, M;
+      pelvisWrench(model, data, grid[c], qd, qdd, pelvis.at(g), F, M);
       const Eigen::Vector2d cop(-M.y() / F.z(), M.x() / F.z());
       const std::array<FootState, 2> feet = {gait.at(legs[0], g), gait.at(legs[1], g)};
       error[static_cast<std::size_t>(k)] = plannedCop(feet) - cop;
@@ -506,31 +515,13 @@ double solvePelvis(const jle::Model<double>& model, jle::Data<double>& data,
         z_com += model.mass[i] * jle::comWorld(model, data, static_cast<int>(i)).z() / (mass * n);
     }
     if (iteration == iterations) break;
-    for (int m = 0; m <= kHarmonics; ++m) {
-      Eigen::Vector2d A = Eigen::Vector2d::Zero(), B = Eigen::Vector2d::Zero();
-      for (int k = 0; k < n; ++k) {
-        const double g = g0 + k * h;
-        A += error[static_cast<std::size_t>(k)] * std::cos(m * w * g);
-        B += error[static_cast<std::size_t>(k)] * std::sin(m * w * g);
-      }
-      const double response = 1.0 + z_com / kGravity * (m * w) * (m * w);
-      pelvis.correction.a[m] += kRelaxation * (m == 0 ? 1.0 : 2.0) / n * A / response;
-      pelvis.correction.b[m] += kRelaxation * (m == 0 ? 0.0 : 2.0) / n * B / response;
-    }
+    correctPelvis(error, g0, h, z_com, pelvis);
   }
   return largest;
 }
 
-void run(const Options& options) {
-  jle::ModelOptions model_options;
-  model_options.floating_base = true;
-  const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
-  if (model.link_name[0] != "pelvis")
-    throw std::runtime_error(options.urdf + ": the root link is '" + model.link_name[0] +
-                             "', make_gait_bag needs 'pelvis'");
-  const double mass = model.totalMass();
-  const double weight = mass * kGravity;
-
+// The legs' coordinates and sole frames (the body model of docs/gait_demo.md).
+std::array<Leg, 2> findLegs(const jle::Model<double>& model, const std::string& urdf) {
   std::array<Leg, 2> legs;
   const char* names[5] = {"hip_flexion_", "hip_adduction_", "hip_rotation_", "knee_flexion_",
                           "ankle_flexion_"};
@@ -541,18 +532,19 @@ void run(const Options& options) {
     leg.strike_offset = k == 0 ? 0.0 : 0.5 * kStride;
     const std::string s(1, leg.side);
     for (int j = 0; j < 5; ++j)
-      leg.coordinate[static_cast<std::size_t>(j)] =
-          coordinateIndex(model, names[j] + s, options.urdf);
-    leg.heel = frameIndex(model, "heel_" + s, options.urdf);
-    leg.toe = frameIndex(model, "toe_" + s, options.urdf);
+      leg.coordinate[static_cast<std::size_t>(j)] = coordinateIndex(model, names[j] + s, urdf);
+    leg.heel = frameIndex(model, "heel_" + s, urdf);
+    leg.toe = frameIndex(model, "toe_" + s, urdf);
   }
+  return legs;
+}
 
-  // The standing body (q = 0, pelvis at the origin): sole height, foot geometry.
-  jle::Data<double> data(model);
-  jle::VectorX<double> q = jle::VectorX<double>::Zero(model.nq);
+// The standing body (q = 0, pelvis at the origin): each foot's length and footprint, and
+// the sole's height (returned).
+double measureFeet(const jle::Model<double>& model, jle::Data<double>& data,
+                   std::array<Leg, 2>& legs, const std::string& urdf) {
   const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
-  const Vector3d gravity(0.0, 0.0, -kGravity);
-  jle::forwardKinematics(model, data, zero, zero, zero, gravity);
+  jle::forwardKinematics(model, data, zero, zero, zero, Vector3d(0.0, 0.0, -kGravity));
   double sole = 0.0;
   for (Leg& leg : legs) {
     const Vector3d heel = framePosition(model, data, leg.heel);
@@ -561,282 +553,386 @@ void run(const Options& options) {
     leg.y_footprint = kStepWidthRatio * heel.y();
     sole = std::min({sole, heel.z(), toe.z()});
     if (!(leg.foot_length > 0.05))
-      throw std::runtime_error(options.urdf + ": heel_" + std::string(1, leg.side) + " and toe_" +
+      throw std::runtime_error(urdf + ": heel_" + std::string(1, leg.side) + " and toe_" +
                                std::string(1, leg.side) + " are less than 5 cm apart");
   }
-  const int hip_segment = model.segmentOfJoint("hip_flexion_r");
+  return sole;
+}
+
+// The whole trial: the body, its legs, their gait, the pelvis path.
+struct Trial {
+  std::array<Leg, 2> legs;
   Gait gait;
-  gait.hip_x = data.p_world[static_cast<std::size_t>(hip_segment)].x();
   Pelvis pelvis;
-  pelvis.z0 = -sole - kPelvisDrop;
-  gait.x_offset = pelvis.x_offset = 0.0;
+  double cop_error = 0.0;  // [m] solvePelvis's
+};
 
+Trial planTrial(const jle::Model<double>& model, jle::Data<double>& data,
+                const std::string& urdf, jle::VectorX<double>& q) {
+  Trial trial;
+  trial.legs = findLegs(model, urdf);
+  const double sole = measureFeet(model, data, trial.legs, urdf);
+  const int hip_segment = model.segmentOfJoint("hip_flexion_r");
+  trial.gait.hip_x = data.p_world[static_cast<std::size_t>(hip_segment)].x();
+  trial.pelvis.z0 = -sole - kPelvisDrop;
+  trial.gait.x_offset = trial.pelvis.x_offset = 0.0;
   // Knees slightly bent: the inverse kinematics stays on the bent-knee branch.
-  for (const Leg& leg : legs) q[leg.coordinate[3]] = 0.3;
-  const double cop_error = solvePelvis(model, data, legs, gait, pelvis, q, kPelvisIterations);
+  q = jle::VectorX<double>::Zero(model.nq);
+  for (const Leg& leg : trial.legs) q[leg.coordinate[3]] = 0.3;
+  trial.cop_error =
+      solvePelvis(model, data, trial.legs, trial.gait, trial.pelvis, q, kPelvisIterations);
+  return trial;
+}
 
-  // The 1 kHz grid, with two points either side for the 5-point differences.
-  const double h = 1.0 / (kJointRate * kPlateDivisor);
-  const long long n_plate = std::llround(options.strides * kStride / h);
-  const double g0 = kStartPhase * kStride;
-  std::vector<jle::VectorX<double>> grid;
-  grid.reserve(static_cast<std::size_t>(n_plate + 4));
-  double ik_error = 0.0;
-  double min_toe = 1e9;
-  for (long long k = -2; k < n_plate + 2; ++k) {
-    const double g = g0 + static_cast<double>(k) * h;
-    const jle::BaseState<double> base = pelvis.at(g);
-    for (const Leg& leg : legs) {
-      const FootState foot = gait.at(leg, g);
-      ik_error = std::max(ik_error, solveLeg(model, data, leg, base, foot.heel, foot.toe, q));
+// The joint positions of the trial on the 1 kHz grid, with two points either side for
+// the 5-point differences: point c = k + 2 is gait time g0 + k h.
+struct Grid {
+  double h = 1.0 / (kJointRate * kPlateDivisor);
+  double g0 = kStartPhase * kStride;
+  long long samples = 0;  // k = 0 .. samples - 1
+  std::vector<jle::VectorX<double>> q;
+  double ik_error = 0.0;  // [m]
+  double min_toe = 1e9;   // [m] the lowest toe in mid-swing
+};
+
+Grid solveGrid(const jle::Model<double>& model, jle::Data<double>& data, const Trial& trial,
+               int strides, jle::VectorX<double> q, const std::string& urdf) {
+  Grid grid;
+  grid.samples = std::llround(strides * kStride / grid.h);
+  grid.q.reserve(static_cast<std::size_t>(grid.samples + 4));
+  for (long long k = -2; k < grid.samples + 2; ++k) {
+    const double g = grid.g0 + static_cast<double>(k) * grid.h;
+    const jle::BaseState<double> base = trial.pelvis.at(g);
+    for (const Leg& leg : trial.legs) {
+      const FootState foot = trial.gait.at(leg, g);
+      grid.ik_error =
+          std::max(grid.ik_error, solveLeg(model, data, leg, base, foot.heel, foot.toe, q));
       const double swing = foot.since_strike / kStride - kToeOff;  // fraction of T into swing
-      if (swing > 0.1 && swing < 0.3) min_toe = std::min(min_toe, foot.toe.z());
+      if (swing > 0.1 && swing < 0.3) grid.min_toe = std::min(grid.min_toe, foot.toe.z());
     }
-    grid.push_back(q);
+    grid.q.push_back(q);
   }
-  if (ik_error > 1e-6)
-    throw std::runtime_error(options.urdf + ": the legs cannot follow the trial (the inverse "
-                             "kinematics misses the feet by " + std::to_string(ik_error) + " m)");
+  if (grid.ik_error > 1e-6)
+    throw std::runtime_error(urdf + ": the legs cannot follow the trial (the inverse "
+                             "kinematics misses the feet by " +
+                             std::to_string(grid.ik_error) + " m)");
+  return grid;
+}
 
-  // Plates: two lanes along x, covering every footprint.
+// Two plates side by side along x, covering every footprint.
+struct Plates {
+  double length = 0.0, x_centre = 0.0;  // [m]
+  std::array<Vector3d, 2> p_world;      // centres of their surfaces
+};
+
+Plates layPlates(const Trial& trial, const Grid& grid) {
   double x_min = 1e9, x_max = -1e9;
-  for (long long k = 0; k < n_plate; ++k)
-    for (const Leg& leg : legs) {
-      const FootState foot = gait.at(leg, g0 + static_cast<double>(k) * h);
+  for (long long k = 0; k < grid.samples; ++k)
+    for (const Leg& leg : trial.legs) {
+      const FootState foot = trial.gait.at(leg, grid.g0 + static_cast<double>(k) * grid.h);
       if (!foot.stance) continue;
       x_min = std::min({x_min, foot.heel.x(), foot.toe.x()});
       x_max = std::max({x_max, foot.heel.x(), foot.toe.x()});
     }
-  const double plate_length = std::ceil((x_max - x_min + 0.4) * 10.0) / 10.0;
-  const double x_centre = std::round(500.0 * (x_min + x_max)) / 1000.0;  // to the mm
-  const std::array<Vector3d, 2> p_world_plate = {Vector3d(x_centre, -0.5 * kLaneWidth, 0.0),
-                                                 Vector3d(x_centre, 0.5 * kLaneWidth, 0.0)};
+  Plates plates;
+  plates.length = std::ceil((x_max - x_min + 0.4) * 10.0) / 10.0;
+  plates.x_centre = std::round(500.0 * (x_min + x_max)) / 1000.0;  // to the mm
+  plates.p_world = {Vector3d(plates.x_centre, -0.5 * kLaneWidth, 0.0),
+                    Vector3d(plates.x_centre, 0.5 * kLaneWidth, 0.0)};
+  return plates;
+}
 
-  // Messages, allocated once.
-  sensor_msgs::JointState joints;
-  joints.name = model.coordinate_names;
-  joints.position.resize(joints.name.size());
-  tf2_msgs::TFMessage pose_msg, cop_msg, static_msg;
-  pose_msg.transforms.resize(1);
-  cop_msg.transforms.resize(2);
-  std::array<geometry_msgs::WrenchStamped, 2> plate_msg, reaction_msg;
-  std::array<std::string, 2> plate_topic, reaction_topic, plate_frame, cop_frame;
-  for (int i = 0; i < 2; ++i) {
-    const std::string n = std::to_string(i + 1);
-    plate_topic[i] = "/force_plate_" + n + "/wrench";
-    reaction_topic[i] = "/force_plate_" + n + "/reaction";
-    plate_frame[i] = "force_plate_" + n;
-    cop_frame[i] = "force_plate_" + n + "_cop";
-    plate_msg[i].header.frame_id = plate_frame[i];
-    reaction_msg[i].header.frame_id = cop_frame[i];
-  }
-  std::array<Eigen::Matrix<double, 6, 1>, 2> plate_row;  // the plates' samples for the CSV
-  std::array<Vector3d, 2> last_cop = {p_world_plate[0], p_world_plate[1]};
-
-  jle::Uniform uniform(options.seed);
-  auto gaussian = [&uniform]() {  // Box-Muller, one of the pair
-    const double u1 = 1.0 - uniform(), u2 = uniform();
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
-  };
-
-  // Figures for the report.
+// Figures of the trial for the report.
+struct Figures {
   double peak_fz = 0.0, peak_fz_foot = 0.0, max_residual_split = 0.0;
   double cop_min = 1e9, cop_max = -1e9, cop_side = 0.0, cop_shift = 0.0;
-  std::vector<double> q_min(static_cast<std::size_t>(model.nq), 1e9),
-      q_max(static_cast<std::size_t>(model.nq), -1e9);
+  std::vector<double> q_min, q_max;
+};
 
-  const std::string temporary = options.output + ".partial";
-  const std::string csv_temporary = options.csv + ".partial";
-  FILE* csv = nullptr;
-  try {
+// The ground reaction at one instant: the whole wrench the world applies (F, M about the
+// world origin), its centre of pressure on z = 0 and free moment, and each foot's share.
+struct Reaction {
+  Vector3d F, M, cop;
+  double free_moment = 0.0;
+  std::array<Share, 2> share;
+};
+
+// Double support: the force moves from the trailing to the leading foot by a smooth
+// step, each foot's centre of pressure at its nominal point shifted by the same vector.
+void splitDoubleSupport(const std::array<FootState, 2>& feet, Reaction& r, Figures& figures) {
+  const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
+  const int trail = 1 - lead;
+  const double w_lead = smoothStep(feet[lead].since_strike / ((kToeOff - 0.5) * kStride));
+  const Vector3d a(feet[trail].toe.x(), feet[trail].toe.y(), 0.0);
+  const Vector3d b(feet[lead].heel.x(), feet[lead].heel.y(), 0.0);
+  const Vector3d e = r.cop - ((1.0 - w_lead) * a + w_lead * b);
+  figures.cop_shift = std::max(figures.cop_shift, e.norm());
+  r.share[static_cast<std::size_t>(trail)] = {true, (1.0 - w_lead) * r.F, a + e,
+                                              (1.0 - w_lead) * r.free_moment};
+  r.share[static_cast<std::size_t>(lead)] = {true, w_lead * r.F, b + e, w_lead * r.free_moment};
+}
+
+// Single support: all on the stance foot; where the centre of pressure lies on its
+// footprint, heel 0 .. toe 1, and beside the heel-toe line, for the figures.
+void placeSingleSupport(const std::array<FootState, 2>& feet, Reaction& r, Figures& figures) {
+  const int stance = feet[0].stance ? 0 : 1;
+  if (!feet[static_cast<std::size_t>(stance)].stance)
+    throw std::runtime_error("internal: no foot on the ground");
+  r.share[static_cast<std::size_t>(stance)] = {true, r.F, r.cop, r.free_moment};
+  const FootState& f = feet[static_cast<std::size_t>(stance)];
+  const Vector3d along = f.print_toe - f.print_heel;
+  const double u = (r.cop - f.print_heel).dot(along) / along.squaredNorm();
+  figures.cop_min = std::min(figures.cop_min, u);
+  figures.cop_max = std::max(figures.cop_max, u);
+  const Vector3d lateral = Vector3d::UnitZ().cross(along).normalized();
+  figures.cop_side = std::max(figures.cop_side, std::abs((r.cop - f.print_heel).dot(lateral)));
+}
+
+// The ground reaction for the motion at grid point k (with qd, qdd) and its split
+// between the feet, checked: the two shares make the whole wrench.
+Reaction groundReaction(const jle::Model<double>& model, jle::Data<double>& data,
+                        const Trial& trial, const jle::VectorX<double>& q,
+                        const jle::VectorX<double>& qd, const jle::VectorX<double>& qdd,
+                        double g, Figures& figures) {
+  Reaction r;
+  pelvisWrench(model, data, q, qd, qdd, trial.pelvis.at(g), r.F, r.M);
+  if (!(r.F.z() > 0.0))
+    throw std::runtime_error("the trial needs the body pulled down (vertical ground "
+                             "reaction " + std::to_string(r.F.z()) + " N)");
+  r.cop = Vector3d(-r.M.y() / r.F.z(), r.M.x() / r.F.z(), 0.0);
+  r.free_moment = r.M.z() - (r.cop.x() * r.F.y() - r.cop.y() * r.F.x());
+  const std::array<FootState, 2> feet = {trial.gait.at(trial.legs[0], g),
+                                         trial.gait.at(trial.legs[1], g)};
+  if (feet[0].stance && feet[1].stance)
+    splitDoubleSupport(feet, r, figures);
+  else
+    placeSingleSupport(feet, r, figures);
+  Vector3d F_sum = Vector3d::Zero(), M_sum = Vector3d::Zero();
+  for (const Share& s : r.share) {
+    F_sum += s.force;
+    M_sum += s.cop.cross(s.force) + Vector3d(0, 0, s.free_moment);
+  }
+  figures.max_residual_split =
+      std::max({figures.max_residual_split, (F_sum - r.F).norm(), (M_sum - r.M).norm() / 1.0});
+  figures.peak_fz = std::max(figures.peak_fz, r.F.z());
+  return r;
+}
+
+// The bag and the CSV of the trial, their messages allocated once.
+class TrialWriter {
+ public:
+  TrialWriter(const jle::Model<double>& model, const Options& options, const Plates& plates)
+      : model_(model), options_(options), plates_(plates), random_(options.seed),
+        bag_(options.output) {
+    joints_.name = model.coordinate_names;
+    joints_.position.resize(joints_.name.size());
+    pose_msg_.transforms.resize(1);
+    cop_msg_.transforms.resize(2);
+    for (int i = 0; i < 2; ++i) {
+      const std::string n = std::to_string(i + 1);
+      plate_topic_[i] = "/force_plate_" + n + "/wrench";
+      reaction_topic_[i] = "/force_plate_" + n + "/reaction";
+      plate_frame_[i] = "force_plate_" + n;
+      cop_frame_[i] = "force_plate_" + n + "_cop";
+      plate_msg_[i].header.frame_id = plate_frame_[i];
+      reaction_msg_[i].header.frame_id = cop_frame_[i];
+      last_cop_[i] = plates.p_world[i];
+    }
     if (!options.csv.empty()) {
-      csv = std::fopen(csv_temporary.c_str(), "w");
-      if (!csv) throw std::runtime_error(options.csv + ": cannot write " + csv_temporary);
-      std::fprintf(csv, "t");
-      for (const std::string& n : model.coordinate_names)
-        std::fprintf(csv, ",%s.q,%s.qd,%s.qdd", n.c_str(), n.c_str(), n.c_str());
-      for (const char* c : {"x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz", "wx", "wy",
-                            "wz", "ax", "ay", "az", "alx", "aly", "alz"})
-        std::fprintf(csv, ",base.%s", c);
-      for (const char* p : {"plate1", "plate2"})
-        for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) std::fprintf(csv, ",plate@%s.%s", p, c);
-      std::fprintf(csv, "\n");
+      csv_ = std::make_unique<jle::CsvWriter>(options.csv);
+      jle::ExtraStateInputs extra;
+      extra.floating_base = true;
+      extra.plates = {"plate1", "plate2"};
+      const std::vector<std::string> names = jle::stateColumnNames(model, {}, extra);
+      csv_->writeHeader(names);
+      csv_row_.resize(names.size());
     }
-    rosbag::Bag bag(temporary, rosbag::bagmode::Write);
-    {  // The plates' poses, latched.
-      const ros::Time stamp = stampOf(kEpochNs);
-      for (int i = 0; i < 2; ++i)
-        static_msg.transforms.push_back(
-            transform(plate_frame[i], stamp, p_world_plate[i], Matrix3d::Identity()));
-      // A connection header of our own (for "latching") must also name the type.
-      auto header = boost::make_shared<ros::M_string>();
-      (*header)["type"] = ros::message_traits::datatype(static_msg);
-      (*header)["md5sum"] = ros::message_traits::md5sum(static_msg);
-      (*header)["message_definition"] = ros::message_traits::definition(static_msg);
-      (*header)["callerid"] = "/make_gait_bag";
-      (*header)["latching"] = "1";
-      bag.write("/tf_static", stamp - ros::Duration(0, 3000000), static_msg, header);
-    }
-    jle::VectorX<double> qd(model.nq), qdd(model.nq);
-    for (long long k = 0; k < n_plate; ++k) {
-      const std::size_t c = static_cast<std::size_t>(k + 2);
-      for (int j = 0; j < model.nq; ++j) {
-        const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j],
-                     p2 = grid[c + 2][j], z = grid[c][j];
-        qd[j] = (m2 - 8.0 * m1 + 8.0 * p1 - p2) / (12.0 * h);
-        qdd[j] = (-m2 + 16.0 * m1 - 30.0 * z + 16.0 * p1 - p2) / (12.0 * h * h);
-        q_min[static_cast<std::size_t>(j)] = std::min(q_min[static_cast<std::size_t>(j)], z);
-        q_max[static_cast<std::size_t>(j)] = std::max(q_max[static_cast<std::size_t>(j)], z);
-      }
-      const double g = g0 + static_cast<double>(k) * h;
-      const jle::BaseState<double> base = pelvis.at(g);
-      jle::forwardKinematics(model, data, grid[c], qd, qdd, gravity, base);
-      jle::inverseDynamics(model, data);
-      // What the world must apply to the pelvis: world axes, about the world origin.
-      const Vector3d F = base.R_world_base * data.force[0];
-      const Vector3d M = base.R_world_base * data.moment[0] + base.p_world_base.cross(F);
-      if (!(F.z() > 0.0))
-        throw std::runtime_error("the trial needs the body pulled down (vertical ground "
-                                 "reaction " + std::to_string(F.z()) + " N)");
-      // Whole-body centre of pressure on z = 0 and free moment.
-      const Vector3d cop(-M.y() / F.z(), M.x() / F.z(), 0.0);
-      const double free_moment = M.z() - (cop.x() * F.y() - cop.y() * F.x());
-
-      std::array<FootState, 2> feet = {gait.at(legs[0], g), gait.at(legs[1], g)};
-      std::array<Share, 2> share;
-      if (feet[0].stance && feet[1].stance) {
-        const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
-        const int trail = 1 - lead;
-        const double w_lead = smoothStep(feet[lead].since_strike / ((kToeOff - 0.5) * kStride));
-        const Vector3d a(feet[trail].toe.x(), feet[trail].toe.y(), 0.0);
-        const Vector3d b(feet[lead].heel.x(), feet[lead].heel.y(), 0.0);
-        const Vector3d e = cop - ((1.0 - w_lead) * a + w_lead * b);
-        cop_shift = std::max(cop_shift, e.norm());
-        share[static_cast<std::size_t>(trail)] = {true, (1.0 - w_lead) * F, a + e,
-                                                  (1.0 - w_lead) * free_moment};
-        share[static_cast<std::size_t>(lead)] = {true, w_lead * F, b + e, w_lead * free_moment};
-      } else {
-        const int stance = feet[0].stance ? 0 : 1;
-        if (!feet[static_cast<std::size_t>(stance)].stance)
-          throw std::runtime_error("internal: no foot on the ground");
-        share[static_cast<std::size_t>(stance)] = {true, F, cop, free_moment};
-        // Where the centre of pressure lies on the footprint, heel 0 .. toe 1, and
-        // beside the heel-toe line.
-        const FootState& f = feet[static_cast<std::size_t>(stance)];
-        const Vector3d along = f.print_toe - f.print_heel;
-        const double u = (cop - f.print_heel).dot(along) / along.squaredNorm();
-        cop_min = std::min(cop_min, u);
-        cop_max = std::max(cop_max, u);
-        const Vector3d lateral = Vector3d::UnitZ().cross(along).normalized();
-        cop_side = std::max(cop_side, std::abs((cop - f.print_heel).dot(lateral)));
-      }
-      // Check of the split: the two shares make the whole wrench.
-      Vector3d F_sum = Vector3d::Zero(), M_sum = Vector3d::Zero();
-      for (const Share& s : share) {
-        F_sum += s.force;
-        M_sum += s.cop.cross(s.force) + Vector3d(0, 0, s.free_moment);
-      }
-      max_residual_split =
-          std::max({max_residual_split, (F_sum - F).norm(), (M_sum - M).norm() / 1.0});
-      peak_fz = std::max(peak_fz, F.z());
-
-      const std::int64_t ns = kEpochNs + k * 1000000LL;
-      const ros::Time stamp = stampOf(ns);
-      const ros::Time early = stamp - ros::Duration(0, 2000000);
-      for (std::size_t i = 0; i < 2; ++i) {
-        peak_fz_foot = std::max(peak_fz_foot, share[i].force.z());
-        // What the foot applies to the plate (the reaction reversed), plate frame
-        // (axes of the world), moment about the plate origin.
-        const Vector3d r = share[i].cop - p_world_plate[i];
-        Vector3d f_plate = -share[i].force;
-        Vector3d m_plate = -(r.cross(share[i].force) + Vector3d(0, 0, share[i].free_moment));
-        if (options.noise > 0.0) {
-          for (int j = 0; j < 3; ++j) f_plate[j] += options.noise * gaussian();
-          for (int j = 0; j < 3; ++j) m_plate[j] += 0.01 * options.noise * gaussian();
-        }
-        plate_msg[i].header.stamp = stamp;
-        setWrench(plate_msg[i], f_plate, m_plate);
-        bag.write(plate_topic[i], early, plate_msg[i]);
-        if (share[i].contact) last_cop[i] = share[i].cop;
-        plate_row[i] << f_plate, m_plate;
-      }
-      if (k % kDisplayDivisor == 0) {
-        for (std::size_t i = 0; i < 2; ++i) {
-          cop_msg.transforms[i] = transform(cop_frame[i], stamp, last_cop[i], Matrix3d::Identity());
-          reaction_msg[i].header.stamp = stamp;
-          setWrench(reaction_msg[i], share[i].force, Vector3d(0, 0, share[i].free_moment));
-        }
-        bag.write("/tf", early, cop_msg);
-        for (std::size_t i = 0; i < 2; ++i) bag.write(reaction_topic[i], stamp, reaction_msg[i]);
-      }
-      if (k % kPlateDivisor == 0) {
-        pose_msg.transforms[0] = transform("pelvis", stamp, base.p_world_base, base.R_world_base);
-        bag.write("/tf", early, pose_msg);
-        joints.header.stamp = stamp;
-        joints.header.seq = static_cast<std::uint32_t>(k / kPlateDivisor);
-        for (int j = 0; j < model.nq; ++j)
-          joints.position[static_cast<std::size_t>(j)] = grid[c][j];
-        bag.write("/joint_states", stamp, joints);
-        if (csv) {
-          std::fprintf(csv, "%.17g", static_cast<double>(ns - kEpochNs) * 1e-9);
-          for (int j = 0; j < model.nq; ++j)
-            std::fprintf(csv, ",%.17g,%.17g,%.17g", grid[c][j], qd[j], qdd[j]);
-          const Eigen::Quaterniond o(base.R_world_base);
-          const double pose[7] = {base.p_world_base.x(), base.p_world_base.y(),
-                                  base.p_world_base.z(), o.x(), o.y(), o.z(), o.w()};
-          for (double x : pose) std::fprintf(csv, ",%.17g", x);
-          for (const Vector3d* v : {&base.v_world, &base.omega_world, &base.a_world, &base.alpha_world})
-            std::fprintf(csv, ",%.17g,%.17g,%.17g", v->x(), v->y(), v->z());
-          for (const auto& row : plate_row)
-            for (int j = 0; j < 6; ++j) std::fprintf(csv, ",%.17g", row[j]);
-          std::fprintf(csv, "\n");
-        }
-      }
-    }
-    bag.close();
-    if (csv) {
-      const bool ok = std::fflush(csv) == 0 && !std::ferror(csv);
-      std::fclose(csv);
-      csv = nullptr;
-      if (!ok) throw std::runtime_error(options.csv + ": write error");
-      if (std::rename(csv_temporary.c_str(), options.csv.c_str()) != 0)
-        throw std::runtime_error(options.csv + ": cannot rename " + csv_temporary + " onto it");
-    }
-    if (std::rename(temporary.c_str(), options.output.c_str()) != 0)
-      throw std::runtime_error(options.output + ": cannot rename " + temporary + " onto it");
-  } catch (...) {
-    if (csv) std::fclose(csv);
-    std::remove(temporary.c_str());
-    if (!options.csv.empty()) std::remove(csv_temporary.c_str());
-    throw;
   }
 
+  // The plates' poses, latched.
+  void writePlatePoses() {
+    const ros::Time stamp = jle_tools::stampOf(kEpochNs);
+    tf2_msgs::TFMessage static_msg;
+    for (int i = 0; i < 2; ++i)
+      static_msg.transforms.push_back(
+          transform(plate_frame_[i], stamp, plates_.p_world[i], Matrix3d::Identity()));
+    // A connection header of our own (for "latching") must also name the type.
+    auto header = boost::make_shared<ros::M_string>();
+    (*header)["type"] = ros::message_traits::datatype(static_msg);
+    (*header)["md5sum"] = ros::message_traits::md5sum(static_msg);
+    (*header)["message_definition"] = ros::message_traits::definition(static_msg);
+    (*header)["callerid"] = "/make_gait_bag";
+    (*header)["latching"] = "1";
+    bag_.bag().write("/tf_static", stamp - ros::Duration(0, 3000000), static_msg, header);
+  }
+
+  // Plate sample k (1 kHz): the plates, and at their rates the display and the joints.
+  void write(long long k, const Reaction& r, const jle::BaseState<double>& base,
+             const jle::VectorX<double>& q, const jle::VectorX<double>& qd,
+             const jle::VectorX<double>& qdd, Figures& figures) {
+    const std::int64_t ns = kEpochNs + k * 1000000LL;
+    const ros::Time stamp = jle_tools::stampOf(ns);
+    const ros::Time early = stamp - ros::Duration(0, 2000000);
+    writePlates(r, stamp, early, figures);
+    if (k % kDisplayDivisor == 0) writeDisplay(r, stamp, early);
+    if (k % kPlateDivisor == 0) {
+      pose_msg_.transforms[0] = transform("pelvis", stamp, base.p_world_base, base.R_world_base);
+      bag_.bag().write("/tf", early, pose_msg_);
+      joints_.header.stamp = stamp;
+      joints_.header.seq = static_cast<std::uint32_t>(k / kPlateDivisor);
+      for (int j = 0; j < model_.nq; ++j) joints_.position[static_cast<std::size_t>(j)] = q[j];
+      bag_.bag().write("/joint_states", stamp, joints_);
+      if (csv_) writeCsvRow(static_cast<double>(ns - kEpochNs) * 1e-9, base, q, qd, qdd);
+    }
+  }
+
+  void commit() {
+    bag_.commit();
+    if (csv_) csv_->commit();
+  }
+
+ private:
+  // Box-Muller, the cosine of each pair (kUsage).
+  double gaussian() {
+    const double u1 = 1.0 - random_.uniform(), u2 = random_.uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+  }
+
+  // What each foot applies to its plate (the reaction reversed), plate frame (axes of
+  // the world), moment about the plate origin; with noise.
+  void writePlates(const Reaction& r, const ros::Time& stamp, const ros::Time& early,
+                   Figures& figures) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      const Share& share = r.share[i];
+      figures.peak_fz_foot = std::max(figures.peak_fz_foot, share.force.z());
+      const Vector3d arm = share.cop - plates_.p_world[i];
+      Vector3d f_plate = -share.force;
+      Vector3d m_plate = -(arm.cross(share.force) + Vector3d(0, 0, share.free_moment));
+      if (options_.noise > 0.0) {
+        for (int j = 0; j < 3; ++j) f_plate[j] += options_.noise * gaussian();
+        for (int j = 0; j < 3; ++j) m_plate[j] += 0.01 * options_.noise * gaussian();
+      }
+      plate_msg_[i].header.stamp = stamp;
+      jle_tools::setWrench(plate_msg_[i], f_plate, m_plate);
+      bag_.bag().write(plate_topic_[i], early, plate_msg_[i]);
+      if (share.contact) last_cop_[i] = share.cop;
+      plate_row_[i] << f_plate, m_plate;
+    }
+  }
+
+  // Where the ground reaction acts and what it is, for display.
+  void writeDisplay(const Reaction& r, const ros::Time& stamp, const ros::Time& early) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      cop_msg_.transforms[i] = transform(cop_frame_[i], stamp, last_cop_[i], Matrix3d::Identity());
+      reaction_msg_[i].header.stamp = stamp;
+      jle_tools::setWrench(reaction_msg_[i], r.share[i].force,
+                           Vector3d(0, 0, r.share[i].free_moment));
+    }
+    bag_.bag().write("/tf", early, cop_msg_);
+    for (std::size_t i = 0; i < 2; ++i) bag_.bag().write(reaction_topic_[i], stamp, reaction_msg_[i]);
+  }
+
+  // t, J.q, J.qd, J.qdd, base.x .. base.alz, plate@plate1.fx .. plate@plate2.mz.
+  void writeCsvRow(double t, const jle::BaseState<double>& base, const jle::VectorX<double>& q,
+                   const jle::VectorX<double>& qd, const jle::VectorX<double>& qdd) {
+    double* o = csv_row_.data();
+    *o++ = t;
+    for (int j = 0; j < model_.nq; ++j) {
+      *o++ = q[j];
+      *o++ = qd[j];
+      *o++ = qdd[j];
+    }
+    const Eigen::Quaterniond orientation(base.R_world_base);
+    for (int i = 0; i < 3; ++i) *o++ = base.p_world_base[i];
+    for (const double x : {orientation.x(), orientation.y(), orientation.z(), orientation.w()})
+      *o++ = x;
+    for (const Vector3d* v : {&base.v_world, &base.omega_world, &base.a_world, &base.alpha_world})
+      for (int i = 0; i < 3; ++i) *o++ = (*v)[i];
+    for (const auto& row : plate_row_)
+      for (int j = 0; j < 6; ++j) *o++ = row[j];
+    csv_->writeRow(csv_row_.data(), csv_row_.size());
+  }
+
+  const jle::Model<double>& model_;
+  const Options& options_;
+  const Plates& plates_;
+  jle::PortableRandom random_;
+  jle_tools::PartialBag bag_;
+  std::unique_ptr<jle::CsvWriter> csv_;
+  std::vector<double> csv_row_;
+  sensor_msgs::JointState joints_;
+  tf2_msgs::TFMessage pose_msg_, cop_msg_;
+  std::array<geometry_msgs::WrenchStamped, 2> plate_msg_, reaction_msg_;
+  std::array<std::string, 2> plate_topic_, reaction_topic_, plate_frame_, cop_frame_;
+  std::array<Eigen::Matrix<double, 6, 1>, 2> plate_row_;  // the plates' samples for the CSV
+  std::array<Vector3d, 2> last_cop_;
+};
+
+void printReport(const jle::Model<double>& model, const Options& options, const Trial& trial,
+                 const Grid& grid, const Plates& plates, const Figures& figures) {
+  const double weight = model.totalMass() * kGravity;
   std::printf("make_gait_bag: %d strides, %.3f s, %lld joint states (200 Hz), %lld plate "
               "samples per plate (1 kHz) -> %s\n",
-              options.strides, static_cast<double>(n_plate) * h, (n_plate + 4) / 5, n_plate,
-              options.output.c_str());
+              options.strides, static_cast<double>(grid.samples) * grid.h,
+              (grid.samples + 4) / 5, grid.samples, options.output.c_str());
   std::printf("  body %.2f kg (weight %.1f N); plates %.1f m x %.1f m, centres x %.3f m, "
               "y -/+%.2f m\n",
-              mass, weight, plate_length, kLaneWidth, x_centre, 0.5 * kLaneWidth);
+              model.totalMass(), weight, plates.length, kLaneWidth, plates.x_centre,
+              0.5 * kLaneWidth);
   std::printf("  joint_loads: --plate plate1=foot_r,%.3f,%.3f,0 --plate plate2=foot_l,%.3f,%.3f,0\n",
-              x_centre, -0.5 * kLaneWidth, x_centre, 0.5 * kLaneWidth);
+              plates.x_centre, -0.5 * kLaneWidth, plates.x_centre, 0.5 * kLaneWidth);
   std::printf("  vertical ground reaction: peak %.2f BW (both feet), %.2f BW (one foot)\n",
-              peak_fz / weight, peak_fz_foot / weight);
+              figures.peak_fz / weight, figures.peak_fz_foot / weight);
   std::printf("  single support: centre of pressure from %.2f to %.2f of heel->toe, up to "
               "%.3f m beside that line\n",
-              cop_min, cop_max, cop_side);
+              figures.cop_min, figures.cop_max, figures.cop_side);
   std::printf("  double support: each foot's centre of pressure within %.3f m of its heel "
               "(leading) or toe (trailing)\n",
-              cop_shift);
-  std::printf("  centre of pressure: planned path missed by %.3f m at most\n", cop_error);
+              figures.cop_shift);
+  std::printf("  centre of pressure: planned path missed by %.3f m at most\n", trial.cop_error);
   std::printf("  inverse kinematics error %.1e m, split error %.1e, lowest toe in mid-swing "
               "%.3f m\n",
-              ik_error, max_residual_split, min_toe);
-  for (const Leg& leg : legs)
+              grid.ik_error, figures.max_residual_split, grid.min_toe);
+  for (const Leg& leg : trial.legs)
     for (int j : leg.coordinate)
-      std::printf("  %-18s %7.1f .. %6.1f deg\n", model.coordinate_names[static_cast<std::size_t>(j)].c_str(),
-                  q_min[static_cast<std::size_t>(j)] * 180.0 / kPi,
-                  q_max[static_cast<std::size_t>(j)] * 180.0 / kPi);
+      std::printf("  %-18s %7.1f .. %6.1f deg\n",
+                  model.coordinate_names[static_cast<std::size_t>(j)].c_str(),
+                  figures.q_min[static_cast<std::size_t>(j)] * 180.0 / kPi,
+                  figures.q_max[static_cast<std::size_t>(j)] * 180.0 / kPi);
+}
+
+void run(const Options& options) {
+  jle::ModelOptions model_options;
+  model_options.floating_base = true;
+  const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
+  if (model.link_name[0] != "pelvis")
+    throw std::runtime_error(options.urdf + ": the root link is '" + model.link_name[0] +
+                             "', make_gait_bag needs 'pelvis'");
+  jle::Data<double> data(model);
+  jle::VectorX<double> q;
+  const Trial trial = planTrial(model, data, options.urdf, q);
+  const Grid grid = solveGrid(model, data, trial, options.strides, q, options.urdf);
+  const Plates plates = layPlates(trial, grid);
+
+  Figures figures;
+  figures.q_min.assign(static_cast<std::size_t>(model.nq), 1e9);
+  figures.q_max.assign(static_cast<std::size_t>(model.nq), -1e9);
+  TrialWriter writer(model, options, plates);
+  writer.writePlatePoses();
+  jle::VectorX<double> qd(model.nq), qdd(model.nq);
+  for (long long k = 0; k < grid.samples; ++k) {
+    const std::size_t c = static_cast<std::size_t>(k + 2);
+    fivePoint(grid.q, c, grid.h, qd, qdd);
+    for (std::size_t j = 0; j < figures.q_min.size(); ++j) {
+      figures.q_min[j] = std::min(figures.q_min[j], grid.q[c][static_cast<int>(j)]);
+      figures.q_max[j] = std::max(figures.q_max[j], grid.q[c][static_cast<int>(j)]);
+    }
+    const double g = grid.g0 + static_cast<double>(k) * grid.h;
+    const Reaction r = groundReaction(model, data, trial, grid.q[c], qd, qdd, g, figures);
+    writer.write(k, r, trial.pelvis.at(g), grid.q[c], qd, qdd, figures);
+  }
+  writer.commit();
+  printReport(model, options, trial, grid, plates, figures);
 }
 
 }  // namespace
@@ -844,4 +940,3 @@ void run(const Options& options) {
 int main(int argc, char** argv) {
   return jle::cli::runTool(argc, argv, "make_gait_bag", kUsage, parseOptions, run);
 }
-

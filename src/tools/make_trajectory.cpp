@@ -5,22 +5,19 @@
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <map>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace {
 
-using jle::cli::UsageError;
-using jle::cli::optionValues;
+using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
     R"(usage: make_trajectory --urdf ROBOT.urdf [--duration 2.0] [--rate 1000] [--seed 1]
@@ -69,21 +66,11 @@ struct Options {
   std::uint32_t seed = 1;
 };
 
-
-double parseNumber(const std::string& key, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
-    throw UsageError(key + ": '" + text + "' is not a finite number");
-  return v;
-}
-
 Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v = optionValues(
       argc, argv, {"--urdf", "--duration", "--rate", "--seed", "--wrench", "--output"});
   Options options;
-  if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
-  options.urdf = v["--urdf"];
+  options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   if (v.count("--output")) options.output = v["--output"];
   if (v.count("--wrench")) options.wrench_link = v["--wrench"];
   if (v.count("--duration")) options.duration = parseNumber("--duration", v["--duration"]);
@@ -91,23 +78,72 @@ Options parseOptions(int argc, char** argv) {
   if (options.duration < 0.0) throw UsageError("--duration: must be >= 0");
   if (!(options.rate > 0.0)) throw UsageError("--rate: must be > 0");
   if (options.duration * options.rate > 1e9) throw UsageError("--duration * --rate: over 1e9 rows");
-  if (v.count("--seed")) {
-    const std::string& text = v["--seed"];
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long seed = std::strtoull(text.c_str(), &end, 10);
-    if (text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || seed > 4294967295ULL)
-      throw UsageError("--seed: '" + text + "' is not an integer in 0 .. 4294967295");
-    options.seed = static_cast<std::uint32_t>(seed);
-  }
+  if (v.count("--seed"))
+    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;
 }
-
-using jle::Uniform;
 
 struct Sine {
   double amplitude = 0.0, omega = 0.0, phase = 0.0;
 };
+
+// The trajectory's numbers, in the documented draw order (kUsage).
+struct Trajectory {
+  std::vector<std::vector<Sine>> coordinates;  // model.coordinate_names order
+  std::vector<double> offsets;                 // of the wrench components fx .. mz
+  std::vector<Sine> components;                // of the wrench components fx .. mz
+};
+
+Trajectory randomTrajectory(const jle::Model<double>& model, bool wrench, std::uint32_t seed) {
+  jle::PortableRandom random(seed);
+  Trajectory out;
+  out.coordinates.resize(static_cast<std::size_t>(model.nq));
+  for (int k = 0; k < model.nq; ++k) {
+    const int s = model.segmentOfJoint(model.coordinate_names[k]);
+    const bool prismatic = model.joint_type[s] == jle::JointType::kPrismatic;
+    const int terms = random.uniform() < 0.5 ? 2 : 3;
+    for (int j = 0; j < terms; ++j) {
+      Sine sine;
+      sine.amplitude = prismatic ? random.uniform(0.002, 0.01) : random.uniform(0.05, 0.4);
+      sine.omega = kTwoPi * random.uniform(0.1, 0.8);
+      sine.phase = random.uniform(0.0, kTwoPi);
+      out.coordinates[k].push_back(sine);
+    }
+  }
+  if (wrench)
+    for (int i = 0; i < 6; ++i) {
+      const double scale = i < 3 ? 10.0 : 1.0;
+      out.offsets.push_back(random.uniform(-scale, scale));
+      Sine sine;
+      sine.amplitude = random.uniform(0.0, scale);
+      sine.omega = kTwoPi * random.uniform(0.1, 1.0);
+      sine.phase = random.uniform(0.0, kTwoPi);
+      out.components.push_back(sine);
+    }
+  return out;
+}
+
+// One row at time t: t, then q, qd, qdd of each coordinate, then the wrench.
+void fillRow(const Trajectory& trajectory, double t, double* out) {
+  *out++ = t;
+  for (const std::vector<Sine>& sines : trajectory.coordinates) {
+    double q = 0.0, qd = 0.0, qdd = 0.0;
+    for (const Sine& s : sines) {
+      const double angle = s.omega * t + s.phase;
+      const double sin = std::sin(angle), cos = std::cos(angle);
+      q += s.amplitude * sin;
+      qd += s.amplitude * s.omega * cos;
+      qdd -= s.amplitude * s.omega * s.omega * sin;
+    }
+    *out++ = q;
+    *out++ = qd;
+    *out++ = qdd;
+  }
+  for (std::size_t c = 0; c < trajectory.components.size(); ++c) {
+    const Sine& s = trajectory.components[c];
+    *out++ = trajectory.offsets[c] + s.amplitude * std::sin(s.omega * t + s.phase);
+  }
+}
 
 void run(const Options& options) {
   const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf);
@@ -119,33 +155,7 @@ void run(const Options& options) {
       throw UsageError("--wrench: no link '" + options.wrench_link + "' in " + options.urdf);
     wrench_links.push_back(options.wrench_link);
   }
-
-  Uniform uniform(options.seed);
-  std::vector<std::vector<Sine>> coordinates(static_cast<std::size_t>(model.nq));
-  for (int k = 0; k < model.nq; ++k) {
-    const int s = model.segmentOfJoint(model.coordinate_names[k]);
-    const bool prismatic = model.joint_type[s] == jle::JointType::kPrismatic;
-    const int terms = uniform() < 0.5 ? 2 : 3;
-    for (int j = 0; j < terms; ++j) {
-      Sine sine;
-      sine.amplitude = prismatic ? uniform(0.002, 0.01) : uniform(0.05, 0.4);
-      sine.omega = kTwoPi * uniform(0.1, 0.8);
-      sine.phase = uniform(0.0, kTwoPi);
-      coordinates[k].push_back(sine);
-    }
-  }
-  std::vector<double> offsets;
-  std::vector<Sine> components;
-  if (!wrench_links.empty())
-    for (int i = 0; i < 6; ++i) {
-      const double scale = i < 3 ? 10.0 : 1.0;
-      offsets.push_back(uniform(-scale, scale));
-      Sine sine;
-      sine.amplitude = uniform(0.0, scale);
-      sine.omega = kTwoPi * uniform(0.1, 1.0);
-      sine.phase = uniform(0.0, kTwoPi);
-      components.push_back(sine);
-    }
+  const Trajectory trajectory = randomTrajectory(model, !wrench_links.empty(), options.seed);
 
   const std::vector<std::string> names = jle::stateColumnNames(model, wrench_links);
   std::vector<double> row(names.size());
@@ -153,26 +163,7 @@ void run(const Options& options) {
   writer.writeHeader(names);
   const long long rows = std::llround(options.duration * options.rate);
   for (long long i = 0; i <= rows; ++i) {
-    const double t = static_cast<double>(i) / options.rate;
-    double* out = row.data();
-    *out++ = t;
-    for (const std::vector<Sine>& sines : coordinates) {
-      double q = 0.0, qd = 0.0, qdd = 0.0;
-      for (const Sine& s : sines) {
-        const double angle = s.omega * t + s.phase;
-        const double sin = std::sin(angle), cos = std::cos(angle);
-        q += s.amplitude * sin;
-        qd += s.amplitude * s.omega * cos;
-        qdd -= s.amplitude * s.omega * s.omega * sin;
-      }
-      *out++ = q;
-      *out++ = qd;
-      *out++ = qdd;
-    }
-    for (std::size_t c = 0; c < components.size(); ++c) {
-      const Sine& s = components[c];
-      *out++ = offsets[c] + s.amplitude * std::sin(s.omega * t + s.phase);
-    }
+    fillRow(trajectory, static_cast<double>(i) / options.rate, row.data());
     writer.writeRow(row.data(), row.size());
   }
   writer.commit();

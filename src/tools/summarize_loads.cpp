@@ -3,16 +3,16 @@
 // RMS difference from the measured effort when the joint states carried one). Used by
 // the headless demo (launch/demo.launch rviz:=false).
 #include <joint_load_estimator/JointLoads.h>
+#include <joint_load_estimator/command_line.hpp>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -33,7 +33,8 @@ came with the joint states; then the number of messages and the span of their st
 It stops on SIGINT or SIGTERM (roslaunch stopping it), when ROS shuts down, after N
 messages (--count), or when no message has arrived for S seconds of wall time once the
 first has (--idle). The table goes to standard output and, with --output, to FILE.
-Exit status: 0, or 2 for a usage error.
+Exit status: 0; 1 if FILE cannot be written; 2 a usage error (an unknown or repeated
+option, a bad value).
 )";
 
 std::atomic<bool> g_stop{false};
@@ -143,60 +144,23 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
+  std::map<std::string, std::string> v =
+      jle::cli::optionValues(argc, argv, {"--topic", "--output", "--count", "--idle"});
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const std::size_t eq = arg.find('=');
-    const std::string key = arg.substr(0, eq);
-    std::string value;
-    if (eq != std::string::npos) {
-      value = arg.substr(eq + 1);
-    } else {
-      if (i + 1 >= argc) throw std::invalid_argument(key + " needs a value");
-      value = argv[++i];
-    }
-    char* end = nullptr;
-    errno = 0;
-    if (key == "--topic") {
-      o.topic = value;
-    } else if (key == "--output") {
-      o.output = value;
-    } else if (key == "--count") {
-      o.count = std::strtol(value.c_str(), &end, 10);
-      if (end == value.c_str() || *end != '\0' || errno != 0 || o.count < 1)
-        throw std::invalid_argument("--count: '" + value + "' is not a positive integer");
-    } else if (key == "--idle") {
-      o.idle = std::strtod(value.c_str(), &end);
-      if (end == value.c_str() || *end != '\0' || !(o.idle > 0.0) || !std::isfinite(o.idle))
-        throw std::invalid_argument("--idle: '" + value + "' is not a positive number");
-    } else {
-      throw std::invalid_argument("unknown option '" + arg + "'");
-    }
-    if (value.empty()) throw std::invalid_argument(key + ": empty value");
-  }
+  if (v.count("--topic")) o.topic = v["--topic"];
+  if (v.count("--output")) o.output = v["--output"];
+  if (v.count("--count"))
+    o.count = static_cast<long>(jle::cli::parseInteger("--count", v["--count"], 1,
+                                                       std::numeric_limits<long>::max()));
+  if (v.count("--idle"))
+    o.idle = jle::cli::parseNumber("--idle", v["--idle"], jle::cli::Sign::kPositive);
   return o;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  // Our own handlers: the table is printed on the way out, not lost to ROS's.
-  ros::init(argc, argv, "summarize_loads", ros::init_options::NoSigintHandler);
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  Options options;
-  try {
-    options = parseOptions(argc, argv);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "summarize_loads: %s (see summarize_loads --help)\n", e.what());
-    return 2;
-  }
+// Listens until told to stop (kUsage), then prints the table.
+void run(const Options& options) {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-
   ros::NodeHandle nh;
   Summary summary;
   ros::WallTime last_message;
@@ -219,13 +183,19 @@ int main(int argc, char** argv) {
   const std::string table = summary.table(nh.resolveName(options.topic));
   std::fputs(table.c_str(), stdout);
   std::fflush(stdout);
+  ros::shutdown();
   if (!options.output.empty()) {
     std::FILE* f = std::fopen(options.output.c_str(), "w");
-    if (f == nullptr || std::fputs(table.c_str(), f) < 0 || std::fclose(f) != 0) {
-      std::fprintf(stderr, "summarize_loads: cannot write %s\n", options.output.c_str());
-      return 1;
-    }
+    if (f == nullptr || std::fputs(table.c_str(), f) < 0 || std::fclose(f) != 0)
+      throw std::runtime_error("cannot write " + options.output);
   }
-  ros::shutdown();
-  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Our own handlers: the table is printed on the way out, not lost to ROS's. ros::init
+  // takes its remappings out of argv.
+  ros::init(argc, argv, "summarize_loads", ros::init_options::NoSigintHandler);
+  return jle::cli::runTool(argc, argv, "summarize_loads", kUsage, parseOptions, run);
 }

@@ -18,10 +18,11 @@
 #include <fstream>
 #include <functional>
 #include <future>
-#include <random>
 #include <sstream>
 
 #include "node_test_common.hpp"
+
+#include <joint_load_estimator/portable_random.hpp>
 
 namespace {
 
@@ -319,14 +320,13 @@ TEST(Calibration, RefusedWhileMoving) {
 TEST(Calibration, RecoversTheBiasWithinItsNoise) {
   SensorNode calib("calib");
   ASSERT_TRUE(calib.connect());
-  std::mt19937 rng(20240611);
-  std::normal_distribution<double> noise(0.0, 1.0);
+  jle::PortableRandom random(20240611);
   auto biased = [&](const ros::Time&) {
     Sample s{kStill, {}, {}};
     staticReading(kStill[1], s.f, s.m);
     for (int i = 0; i < 3; ++i) {
-      s.f[i] += kBiasForce[i] + kSigmaForce * noise(rng);
-      s.m[i] += kBiasTorque[i] + kSigmaTorque * noise(rng);
+      s.f[i] += kBiasForce[i] + kSigmaForce * random.gaussian();
+      s.m[i] += kBiasTorque[i] + kSigmaTorque * random.gaussian();
     }
     return s;
   };

@@ -7,6 +7,8 @@
 // node's input queues never overflow and the order of events is the order of sending.
 #include "node_test_common.hpp"
 
+#include <joint_load_estimator/portable_random.hpp>
+
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -15,7 +17,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <random>
 
 namespace {
 
@@ -56,11 +57,12 @@ struct SumOfSines {
 
 // Stamps 1 ms apart with +-0.3 ms of jitter (whole nanoseconds, fixed seed).
 std::vector<ros::Time> jitteredStamps(const ros::Time& first, int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> jitter(-300000, 300000);  // [ns]
+  jle::PortableRandom random(seed);
   std::vector<ros::Time> stamps{first};
-  for (int k = 1; k < n; ++k)
-    stamps.push_back(stamps.back() + ros::Duration(0, 1000000 + jitter(rng)));
+  for (int k = 1; k < n; ++k) {
+    const int jitter = random.index(600001) - 300000;  // [ns]
+    stamps.push_back(stamps.back() + ros::Duration(0, 1000000 + jitter));
+  }
   return stamps;
 }
 

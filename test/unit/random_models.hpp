@@ -1,11 +1,13 @@
-// Random robot models as URDF strings, deterministic from a seed, and the error of the
-// joint loads computed in one scalar type against a more precise one on the same
-// inputs. Shared by test/unit/test_stability.cpp and bench/stability.cpp.
+// The tests' random numbers (jle::PortableRandom with the draws tests need: vectors,
+// rotations, log-uniform numbers), random robot models as URDF strings, deterministic
+// from a seed, and the error of the joint loads computed in one scalar type against a
+// more precise one on the same inputs. Shared by the unit tests and bench/stability.cpp.
 #pragma once
 
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -14,38 +16,47 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <random>
 #include <string>
 #include <vector>
 
 namespace jle_test {
 
-/// Uniform numbers from std::mt19937, whose sequence the standard fixes (the standard
-/// distributions are implementation-defined): the same seed gives the same model on
-/// every platform.
-class Random {
+/// jle::PortableRandom (the same seed gives the same model on every platform), with
+/// the draws the random models need.
+class Random : public jle::PortableRandom {
  public:
-  explicit Random(std::uint32_t seed) : gen_(seed) {}
-  /// Uniform in [lo, hi), 53 random bits.
-  double uniform(double lo, double hi) {
-    const std::uint64_t a = gen_() >> 5, b = gen_() >> 6;  // 27 + 26 bits
-    const double u =
-        (static_cast<double>(a) * 67108864.0 + static_cast<double>(b)) * (1.0 / 9007199254740992.0);
-    return lo + (hi - lo) * u;
-  }
+  using jle::PortableRandom::PortableRandom;
   /// Log-uniform in [lo, hi] (lo > 0).
   double logUniform(double lo, double hi) { return lo * std::pow(hi / lo, uniform(0.0, 1.0)); }
-  /// Uniform in 0..n-1.
-  int index(int n) { return static_cast<int>(uniform(0.0, 1.0) * n); }
   /// Uniform on the unit sphere.
   Eigen::Vector3d unitVector() {
     const double z = uniform(-1.0, 1.0), phi = uniform(0.0, 2.0 * M_PI);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     return Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
   }
+  /// Uniform in the cube [-half_range, half_range)^3 (x, y, z drawn in that order).
+  Eigen::Vector3d vector(double half_range) {
+    const double x = uniform(-half_range, half_range), y = uniform(-half_range, half_range),
+                 z = uniform(-half_range, half_range);
+    return Eigen::Vector3d(x, y, z);
+  }
+  /// A uniformly random rotation: the unit quaternion of four normal numbers (w, x, y, z
+  /// drawn in that order).
+  Eigen::Matrix3d rotation() {
+    const double w = gaussian(), x = gaussian(), y = gaussian(), z = gaussian();
+    return Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
+  }
+};
+
+/// Uniform in [lo, hi) from a Random, used like a distribution: UniformIn u(lo, hi);
+/// u(rng).
+class UniformIn {
+ public:
+  UniformIn(double lo, double hi) : lo_(lo), hi_(hi) {}
+  double operator()(Random& rng) const { return rng.uniform(lo_, hi_); }
 
  private:
-  std::mt19937 gen_;
+  double lo_, hi_;
 };
 
 /// What randomUrdf() builds. Every link has a mass and an inertia; the base is fixed.
@@ -136,14 +147,22 @@ inline std::string randomUrdf(const RandomModelSpec& spec) {
   return xml;
 }
 
-/// A joint state: q uniform in [-pi, pi] (prismatic: [-length, length]), qd in
-/// [-qd_scale, qd_scale], qdd in [-qdd_scale, qdd_scale].
+/// A joint state, coordinates in model.coordinate_names order.
 struct State {
   Eigen::VectorXd q, qd, qdd;
 };
 
-inline State randomState(const jle::Model<double>& model, Random& rng, double qd_scale,
-                         double qdd_scale, double length = 0.3) {
+/// Where randomState draws: each quantity uniform in centre +- half-width, revolute and
+/// prismatic coordinates apart [rad or m, /s, /s^2], in the order
+/// {q, qd, qdd, prismatic_centre, prismatic_q, prismatic_qd, prismatic_qdd}.
+struct StateRanges {
+  double q = M_PI, qd = 1.0, qdd = 5.0;  ///< revolute: q in [-q, q)
+  double prismatic_centre = 0.0;          ///< prismatic: q in prismatic_centre +- prismatic_q
+  double prismatic_q = 0.3, prismatic_qd = 1.0, prismatic_qdd = 5.0;
+};
+
+/// A random joint state; per coordinate q, qd, qdd drawn in that order.
+inline State randomState(const jle::Model<double>& model, Random& rng, const StateRanges& r) {
   State s;
   s.q.resize(model.nq);
   s.qd.resize(model.nq);
@@ -152,11 +171,40 @@ inline State randomState(const jle::Model<double>& model, Random& rng, double qd
   for (int i : model.moving_segments)
     if (model.joint_type[i] == jle::JointType::kPrismatic) prismatic[model.coordinate[i]] = 1;
   for (int k = 0; k < model.nq; ++k) {
-    s.q[k] = prismatic[k] ? rng.uniform(-length, length) : rng.uniform(-M_PI, M_PI);
-    s.qd[k] = rng.uniform(-qd_scale, qd_scale);
-    s.qdd[k] = rng.uniform(-qdd_scale, qdd_scale);
+    s.q[k] = prismatic[k] ? r.prismatic_centre + rng.uniform(-r.prismatic_q, r.prismatic_q)
+                          : rng.uniform(-r.q, r.q);
+    const double qd = prismatic[k] ? r.prismatic_qd : r.qd;
+    const double qdd = prismatic[k] ? r.prismatic_qdd : r.qdd;
+    s.qd[k] = rng.uniform(-qd, qd);
+    s.qdd[k] = rng.uniform(-qdd, qdd);
   }
   return s;
+}
+
+/// q uniform in [-pi, pi) (prismatic: [-length, length)), qd in [-qd_scale, qd_scale),
+/// qdd in [-qdd_scale, qdd_scale).
+inline State randomState(const jle::Model<double>& model, Random& rng, double qd_scale,
+                         double qdd_scale, double length = 0.3) {
+  StateRanges r;
+  r.qd = r.prismatic_qd = qd_scale;
+  r.qdd = r.prismatic_qdd = qdd_scale;
+  r.prismatic_q = length;
+  return randomState(model, rng, r);
+}
+
+/// A random floating-base state: a uniformly random rotation, then the position,
+/// velocity, angular velocity, acceleration and angular acceleration each uniform in a
+/// cube of the given half-width [m, m/s, rad/s, m/s^2, rad/s^2], in that order.
+inline jle::BaseState<double> randomBase(Random& rng, double p, double v, double omega, double a,
+                                         double alpha) {
+  jle::BaseState<double> base;
+  base.R_world_base = rng.rotation();
+  base.p_world_base = rng.vector(p);
+  base.v_world = rng.vector(v);
+  base.omega_world = rng.vector(omega);
+  base.a_world = rng.vector(a);
+  base.alpha_world = rng.vector(alpha);
+  return base;
 }
 
 /// A wrench applied to the robot (dynamics.hpp's addExternalWrench), given in double.

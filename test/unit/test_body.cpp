@@ -9,6 +9,8 @@
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "tool_test.hpp"
+
 #include <gtest/gtest.h>
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
@@ -20,16 +22,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -56,49 +51,15 @@ constexpr double kHatMass = 0.678, kHatCom = 0.626;
 constexpr double kThighLength = 0.245, kShankLength = 0.246, kAnkleHeight = 0.039,
                  kFootLength = 0.152, kHipWidth = 0.191, kHatLength = 0.818 - 0.530;
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using jle_test::Result;
+using jle_test::readFile;
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-class BodyTool : public ::testing::Test {
+class BodyTool : public jle_test::ToolTest {
  protected:
-  void SetUp() override {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/jle_test_body_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr) << std::strerror(errno);
-    dir_ = pattern;
-    fs::create_directory(dir_ + "/out");
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  BodyTool() : ToolTest("jle_test_body") {}
 
   Result run(const std::vector<std::string>& args) const {
-    std::string command = quote(JLE_MAKE_BODY_URDF);
-    for (const std::string& a : args) command += " " + quote(a);
-    command += " >" + quote(path("stdout.txt")) + " 2>" + quote(path("stderr.txt"));
-    const int raw = std::system(command.c_str());
-    Result r;
-    r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = readFile(path("stdout.txt"));
-    r.err = readFile(path("stderr.txt"));
-    return r;
+    return ToolTest::run(JLE_MAKE_BODY_URDF, args);
   }
   // The model the tool writes for `args`; fails the test if the tool fails.
   jle::Model<double> generate(std::vector<std::string> args, bool floating = false) const {
@@ -109,8 +70,6 @@ class BodyTool : public ::testing::Test {
     options.floating_base = floating;
     return jle::modelFromUrdfFile(path("out/body.urdf"), options);
   }
-
-  std::string dir_;
 };
 
 jle::Model<double> bundled(bool floating = false) {

@@ -1,15 +1,18 @@
 // The command-line tools joint_loads and make_trajectory, run as processes: their CSV
 // plumbing (column mapping, order, frames, number formatting), their refusal of bad
-// input with one located message and no output file, and make_trajectory's formula.
+// input with one located message and no output file, and make_trajectory's formula;
+// and the option values' parsers that every tool shares (command_line.hpp).
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include "tool_test.hpp"
 
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,10 +21,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -33,71 +34,12 @@ const std::string kData = JLE_TEST_DATA;
 const std::string kPandaChain = kData + "/urdf/chains/panda_chain.urdf";
 const std::string kPanda = kData + "/urdf/panda.urdf";
 
-// ------------------------------------------------------------------ processes, files
+using jle_test::Result;
+using jle_test::Table;
+using jle_test::readFile;
+using jle_test::writeFile;
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void writeFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-struct Result {
-  int status = -1;  // exit status, -1 if the process did not exit normally
-  std::string out, err;
-};
-
-// A CSV as text cells; a parser of its own, so that the tools' reader is not its own judge.
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-
-  int column(const std::string& name) const {
-    const auto it = std::find(header.begin(), header.end(), name);
-    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
-  }
-  double number(std::size_t row, const std::string& name) const {
-    const int c = column(name);
-    EXPECT_GE(c, 0) << name;
-    return c < 0 ? 0.0 : std::strtod(rows[row][c].c_str(), nullptr);
-  }
-};
-
-std::vector<std::string> splitCells(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream s(line);
-  std::string cell;
-  while (std::getline(s, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.push_back("");
-  return cells;
-}
-
-Table parseTable(const std::string& text) {
-  Table table;
-  std::stringstream s(text);
-  std::string line;
-  bool first = true;
-  while (std::getline(s, line)) {
-    if (first) {
-      table.header = splitCells(line);
-      first = false;
-    } else {
-      table.rows.push_back(splitCells(line));
-    }
-  }
-  return table;
-}
+Table parseTable(const std::string& text) { return jle_test::parseCsv(text); }
 
 std::string formatTable(const Table& table, const std::string& end_of_line = "\n") {
   const auto join = [&](const std::vector<std::string>& cells) {
@@ -112,35 +54,12 @@ std::string formatTable(const Table& table, const std::string& end_of_line = "\n
 
 // One temporary directory per test: inputs and captured streams at the top, the tools'
 // outputs in out/, which must stay empty whenever a tool fails.
-class CliTest : public ::testing::Test {
+class CliTest : public jle_test::ToolTest {
  protected:
-  void SetUp() override {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/jle_test_cli_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr) << pattern << ": " << std::strerror(errno);
-    dir_ = pattern;
-    fs::create_directory(outDir());
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
+  CliTest() : ToolTest("jle_test_cli") {}
 
-  std::string path(const std::string& name) const { return dir_ + "/" + name; }
-  std::string outDir() const { return dir_ + "/out"; }
   std::string outPath() const { return outDir() + "/loads.csv"; }
 
-  Result run(const std::string& program, const std::vector<std::string>& args) const {
-    std::string command = quote(program);
-    for (const std::string& a : args) command += " " + quote(a);
-    command += " >" + quote(path("stdout.txt")) + " 2>" + quote(path("stderr.txt"));
-    const int raw = std::system(command.c_str());
-    Result r;
-    r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = readFile(path("stdout.txt"));
-    r.err = readFile(path("stderr.txt"));
-    return r;
-  }
   Result jointLoads(const std::vector<std::string>& args) const {
     return run(JLE_JOINT_LOADS, args);
   }
@@ -162,8 +81,6 @@ class CliTest : public ::testing::Test {
     for (const auto& e : fs::directory_iterator(outDir())) names.push_back(e.path().string());
     return names;
   }
-
-  std::string dir_;
 };
 
 // ------------------------------------------------------------------ the library's answer
@@ -721,6 +638,89 @@ TEST_F(CliTest, TrajectoryRefusesBadOptions) {
   const Result r = makeTrajectory({"--urdf", path("absent.urdf"), "--output", outPath()});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find(path("absent.urdf")), std::string::npos) << r.err;
+}
+
+// ------------------------------------------------------------------ option values
+
+// The message of the UsageError that `parse` throws ("" if it throws none).
+template <typename Parse>
+std::string usageError(Parse parse) {
+  try {
+    parse();
+  } catch (const jle::cli::UsageError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(CommandLine, NumbersAndTheirMessages) {
+  using jle::cli::Sign;
+  using jle::cli::parseNumber;
+  EXPECT_EQ(parseNumber("--rate", "2.5"), 2.5);
+  EXPECT_EQ(parseNumber("--rate", "-1e-3"), -1e-3);
+  for (const char* bad : {"abc", "1.5x", "", " ", "nan", "inf", "1e400", "2,5"})
+    EXPECT_EQ(usageError([&] { parseNumber("--rate", bad); }),
+              "--rate: '" + std::string(bad) + "' is not a finite number");
+  EXPECT_EQ(parseNumber("--noise", "0", Sign::kNonNegative), 0.0);
+  EXPECT_EQ(usageError([] { parseNumber("--noise", "-0.1", Sign::kNonNegative); }),
+            "--noise: '-0.1' is not a finite number >= 0");
+  EXPECT_EQ(parseNumber("--idle", "0.5", Sign::kPositive), 0.5);
+  EXPECT_EQ(usageError([] { parseNumber("--idle", "0", Sign::kPositive); }),
+            "--idle: '0' is not a finite number > 0");
+  EXPECT_EQ(usageError([] { parseNumber("--idle", "x", Sign::kPositive); }),
+            "--idle: 'x' is not a finite number > 0");
+  EXPECT_EQ(jle::cli::parseNumberIn("--mass", "500", 1.0, 500.0), 500.0);
+  EXPECT_EQ(usageError([] { jle::cli::parseNumberIn("--mass", "500.5", 1.0, 500.0); }),
+            "--mass: 500.5 is outside 1 .. 500");
+  EXPECT_EQ(usageError([] { jle::cli::parseNumberIn("--mass", "heavy", 1.0, 500.0); }),
+            "--mass: 'heavy' is not a finite number");
+}
+
+TEST(CommandLine, IntegersAndTheirMessages) {
+  using jle::cli::parseInteger;
+  EXPECT_EQ(parseInteger("--seed", "0", 0, 4294967295ULL), 0u);
+  EXPECT_EQ(parseInteger("--seed", "4294967295", 0, 4294967295ULL), 4294967295ULL);
+  for (const char* bad : {"-3", "+3", " 3", "3 ", "3x", "0x10", "", "4294967296",
+                          "18446744073709551616"})
+    EXPECT_EQ(usageError([&] { parseInteger("--seed", bad, 0, 4294967295ULL); }),
+              "--seed: '" + std::string(bad) + "' is not an integer in 0 .. 4294967295");
+  EXPECT_EQ(usageError([] { parseInteger("--strides", "0", 1, 100); }),
+            "--strides: '0' is not an integer in 1 .. 100");
+  EXPECT_EQ(parseInteger("--strides", "100", 1, 100), 100u);
+}
+
+TEST(CommandLine, RequiredValues) {
+  const std::map<std::string, std::string> values = {{"--urdf", "a.urdf"}};
+  EXPECT_EQ(jle::cli::requiredValue(values, "--urdf", "ROBOT.urdf"), "a.urdf");
+  EXPECT_EQ(usageError([&] { jle::cli::requiredValue(values, "--input", "STATES.csv"); }),
+            "--input STATES.csv is required");
+}
+
+TEST(CommandLine, NumberLists) {
+  double v[3] = {0, 0, 0};
+  ASSERT_TRUE(jle::cli::parseNumberList("0.5, -1.25 ,-9.7", 3, v));
+  EXPECT_EQ(v[0], 0.5);
+  EXPECT_EQ(v[1], -1.25);
+  EXPECT_EQ(v[2], -9.7);
+  for (const char* bad : {"0,-9.81", "0,0,-9.8,1", "0,0,nan", "0,zero,-9.8", "1,,2", "", "1,2,3,"})
+    EXPECT_FALSE(jle::cli::parseNumberList(bad, 3, v)) << bad;
+}
+
+TEST_F(CliTest, ToolsReportTheSharedMessages) {
+  const Result seed = makeTrajectory({"--urdf", kPanda, "--seed", "-3", "--output", outPath()});
+  EXPECT_EQ(seed.status, 2);
+  EXPECT_EQ(seed.err, "make_trajectory: --seed: '-3' is not an integer in 0 .. 4294967295 "
+                      "(see make_trajectory --help)\n");
+  const Result rate = makeTrajectory({"--urdf", kPanda, "--rate", "fast", "--output", outPath()});
+  EXPECT_EQ(rate.status, 2);
+  EXPECT_EQ(rate.err, "make_trajectory: --rate: 'fast' is not a finite number "
+                      "(see make_trajectory --help)\n");
+  const Result mass = jointLoads({"--urdf", kPanda, "--input", path("absent.csv"), "--per-kg",
+                                  "--body-mass", "0"});
+  EXPECT_EQ(mass.status, 2);
+  EXPECT_EQ(mass.err, "joint_loads: --body-mass: '0' is not a finite number > 0 "
+                      "(see joint_loads --help)\n");
+  EXPECT_EQ(outEntries(), std::vector<std::string>{});
 }
 
 }  // namespace

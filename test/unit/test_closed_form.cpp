@@ -16,6 +16,8 @@
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "random_models.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <gmock/gmock.h>
@@ -23,7 +25,6 @@
 
 #include <cmath>
 #include <iomanip>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -152,8 +153,8 @@ TEST(SinglePendulum, AboutZWithGravityAlongMinusY) {
   jle::Data<double> data(model);
   const Vec3 gravity(0, -kG, 0);
 
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-6.0, 6.0), acc(-40.0, 40.0);
+  jle_test::Random rng(11);
+  jle_test::UniformIn angle(-M_PI, M_PI), rate(-6.0, 6.0), acc(-40.0, 40.0);
   for (int trial = 0; trial < 50; ++trial) {
     const double q = angle(rng), qd = rate(rng), qdd = acc(rng);
     jle::forwardKinematics(model, data, vecx({q}), vecx({qd}), vecx({qdd}), gravity);
@@ -191,8 +192,8 @@ TEST(SinglePendulum, HangingAboutYWithGravityAlongMinusZ) {
   jle::Data<double> data(model);
   const Vec3 gravity(0, 0, -kG);
 
-  std::mt19937 rng(12);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-6.0, 6.0), acc(-40.0, 40.0);
+  jle_test::Random rng(12);
+  jle_test::UniformIn angle(-M_PI, M_PI), rate(-6.0, 6.0), acc(-40.0, 40.0);
   for (int trial = 0; trial < 50; ++trial) {
     const double q = angle(rng), qd = rate(rng), qdd = acc(rng);
     jle::forwardKinematics(model, data, vecx({q}), vecx({qd}), vecx({qdd}), gravity);
@@ -231,8 +232,8 @@ TEST(DoublePendulum, MatchesTextbookEquationsOfMotion) {
   const int s1 = model.segmentOfJoint("shoulder"), s2 = model.segmentOfJoint("elbow");
   jle::Data<double> data(model);
 
-  std::mt19937 rng(21);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-5.0, 5.0), acc(-30.0, 30.0);
+  jle_test::Random rng(21);
+  jle_test::UniformIn angle(-M_PI, M_PI), rate(-5.0, 5.0), acc(-30.0, 30.0);
   for (int trial = 0; trial < 100; ++trial) {
     const double q1 = angle(rng), q2 = angle(rng);
     const double qd1 = rate(rng), qd2 = rate(rng), qdd1 = acc(rng), qdd2 = acc(rng);
@@ -347,16 +348,6 @@ std::vector<jle::Model<double>> freeBodyModels(const FreeBody& b) {
   return out;
 }
 
-Mat3 randomRotation(std::mt19937& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
-}
-
-Vec3 randomVector(std::mt19937& rng, double half_range) {
-  std::uniform_real_distribution<double> u(-half_range, half_range);
-  return Vec3(u(rng), u(rng), u(rng));
-}
-
 TEST(FreeBody, ResidualIsNewtonEulerMinusAppliedWrenchAndWeight) {
   const FreeBody b;
   const Vec3 gravity(0, 0, -kG);
@@ -366,16 +357,10 @@ TEST(FreeBody, ResidualIsNewtonEulerMinusAppliedWrenchAndWeight) {
     ASSERT_EQ(model.link_name[0], "body");
     jle::Data<double> data(model);
     const int handle = model.frameIndex("handle");
-    std::mt19937 rng(31);
+    jle_test::Random rng(31);
     for (int trial = 0; trial < 30; ++trial) {
-      jle::BaseState<double> base;
-      base.R_world_base = randomRotation(rng);
-      base.p_world_base = randomVector(rng, 2.0);
-      base.v_world = randomVector(rng, 1.0);
-      base.omega_world = randomVector(rng, 4.0);
-      base.a_world = randomVector(rng, 10.0);
-      base.alpha_world = randomVector(rng, 20.0);
-      const Vec3 F = randomVector(rng, 50.0), M = randomVector(rng, 10.0);  // world, at handle
+      const jle::BaseState<double> base = jle_test::randomBase(rng, 2.0, 1.0, 4.0, 10.0, 20.0);
+      const Vec3 F = rng.vector(50.0), M = rng.vector(10.0);  // world, at handle
       jle::forwardKinematics(model, data, VecX(), VecX(), VecX(), gravity, base);
       jle::addExternalWrench(model, data, handle, F, M, jle::WrenchFrame::kWorld);
       jle::inverseDynamics(model, data);
@@ -408,15 +393,9 @@ TEST(FreeBody, MotionCausedByTheAppliedWrenchLeavesNoResidual) {
   for (const jle::Model<double>& model : freeBodyModels(b)) {
     jle::Data<double> data(model);
     const int handle = model.frameIndex("handle");
-    std::mt19937 rng(32);
+    jle_test::Random rng(32);
     for (int trial = 0; trial < 30; ++trial) {
-      jle::BaseState<double> base;
-      base.R_world_base = randomRotation(rng);
-      base.p_world_base = randomVector(rng, 2.0);
-      base.v_world = randomVector(rng, 1.0);
-      base.omega_world = randomVector(rng, 4.0);
-      base.a_world = randomVector(rng, 10.0);
-      base.alpha_world = randomVector(rng, 20.0);
+      const jle::BaseState<double> base = jle_test::randomBase(rng, 2.0, 1.0, 4.0, 10.0, 20.0);
 
       // The wrench that, with gravity, causes exactly this motion: Newton and Euler
       // about O, moved to the handle and expressed in the handle frame.
@@ -536,8 +515,8 @@ TEST(Prismatic, SliderCarriesItsWeightAndItsInertia) {
   const Vec3 c(0.03, -0.04, 0.12);
   Inertial slider{m, c, Vec3(0.2, 0.0, 0.1), inertiaMatrix(0.02, 0.03, 0.015)};
   const Vec3 gravity(0, 0, -kG);
-  std::mt19937 rng(41);
-  std::uniform_real_distribution<double> pos(-0.5, 0.5), rate(-2.0, 2.0), acc(-20.0, 20.0);
+  jle_test::Random rng(41);
+  jle_test::UniformIn pos(-0.5, 0.5), rate(-2.0, 2.0), acc(-20.0, 20.0);
 
   // Vertical slider: effort = m (qdd + g); then a slider inclined at cos(a) = 0.8 from the
   // vertical: effort = m (qdd + g cos a), the textbook inclined plane.
@@ -581,8 +560,8 @@ TEST(Prismatic, SliderOnATurningArmFeelsCoriolis) {
   const int s1 = model.segmentOfJoint("turn"), s2 = model.segmentOfJoint("slide");
   jle::Data<double> data(model);
 
-  std::mt19937 rng(43);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), radius(0.1, 0.8), rate(-4.0, 4.0),
+  jle_test::Random rng(43);
+  jle_test::UniformIn angle(-M_PI, M_PI), radius(0.1, 0.8), rate(-4.0, 4.0),
       acc(-30.0, 30.0);
   for (int trial = 0; trial < 50; ++trial) {
     const double th = angle(rng), r = radius(rng);
@@ -628,8 +607,8 @@ TEST(Mimic, LeaderAndFollowerAreTwoPendulumsOnOneCoordinate) {
   const int sA = model.segmentOfJoint("lead"), sB = model.segmentOfJoint("follow");
   jle::Data<double> data(model);
 
-  std::mt19937 rng(42);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-5.0, 5.0), acc(-30.0, 30.0);
+  jle_test::Random rng(42);
+  jle_test::UniformIn angle(-M_PI, M_PI), rate(-5.0, 5.0), acc(-30.0, 30.0);
   for (int trial = 0; trial < 30; ++trial) {
     const double q = angle(rng), qd = rate(rng), qdd = acc(rng);
     jle::forwardKinematics(model, data, vecx({q}), vecx({qd}), vecx({qdd}), Vec3(0, -kG, 0));
@@ -682,8 +661,8 @@ TEST(LumpedFixedJoint, EqualsOneLinkWithTheCombinedInertia) {
   const Vec3 gravity(0, 0, -kG);
   const Mat3 R_joint = rpyMatrix(j_rpy);
 
-  std::mt19937 rng(51);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-6.0, 6.0), acc(-40.0, 40.0);
+  jle_test::Random rng(51);
+  jle_test::UniformIn angle(-M_PI, M_PI), rate(-6.0, 6.0), acc(-40.0, 40.0);
   for (int trial = 0; trial < 30; ++trial) {
     const double q = angle(rng), qd = rate(rng), qdd = acc(rng);
     jle::forwardKinematics(lumped, dl, vecx({q}), vecx({qd}), vecx({qdd}), gravity);
@@ -728,8 +707,8 @@ TEST(KeptFixedJoint, SensorWrenchIsTheDistalNewtonEuler) {
   jle::Data<double> data(model);
   const Eigen::Vector2d g(0, -kG);
 
-  std::mt19937 rng(52);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), rate(-5.0, 5.0), acc(-30.0, 30.0);
+  jle_test::Random rng(52);
+  jle_test::UniformIn angle(-M_PI, M_PI), rate(-5.0, 5.0), acc(-30.0, 30.0);
   for (int trial = 0; trial < 50; ++trial) {
     const double q1 = angle(rng), q2 = angle(rng);
     const double qd1 = rate(rng), qd2 = rate(rng), qdd1 = acc(rng), qdd2 = acc(rng);

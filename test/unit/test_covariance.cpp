@@ -9,6 +9,8 @@
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "random_models.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -16,7 +18,6 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -573,8 +574,8 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
   if (kind == Stamps::kIrregular) {
     // dt uniform in 1 ms (1 +- jitter), and a 100 ms gap at 1 s (over 3 periods: the
     // history starts again; under the filter's max_gap of 0.5 s: the filter goes on).
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<double> dt(1e-3 * (1.0 - jitter), 1e-3 * (1.0 + jitter));
+    jle_test::Random rng(7);
+    const jle_test::UniformIn dt(1e-3 * (1.0 - jitter), 1e-3 * (1.0 + jitter));
     for (double t = 0.0; t < 2.0; t += t > 1.0 && t < 1.0015 ? 0.1 : dt(rng)) stamps.push_back(t);
   } else {
     const double h = kind == Stamps::k1kHz ? 1e-3 : 1e-2;
@@ -874,8 +875,8 @@ TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
       jle::Estimator exact(model, config);
       config.uncertainty.period = kDefaultPeriod;
       jle::Estimator guarded(model, config);
-      std::mt19937 rng(11);
-      std::uniform_real_distribution<double> dt(1e-3 * (1.0 - jitter), 1e-3 * (1.0 + jitter));
+      jle_test::Random rng(11);
+      const jle_test::UniformIn dt(1e-3 * (1.0 - jitter), 1e-3 * (1.0 + jitter));
       Eigen::VectorXd q, qd, qdd;
       double worst = 0.0;
       long published = 0, equal = 0;

@@ -1,11 +1,11 @@
 // The differentiators against polynomials they must reproduce exactly (at any
 // spacing), and the Kalman filter against a known steady state.
 #include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 namespace {
 
@@ -15,12 +15,12 @@ using jle::DifferentiatorType;
 
 // Times with +-40% jitter around 1 ms, from a fixed seed.
 std::vector<double> jitteredTimes(int n, double t0 = 3.0) {
-  std::mt19937 gen(7);
+  jle::PortableRandom random(7);
   std::vector<double> t;
   double now = t0;
   for (int i = 0; i < n; ++i) {
     t.push_back(now);
-    now += 1e-3 * (0.6 + 0.8 * (gen() / 4294967296.0));
+    now += 1e-3 * random.uniform(0.6, 1.4);
   }
   return t;
 }

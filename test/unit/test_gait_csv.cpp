@@ -2,51 +2,48 @@
 // (joint_loads --floating-base --plate ...): the path a biomechanist takes with a trial
 // of their own (docs/gait_demo.md). The plates explain the motion, so the pelvis residual
 // is what the generator's numerical derivatives leave.
+#include "tool_test.hpp"
+
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace {
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(cell);
-  return out;
-}
+using jle_test::Result;
 
-TEST(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
-  char dir_template[] = "/tmp/jle_gait_csv_XXXXXX";
-  ASSERT_NE(mkdtemp(dir_template), nullptr);
-  const std::string dir = dir_template;
+class GaitCsv : public jle_test::ToolTest {
+ protected:
+  GaitCsv() : ToolTest("jle_gait_csv") {}
+};
+
+TEST_F(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   const std::string urdf = std::string(JLE_TEST_DATA) + "/urdf/body_75kg_175cm.urdf";
-  const std::string make = std::string(JLE_MAKE_GAIT_BAG) + " --urdf " + urdf + " --output " +
-                           dir + "/gait.bag --csv " + dir + "/gait.csv > " + dir + "/report.txt";
-  ASSERT_EQ(std::system(make.c_str()), 0);
+  const Result make = run(JLE_MAKE_GAIT_BAG, {"--urdf", urdf, "--output", path("gait.bag"),
+                                              "--csv", path("gait.csv")});
+  ASSERT_EQ(make.status, 0) << make.err;
   // The generator prints the plate options to give joint_loads.
-  std::ifstream report(dir + "/report.txt");
+  std::vector<std::string> loads_args = {"--urdf",   urdf, "--input", path("gait.csv"),
+                                         "--output", path("loads.csv"), "--floating-base"};
+  std::istringstream report(make.out);
   std::string line, plates;
   while (std::getline(report, line))
     if (line.find("joint_loads: ") != std::string::npos)
       plates = line.substr(line.find("joint_loads: ") + 13);
   ASSERT_FALSE(plates.empty());
-  const std::string loads = std::string(JLE_JOINT_LOADS) + " --urdf " + urdf + " --input " + dir +
-                            "/gait.csv --output " + dir + "/loads.csv --floating-base " + plates +
-                            " --contact-threshold 1";
-  ASSERT_EQ(std::system(loads.c_str()), 0);
+  std::istringstream words(plates);
+  for (std::string word; words >> word;) loads_args.push_back(word);
+  loads_args.insert(loads_args.end(), {"--contact-threshold", "1"});
+  const Result loads = run(JLE_JOINT_LOADS, loads_args);
+  ASSERT_EQ(loads.status, 0) << loads.err;
 
-  std::ifstream in(dir + "/loads.csv");
-  ASSERT_TRUE(std::getline(in, line));
-  const std::vector<std::string> header = split(line);
+  const jle_test::Table table = jle_test::parseCsv(jle_test::readFile(path("loads.csv")));
+  const std::vector<std::string>& header = table.header;
   std::vector<int> force, moment;
   for (int i = 0; i < static_cast<int>(header.size()); ++i) {
     if (header[i] == "base.fx" || header[i] == "base.fy" || header[i] == "base.fz") force.push_back(i);
@@ -56,8 +53,7 @@ TEST(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   ASSERT_EQ(moment.size(), 3u);
   double max_force = 0.0, max_moment = 0.0;
   int rows = 0;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> cells = split(line);
+  for (const std::vector<std::string>& cells : table.rows) {
     double f2 = 0.0, m2 = 0.0;
     for (int i : force) f2 += std::pow(std::atof(cells[static_cast<std::size_t>(i)].c_str()), 2);
     for (int i : moment) m2 += std::pow(std::atof(cells[static_cast<std::size_t>(i)].c_str()), 2);
@@ -78,11 +74,6 @@ TEST(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   // (Without the plates the residual would be the body weight, 735 N.)
   EXPECT_LT(max_force, 3.0);
   EXPECT_LT(max_moment, 3.0);
-  std::remove((dir + "/gait.bag").c_str());
-  std::remove((dir + "/gait.csv").c_str());
-  std::remove((dir + "/loads.csv").c_str());
-  std::remove((dir + "/report.txt").c_str());
-  rmdir(dir.c_str());
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -37,11 +38,18 @@ Moments moments(const std::vector<double>& x) {
 }
 
 TEST(PortableRandom, MapsTheStandardEngineAsDocumented) {
-  // The standard fixes mt19937_64's 10000th output for the default seed 5489
-  // ([rand.predef]): 9981545732273789042. uniform() is its top 53 bits times 2^-53.
+  // The standard fixes mt19937's 10000th output for the default seed 5489
+  // ([rand.predef]): 4123659995. uniform() takes two outputs, (a 2^26 + b) 2^-53 with b
+  // the second one >> 6: the 5000th uniform() ends in the bits of the 10000th output
+  // (2^53 uniform() is an integer below 2^53, exact in a double).
   jle::PortableRandom rng(5489);
-  for (int i = 0; i < 9999; ++i) rng.uniform();
-  EXPECT_EQ(rng.uniform(), static_cast<double>(9981545732273789042ULL >> 11) * 0x1.0p-53);
+  for (int i = 0; i < 4999; ++i) rng.uniform();
+  const double u = rng.uniform() * 0x1.0p53;
+  EXPECT_EQ(std::fmod(u, 67108864.0), static_cast<double>(4123659995u >> 6));
+  EXPECT_EQ(u, std::floor(u));
+  // A seed below 2^32 seeds the engine as it is; above, its halves are folded.
+  jle::PortableRandom a(7), b((std::uint64_t{5} << 32) | 2);  // 2 ^ 5 = 7
+  EXPECT_EQ(a.uniform(), b.uniform());
 }
 
 TEST(PortableRandom, UniformAndGaussianHaveTheirMomentsAndRange) {

@@ -8,6 +8,8 @@
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "random_models.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -19,7 +21,6 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -47,39 +48,12 @@ std::string readFile(const std::string& path) {
 // ---------------------------------------------------------------------------------
 // Random states and wrenches.
 
-Vec3 randomVector(std::mt19937& rng, double half_range) {
-  std::uniform_real_distribution<double> u(-half_range, half_range);
-  return Vec3(u(rng), u(rng), u(rng));
-}
-
-Mat3 randomRotation(std::mt19937& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
-}
-
-struct State {
-  VecX q, qd, qdd;
-};
+using jle_test::State;
 
 // Joint angles over a full turn, rates and accelerations of a fast arm motion; sliders
 // (the panda's fingers) within their 4 cm stroke.
-State randomState(const jle::Model<double>& model, std::mt19937& rng) {
-  State s{VecX(model.nq), VecX(model.nq), VecX(model.nq)};
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int k = 0; k < model.nq; ++k) {
-    const int seg = static_cast<int>(
-        std::find(model.coordinate.begin(), model.coordinate.end(), k) - model.coordinate.begin());
-    if (model.joint_type[seg] == jle::JointType::kPrismatic) {
-      s.q[k] = 0.02 + 0.02 * u(rng);
-      s.qd[k] = 0.1 * u(rng);
-      s.qdd[k] = 1.0 * u(rng);
-    } else {
-      s.q[k] = M_PI * u(rng);
-      s.qd[k] = 3.0 * u(rng);
-      s.qdd[k] = 20.0 * u(rng);
-    }
-  }
-  return s;
+State randomState(const jle::Model<double>& model, jle_test::Random& rng) {
+  return jle_test::randomState(model, rng, {M_PI, 3.0, 20.0, 0.02, 0.02, 0.1, 1.0});
 }
 
 // `x` ordered like from.coordinate_names, reordered like to.coordinate_names.
@@ -93,15 +67,8 @@ VecX byName(const VecX& x, const jle::Model<double>& from, const jle::Model<doub
   return out;
 }
 
-jle::BaseState<double> randomBase(std::mt19937& rng) {
-  jle::BaseState<double> base;
-  base.R_world_base = randomRotation(rng);
-  base.p_world_base = randomVector(rng, 2.0);
-  base.v_world = randomVector(rng, 1.0);
-  base.omega_world = randomVector(rng, 2.0);
-  base.a_world = randomVector(rng, 5.0);
-  base.alpha_world = randomVector(rng, 10.0);
-  return base;
+jle::BaseState<double> randomBase(jle_test::Random& rng) {
+  return jle_test::randomBase(rng, 2.0, 1.0, 2.0, 5.0, 10.0);
 }
 
 // A wrench applied at a named link, in that link's frame or the world.
@@ -111,10 +78,10 @@ struct Applied {
   jle::WrenchFrame frame;
 };
 
-std::vector<Applied> randomWrenches(const std::vector<std::string>& links, std::mt19937& rng) {
+std::vector<Applied> randomWrenches(const std::vector<std::string>& links, jle_test::Random& rng) {
   std::vector<Applied> out;
   for (std::size_t k = 0; k < links.size(); ++k)
-    out.push_back({links[k], randomVector(rng, 100.0), randomVector(rng, 10.0),
+    out.push_back({links[k], rng.vector(100.0), rng.vector(10.0),
                    k % 2 ? jle::WrenchFrame::kWorld : jle::WrenchFrame::kLocal});
   return out;
 }
@@ -189,8 +156,8 @@ void setOrigin(tinyxml2::XMLElement* parent, const Pose& pose) {
   o->SetAttribute("rpy", vec(rpyOf(pose.R)).c_str());
 }
 
-Pose randomPose(std::mt19937& rng) {
-  return {rpyMatrix(randomVector(rng, 1.2)), randomVector(rng, 0.3)};
+Pose randomPose(jle_test::Random& rng) {
+  return {rpyMatrix(rng.vector(1.2)), rng.vector(0.3)};
 }
 
 tinyxml2::XMLElement* addLink(tinyxml2::XMLElement* robot, const std::string& name) {
@@ -240,7 +207,7 @@ std::string print(const tinyxml2::XMLDocument& doc) {
 // at a random pose in the joint's parent (the joint's origin re-expressed from the
 // mount, so nothing moves), and on every link a dangling marker link at a random pose,
 // half of them with an explicit zero-mass <inertial>.
-std::string withMasslessFrames(const std::string& xml, std::mt19937& rng) {
+std::string withMasslessFrames(const std::string& xml, jle_test::Random& rng) {
   tinyxml2::XMLDocument doc;
   EXPECT_EQ(doc.Parse(xml.c_str()), tinyxml2::XML_SUCCESS);
   tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
@@ -272,7 +239,7 @@ std::string withMasslessFrames(const std::string& xml, std::mt19937& rng) {
 // the two offsets add a m (1 - a) s^2 (1 - e e^T) about c, which the parts' own inertias,
 // a and (1 - a) times I minus that, give back. Taking e along the axis of the smallest
 // principal moment and s^2 small keeps both parts physical (positive, triangle).
-std::string withSplitMasses(const std::string& xml, std::mt19937& rng) {
+std::string withSplitMasses(const std::string& xml, jle_test::Random& rng) {
   tinyxml2::XMLDocument doc;
   EXPECT_EQ(doc.Parse(xml.c_str()), tinyxml2::XML_SUCCESS);
   tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
@@ -300,7 +267,7 @@ std::string withSplitMasses(const std::string& xml, std::mt19937& rng) {
     setInertial(l, a * m, Pose{Mat3::Identity(), c + (1 - a) * s * e}, a * I_rest);
     const Pose X_link_part = randomPose(rng);
     const Pose X_part_inertial =
-        X_link_part.inverse() * Pose{rpyMatrix(randomVector(rng, 1.2)), c - a * s * e};
+        X_link_part.inverse() * Pose{rpyMatrix(rng.vector(1.2)), c - a * s * e};
     // The inertia of the part, in its inertial axes.
     const Mat3 R = X_link_part.R * X_part_inertial.R;
     tinyxml2::XMLElement* part = addLink(robot, name + "_part");
@@ -353,7 +320,7 @@ class SameRobot : public testing::TestWithParam<std::string> {};
 
 TEST_P(SameRobot, MasslessFramesChangeNoLoad) {
   const std::string xml = readFile(urdfPath(GetParam()));
-  std::mt19937 rng(61);
+  jle_test::Random rng(61);
   const jle::Model<double> original = jle::modelFromUrdfString(xml);
   const jle::Model<double> edited = jle::modelFromUrdfString(withMasslessFrames(xml, rng));
   // The edit really added frames, none of them a segment.
@@ -374,7 +341,7 @@ TEST_P(SameRobot, MasslessFramesChangeNoLoad) {
 
 TEST_P(SameRobot, SplitMassesChangeNoLoad) {
   const std::string xml = readFile(urdfPath(GetParam()));
-  std::mt19937 rng(62);
+  jle_test::Random rng(62);
   const jle::Model<double> original = jle::modelFromUrdfString(xml);
   const jle::Model<double> edited = jle::modelFromUrdfString(withSplitMasses(xml, rng));
   ASSERT_GT(edited.frames.size(), original.frames.size());
@@ -423,22 +390,22 @@ TEST_P(WorldFrame, ChildFrameLoadsDoNotDependOnIt) {
   const jle::Model<double> model = jle::modelFromUrdfFile(urdfPath(scene.urdf), options);
   jle::Data<double> da(model), db(model);
   const std::vector<std::string> joints = movingJoints(model);
-  std::mt19937 rng(71);
+  jle_test::Random rng(71);
   for (int trial = 0; trial < 20; ++trial) {
     const State s = randomState(model, rng);
     jle::BaseState<double> base;  // the reference scene: the base at the world origin
     if (scene.floating) {
-      base.v_world = randomVector(rng, 1.0);
-      base.omega_world = randomVector(rng, 2.0);
-      base.a_world = randomVector(rng, 5.0);
-      base.alpha_world = randomVector(rng, 10.0);
+      base.v_world = rng.vector(1.0);
+      base.omega_world = rng.vector(2.0);
+      base.a_world = rng.vector(5.0);
+      base.alpha_world = rng.vector(10.0);
     }
     const std::vector<Applied> w = randomWrenches(scene.wrench_links, rng);
 
-    const Mat3 R = randomRotation(rng);
+    const Mat3 R = rng.rotation();
     jle::BaseState<double> moved;
     moved.R_world_base = R;
-    moved.p_world_base = randomVector(rng, 5.0);
+    moved.p_world_base = rng.vector(5.0);
     moved.v_world = R * base.v_world;
     moved.omega_world = R * base.omega_world;
     moved.a_world = R * base.a_world;
@@ -505,13 +472,7 @@ template <typename Scalar>
 Loads loadsIn(const jle::Model<double>& model_double, const State& s, const Vec3& gravity,
               const jle::BaseState<double>& base_double, const std::vector<Applied>& wrenches) {
   const jle::Model<Scalar> model = model_double.template cast<Scalar>();
-  jle::BaseState<Scalar> base;
-  base.R_world_base = base_double.R_world_base.cast<Scalar>();
-  base.p_world_base = base_double.p_world_base.cast<Scalar>();
-  base.v_world = base_double.v_world.cast<Scalar>();
-  base.omega_world = base_double.omega_world.cast<Scalar>();
-  base.a_world = base_double.a_world.cast<Scalar>();
-  base.alpha_world = base_double.alpha_world.cast<Scalar>();
+  const jle::BaseState<Scalar> base = jle_test::castBase<Scalar>(base_double);
   jle::Data<Scalar> data(model);
   solve(model, data, jle::VectorX<Scalar>(s.q.cast<Scalar>()),
         jle::VectorX<Scalar>(s.qd.cast<Scalar>()), jle::VectorX<Scalar>(s.qdd.cast<Scalar>()),
@@ -550,18 +511,18 @@ TEST_P(Precision, FloatDoubleAndLongDoubleAgree) {
   // The model itself rounded to float, so that the types share it exactly.
   const jle::Model<double> model =
       jle::modelFromUrdfFile(urdfPath(scene.urdf), options).cast<float>().cast<double>();
-  std::mt19937 rng(81);
+  jle_test::Random rng(81);
   double worst_double = 0, worst_float = 0;
   for (int trial = 0; trial < 20; ++trial) {
     State s = randomState(model, rng);
     s = {toFloat(s.q), toFloat(s.qd), toFloat(s.qdd)};
     jle::BaseState<double> base;
     if (scene.floating) {
-      base.R_world_base = randomRotation(rng).cast<float>().cast<double>();
-      base.p_world_base = toFloat(randomVector(rng, 2.0));
-      base.omega_world = toFloat(randomVector(rng, 2.0));
-      base.a_world = toFloat(randomVector(rng, 5.0));
-      base.alpha_world = toFloat(randomVector(rng, 10.0));
+      base.R_world_base = rng.rotation().cast<float>().cast<double>();
+      base.p_world_base = toFloat(rng.vector(2.0));
+      base.omega_world = toFloat(rng.vector(2.0));
+      base.a_world = toFloat(rng.vector(5.0));
+      base.alpha_world = toFloat(rng.vector(10.0));
     }
     std::vector<Applied> w = randomWrenches(scene.wrench_links, rng);
     for (Applied& a : w) {
@@ -628,12 +589,12 @@ TEST(JointWrenchFrames, ParentAndWorldAreTheChildWrenchRotated) {
     const jle::Model<double> model = jle::modelFromUrdfString(xml, options);
     const std::map<std::string, std::string> parent_of = parentLinks(xml);
     jle::Data<double> data(model);
-    std::mt19937 rng(91);
+    jle_test::Random rng(91);
     int lumped_parents = 0;
     for (int trial = 0; trial < 10; ++trial) {
       const State s = randomState(model, rng);
       jle::BaseState<double> base;
-      base.R_world_base = randomRotation(rng);
+      base.R_world_base = rng.rotation();
       solve(model, data, s.q, s.qd, s.qdd, kGravity, base,
             randomWrenches({model.frames.back().name}, rng));
       for (int i = 1; i < model.nsegments(); ++i) {
@@ -692,7 +653,7 @@ TEST(NewtonEuler, FloatingTalosResidualIsTheGlobalMomentumBalance) {
   const std::vector<std::string> links = {
       "left_sole_link",           "right_sole_link", "wrist_left_ft_tool_link",
       "wrist_right_ft_tool_link", "head_2_link",     "torso_2_link"};
-  std::mt19937 rng(101);
+  jle_test::Random rng(101);
   for (int trial = 0; trial < 20; ++trial) {
     const State s = randomState(model, rng);
     const jle::BaseState<double> base = randomBase(rng);

@@ -17,6 +17,8 @@
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "random_models.hpp"
+
 #include <gtest/gtest.h>
 #include <kdl/chain.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
@@ -35,7 +37,6 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <random>
 #include <set>
 #include <sstream>
 #include <string>
@@ -143,32 +144,12 @@ KDL::Tree kdlTree(const std::string& xml) {
 // ---------------------------------------------------------------------------------------
 // Random states and loads.
 
-/// Coordinates in the library's order (model.coordinate_names).
-struct State {
-  VectorX<double> q, qd, qdd;
-};
+using jle_test::State;
 
 /// q, qd, qdd uniform in ranges a real arm sees (revolute: +-pi rad, +-3 rad/s,
 /// +-10 rad/s^2; prismatic fingers: 0..4 cm, +-0.2 m/s, +-2 m/s^2).
-State randomState(const jle::Model<double>& model,
-                  const std::map<std::string, KdlJoint>& kdl_joints, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  State s;
-  s.q.resize(model.nq);
-  s.qd.resize(model.nq);
-  s.qdd.resize(model.nq);
-  for (int k = 0; k < model.nq; ++k) {
-    if (kdl_joints.at(model.coordinate_names[k]).prismatic) {
-      s.q[k] = 0.02 + 0.02 * u(rng);
-      s.qd[k] = 0.2 * u(rng);
-      s.qdd[k] = 2.0 * u(rng);
-    } else {
-      s.q[k] = M_PI * u(rng);
-      s.qd[k] = 3.0 * u(rng);
-      s.qdd[k] = 10.0 * u(rng);
-    }
-  }
-  return s;
+State randomState(const jle::Model<double>& model, jle_test::Random& rng) {
+  return jle_test::randomState(model, rng, {M_PI, 3.0, 10.0, 0.02, 0.02, 0.2, 2.0});
 }
 
 /// The same state as KDL arrays: each KDL joint takes its coordinate by name, a mimic
@@ -215,14 +196,13 @@ struct Load {
 };
 
 /// Random loads of up to 50 N and 10 N m on every link in `links`.
-std::vector<Load> randomLoads(const std::vector<std::string>& links, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
+std::vector<Load> randomLoads(const std::vector<std::string>& links, jle_test::Random& rng) {
   std::vector<Load> out;
   for (const std::string& link : links) {
     Load l;
     l.link = link;
-    l.force = 50.0 * Vector3d(u(rng), u(rng), u(rng));
-    l.moment = 10.0 * Vector3d(u(rng), u(rng), u(rng));
+    l.force = 50.0 * rng.vector(1.0);
+    l.moment = 10.0 * rng.vector(1.0);
     out.push_back(l);
   }
   return out;
@@ -373,9 +353,9 @@ Worst treeEffortDisagreement(const std::string& xml, int states, unsigned int se
 
   KDL::TreeIdSolver_RNE solver(tree, toKdl(kGravity));
   KDL::JntArray tau(tree.getNrOfJoints());
-  std::mt19937 rng(seed);
+  jle_test::Random rng(seed);
   for (int n = 0; n < states; ++n) {
-    const State s = randomState(model, kdl_joints, rng);
+    const State s = randomState(model, rng);
     const std::vector<Load> loads = randomLoads(leaves, rng);
     const KdlState k = toKdlState(model, tree, kdl_joints, mimics, s);
     if (solver.CartToJnt(k.q, k.qd, k.qdd, toKdlWrenches(loads), tau) < 0) {
@@ -429,7 +409,7 @@ TEST_P(KdlTree, LinkPosesAgreeWithTreeFkSolverPos) {
   const std::map<std::string, KdlJoint> kdl_joints = kdlJoints(tree);
   const std::map<std::string, Mimic> mimics = urdfMimics(xml);
   KDL::TreeFkSolverPos_recursive fk(tree);
-  std::mt19937 rng(7u);
+  jle_test::Random rng(7u);
   double worst = 0.0;
   std::string worst_where = "(none)";
   const auto compare = [&](const Eigen::Matrix3d& R, const Vector3d& p, const KDL::Frame& X,
@@ -445,7 +425,7 @@ TEST_P(KdlTree, LinkPosesAgreeWithTreeFkSolverPos) {
     }
   };
   for (int n = 0; n < 100; ++n) {
-    const State s = randomState(model, kdl_joints, rng);
+    const State s = randomState(model, rng);
     const KdlState k = toKdlState(model, tree, kdl_joints, mimics, s);
     jle::forwardKinematics(model, data, s.q, s.qd, s.qdd, kGravity);
     KDL::Frame X;
@@ -522,10 +502,10 @@ TEST_P(KdlChain, EffortsAgreeWithChainIdSolverRne) {
 
   KDL::ChainIdSolver_RNE solver(chain, toKdl(kGravity));
   KDL::JntArray kq(model.nq), kqd(model.nq), kqdd(model.nq), tau(model.nq);
-  std::mt19937 rng(4242u);
+  jle_test::Random rng(4242u);
   Worst worst;
   for (int n = 0; n < 1000; ++n) {
-    const State s = randomState(model, chain_joints, rng);
+    const State s = randomState(model, rng);
     const std::vector<Load> loads = randomLoads({c.tip}, rng);
     for (int k = 0; k < model.nq; ++k) {
       const unsigned int j = chain_joints.at(model.coordinate_names[k]).q_nr;
@@ -649,10 +629,10 @@ TEST_P(KdlWrenchGauge, SixComponentsAgreeWithTreeIdSolverRne) {
 
   KDL::TreeIdSolver_RNE solver(tree, toKdl(kGravity));
   KDL::JntArray tau(tree.getNrOfJoints());
-  std::mt19937 rng(99u);
+  jle_test::Random rng(99u);
   Worst worst;
   for (int n = 0; n < 200; ++n) {
-    const State s = randomState(model, kdl_joints, rng);
+    const State s = randomState(model, rng);
     const std::vector<Load> loads = randomLoads(leaves, rng);
     const KdlState k = toKdlState(model, tree, kdl_joints, mimics, s, gauge);
     ASSERT_GE(solver.CartToJnt(k.q, k.qd, k.qdd, toKdlWrenches(loads), tau), 0);

@@ -2,21 +2,17 @@
 // files of joint_loads and process_bag, run as processes. Expected values are worked by
 // hand in the tests (Newton-Euler of one rigid body; the statics of a standing body),
 // not taken from the library.
+#include "tool_test.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -32,61 +28,15 @@ const std::string kStand = kData + "/urdf/two_leg_stand.urdf";
 const std::string kPandaDemo = kData + "/urdf/panda_demo.urdf";
 constexpr double kG = 9.80665;
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using jle_test::Result;
+using jle_test::Table;
+using jle_test::parseCsv;
+using jle_test::readFile;
 
 std::string num(double x) {
   char b[40];
   std::snprintf(b, sizeof b, "%.17g", x);
   return b;
-}
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-// A table of text cells (a parser of the test's own), from CSV or from the body of a .sto.
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-  int column(const std::string& name) const {
-    const auto it = std::find(header.begin(), header.end(), name);
-    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
-  }
-  double number(std::size_t row, const std::string& name) const {
-    const int c = column(name);
-    EXPECT_GE(c, 0) << "no column " << name;
-    return c < 0 || row >= rows.size() ? NAN : std::strtod(rows[row][c].c_str(), nullptr);
-  }
-};
-
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> cells;
-  std::stringstream s(line);
-  std::string cell;
-  while (std::getline(s, cell, sep)) cells.push_back(cell);
-  return cells;
-}
-
-Table parseCsv(const std::string& text) {
-  Table t;
-  std::stringstream s(text);
-  std::string line;
-  if (std::getline(s, line)) t.header = split(line, ',');
-  while (std::getline(s, line))
-    if (!line.empty()) t.rows.push_back(split(line, ','));
-  return t;
 }
 
 // A .sto: the header lines up to endheader, then a tab-separated table.
@@ -99,45 +49,17 @@ Sto parseSto(const std::string& text) {
   Sto sto;
   std::stringstream s(text);
   std::string line;
-  while (std::getline(s, line)) {
-    if (line == "endheader") break;
-    sto.header_lines.push_back(line);
-  }
-  if (std::getline(s, line)) sto.table.header = split(line, '\t');
-  while (std::getline(s, line))
-    if (!line.empty()) sto.table.rows.push_back(split(line, '\t'));
+  while (std::getline(s, line) && line != "endheader") sto.header_lines.push_back(line);
+  std::stringstream rest;
+  rest << s.rdbuf();
+  sto.table = parseCsv(rest.str(), '\t');
   return sto;
 }
 
-class OfflineFormatsTest : public ::testing::Test {
+class OfflineFormatsTest : public jle_test::ToolTest {
  protected:
-  void SetUp() override {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/jle_test_offline_XXXXXX";
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-  std::string path(const std::string& name) const { return dir_ + "/" + name; }
-  void write(const std::string& name, const std::string& text) const {
-    std::ofstream(path(name), std::ios::binary) << text;
-  }
-  Result run(const std::string& program, const std::vector<std::string>& args) const {
-    std::string command = quote(program);
-    for (const std::string& a : args) command += " " + quote(a);
-    command += " >" + quote(path("stdout.txt")) + " 2>" + quote(path("stderr.txt"));
-    const int raw = std::system(command.c_str());
-    Result r;
-    r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = readFile(path("stdout.txt"));
-    r.err = readFile(path("stderr.txt"));
-    return r;
-  }
+  OfflineFormatsTest() : ToolTest("jle_test_offline") {}
   Result jointLoads(const std::vector<std::string>& args) const { return run(JLE_JOINT_LOADS, args); }
-  std::string dir_;
 };
 
 // ------------------------------------------------------------- one free rigid body

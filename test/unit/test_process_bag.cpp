@@ -13,6 +13,8 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/JointState.h>
 
+#include "tool_test.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -41,11 +43,9 @@ constexpr double kPi = 3.141592653589793;
 
 // ------------------------------------------------------------------ processes, files
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
+using jle_test::quote;
+using jle_test::readFile;
+using jle_test::writeFile;
 
 struct Result {
   int status = -1;     // exit status, -1 if the process did not exit normally
@@ -62,18 +62,6 @@ Result run(const std::string& command) {
   const int status = pclose(p);
   r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
-}
-
-void writeFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // A CSV of numbers, parsed here (the tools' reader is not its own judge).
