@@ -75,17 +75,9 @@ long toLong(const std::map<std::string, std::string> &v, const std::string &key,
   auto it = v.find(key);
   if (it == v.end())
     return fallback;
-  std::size_t used = 0;
-  long x = 0;
-  try {
-    x = std::stol(it->second, &used);
-  } catch (const std::exception &) {
-    used = 0;
-  }
-  if (used != it->second.size() || x < min)
-    throw jle::cli::UsageError(key +
-                               " must be an integer >= " + std::to_string(min));
-  return x;
+  return static_cast<long>(jle::cli::parseInteger(
+      key, it->second, static_cast<unsigned long long>(min),
+      static_cast<unsigned long long>(std::numeric_limits<long>::max())));
 }
 
 Options parseOptions(int argc, char **argv) {

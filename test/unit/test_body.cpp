@@ -364,7 +364,8 @@ struct Plate {
 // The body stands still at q = 0 with its soles on the floor z = 0, the pelvis (floating
 // base) at the hip height l_thigh + l_shank + h_foot. Each plate reports what the foot
 // applies to it: share x W down at the COP, in the plate frame, moment about the plate
-// origin; the reaction goes to the foot through force_plate.hpp.
+// origin; the reaction goes to the foot through force_plate.hpp (applyPlateReaction, as
+// the estimator and joint_loads apply it).
 struct Standing {
   jle::Model<double> model;
   jle::Data<double> data;
@@ -383,9 +384,7 @@ struct Standing {
       const jle::PlateReading reading =
           jle::readForcePlate(c, force_plate, cop_plate.cross(force_plate));
       EXPECT_TRUE(reading.contact);
-      Vector3d f, n;
-      jle::plateReactionInWorld(c, reading, linkWorld(model, data, feet[k]), f, n);
-      jle::addExternalWrench(model, data, model.frameIndex(feet[k]), f, n, jle::WrenchFrame::kWorld);
+      jle::applyPlateReaction(model, data, model.frameIndex(feet[k]), c, reading);
     }
     jle::inverseDynamics(model, data);
   }

@@ -16,6 +16,7 @@
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "papers_foot.hpp"
 #include "random_models.hpp"
 
 #include <Eigen/Core>
@@ -433,77 +434,34 @@ TEST(FreeBody, MotionCausedByTheAppliedWrenchLeavesNoResidual) {
 // system reduces to 3x3 and the gyroscopic term vanishes:
 //   F_A = m a_G - F_P - m g
 //   M_A = J_G theta_dd - (xi_A x F_A)_z - (xi_P x F_P)_z,   xi = point - x_G.
-// Geometry, in the foot frame (origin at the ankle, turning with theta): the ankle
-// lies at distance l from G in the direction (-cos beta, sin beta) (behind and above
-// G); the centre of pressure lies b ahead of G and d below it.
+// The foot, its motion and these equations: papers_foot.hpp.
 
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
+using jle_test::cross2;
 
 TEST(PlanarFoot, AnkleWrenchMatchesThePapersPlanarEquations) {
-  const double m = 1.2, J_G = 0.0065;             // [kg], [kg m^2]
-  const double l = 0.09, beta = 0.6;              // ankle from G [m], [rad]
-  const double b = 0.11, d = 0.04;                // centre of pressure from G [m]
-  const Eigen::Vector2d ankle_world(0.05, 0.08);  // the fixed ankle [m]
-  const Eigen::Vector2d g(0, -kG);
-
-  // Foot-frame positions from the ankle.
-  const Eigen::Vector2d xi_A_foot = l * Eigen::Vector2d(-std::cos(beta), std::sin(beta));
-  const Eigen::Vector2d G_foot = -xi_A_foot;
-  const Eigen::Vector2d xi_P_foot(b, -d);
-  const Eigen::Vector2d P_foot = G_foot + xi_P_foot;
-
-  // The equivalent URDF: a massless world, the ankle about z, the foot with its
-  // inertia axes turned in the plane (J_G stays I_zz), the centre of pressure a fixed
-  // child frame of the foot.
-  Inertial foot{m, Vec3(G_foot.x(), G_foot.y(), 0), Vec3(0, 0, 0.3),
-                inertiaMatrix(0.0012, 0.0058, J_G)};
-  const jle::Model<double> model = jle::modelFromUrdfString(
-      robot(link("world") + link("foot", foot) + link("cop") +
-            joint("ankle", "revolute", "world", "foot", Vec3(ankle_world.x(), ankle_world.y(), 0)) +
-            joint("cop_joint", "fixed", "foot", "cop", Vec3(P_foot.x(), P_foot.y(), 0))));
+  const jle_test::PapersFoot foot;
+  const jle::Model<double> model = jle::modelFromUrdfString(foot.urdf());
   const int s = model.segmentOfJoint("ankle");
   const int cop = model.frameIndex("cop");
   jle::Data<double> data(model);
-
-  // theta(t) = theta0 + A sin(omega t) over one second of a stance-like motion, and a
-  // plate reaction F_P(t) that rises and falls.
-  const double theta0 = -0.1, A = 0.35, omega = 5.0;
   for (int k = 0; k <= 40; ++k) {
-    const double t = 0.025 * k;
-    const double theta = theta0 + A * std::sin(omega * t);
-    const double theta_d = A * omega * std::cos(omega * t);
-    const double theta_dd = -A * omega * omega * std::sin(omega * t);
-    const Eigen::Vector2d F_P(60.0 * std::sin(2 * omega * t), 700.0 * std::sin(M_PI * t) + 5.0);
-
-    // Kinematics of G turning about the fixed ankle: tangential + centripetal.
-    const Eigen::Matrix2d Q = Eigen::Rotation2Dd(theta).toRotationMatrix();
-    const Eigen::Vector2d r = Q * G_foot;  // ankle -> G, world
-    const Eigen::Vector2d a_G(-theta_dd * r.y() - theta_d * theta_d * r.x(),
-                              theta_dd * r.x() - theta_d * theta_d * r.y());
-    const Eigen::Vector2d xi_A = Q * xi_A_foot, xi_P = Q * xi_P_foot;
-    const Eigen::Vector2d F_A = m * a_G - F_P - m * g;
-    const double M_A = J_G * theta_dd - cross2(xi_A, F_A) - cross2(xi_P, F_P);
-
-    jle::forwardKinematics(model, data, vecx({theta}), vecx({theta_d}), vecx({theta_dd}),
-                           Vec3(g.x(), g.y(), 0));
-    jle::addExternalWrench(model, data, cop, Vec3(F_P.x(), F_P.y(), 0), Vec3(Vec3::Zero()),
+    const jle_test::PapersFoot::Instant i = foot.at(k);
+    const double t = i.t;
+    jle::forwardKinematics(model, data, vecx({i.theta}), vecx({i.theta_d}), vecx({i.theta_dd}),
+                           Vec3(foot.g.x(), foot.g.y(), 0));
+    jle::addExternalWrench(model, data, cop, Vec3(i.F_P.x(), i.F_P.y(), 0), Vec3(Vec3::Zero()),
                            jle::WrenchFrame::kWorld);
     jle::inverseDynamics(model, data);
     const jle::Wrench<double> W = jle::jointWrench(model, data, s, jle::WrenchFrame::kWorld);
 
-    const double force_scale = m * (a_G.norm() + kG) + F_P.norm();
-    const double moment_scale =
-        J_G * std::abs(theta_dd) + l * F_A.norm() + xi_P.norm() * F_P.norm();
-    EXPECT_NEAR(W.force.x(), F_A.x(), kRel * force_scale) << "t " << t;
-    EXPECT_NEAR(W.force.y(), F_A.y(), kRel * force_scale) << "t " << t;
-    EXPECT_NEAR(W.moment.z(), M_A, kRel * moment_scale) << "t " << t;
+    EXPECT_NEAR(W.force.x(), i.F_A.x(), kRel * i.force_scale) << "t " << t;
+    EXPECT_NEAR(W.force.y(), i.F_A.y(), kRel * i.force_scale) << "t " << t;
+    EXPECT_NEAR(W.moment.z(), i.M_A, kRel * i.moment_scale) << "t " << t;
     // Nothing leaves the plane.
-    EXPECT_NEAR(W.force.z(), 0.0, kRel * force_scale) << "t " << t;
-    EXPECT_NEAR(W.moment.x(), 0.0, kRel * moment_scale) << "t " << t;
-    EXPECT_NEAR(W.moment.y(), 0.0, kRel * moment_scale) << "t " << t;
-    EXPECT_NEAR(data.effort[s], M_A, kRel * moment_scale) << "t " << t;
+    EXPECT_NEAR(W.force.z(), 0.0, kRel * i.force_scale) << "t " << t;
+    EXPECT_NEAR(W.moment.x(), 0.0, kRel * i.moment_scale) << "t " << t;
+    EXPECT_NEAR(W.moment.y(), 0.0, kRel * i.moment_scale) << "t " << t;
+    EXPECT_NEAR(data.effort[s], i.M_A, kRel * i.moment_scale) << "t " << t;
   }
 }
 
@@ -770,6 +728,16 @@ std::string inertial(const std::string& mass, const std::string& ixx, const std:
          "\" ixz=\"0\" iyy=\"" + iyy + "\" iyz=\"0\" izz=\"" + izz + "\"/></inertial>";
 }
 
+// An arm that is sound: 2 kg, a valid inertia.
+std::string soundArm() { return inertial("2", "0.1", "0.1", "0.1"); }
+
+// A joint `name` of `type` from the arm to link `child`, `inside` within the element.
+std::string armJoint(const std::string& name, const std::string& type, const std::string& child,
+                     const std::string& inside = "") {
+  return "<joint name=\"" + name + "\" type=\"" + type + "\"><parent link=\"arm\"/><child link=\"" +
+         child + "\"/>" + inside + "</joint>";
+}
+
 // The message of the ModelError that parsing `xml` throws ("" and a failure if none).
 std::string refusal(const std::string& xml, const jle::ModelOptions& options = {}) {
   try {
@@ -784,7 +752,7 @@ std::string refusal(const std::string& xml, const jle::ModelOptions& options = {
 TEST(BadModel, ValidTemplateIsAccepted) {
   // The refusals below come from their one defect, not from the template.
   const jle::Model<double> model =
-      jle::modelFromUrdfString(twoLinks(inertial("2", "0.1", "0.1", "0.1")));
+      jle::modelFromUrdfString(twoLinks(soundArm()));
   EXPECT_EQ(model.nq, 1);
   EXPECT_TRUE(model.warnings.empty());
 }
@@ -816,7 +784,7 @@ TEST(BadModel, TriangleInequality) {
 }
 
 TEST(BadModel, ZeroLengthAxis) {
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), "", "0 0 0")),
+  EXPECT_THAT(refusal(twoLinks(soundArm(), "", "0 0 0")),
               AllOf(HasSubstr("'shoulder'"), HasSubstr("zero length")));
 }
 
@@ -824,7 +792,7 @@ TEST(BadModel, LinkChildOfTwoJoints) {
   const std::string second =
       "<joint name=\"shortcut\" type=\"fixed\"><parent link=\"base\"/>"
       "<child link=\"arm\"/></joint>";
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), second)),
+  EXPECT_THAT(refusal(twoLinks(soundArm(), second)),
               AllOf(HasSubstr("'arm'"), HasSubstr("'shoulder'"), HasSubstr("'shortcut'")));
 }
 
@@ -833,20 +801,17 @@ TEST(BadModel, ClosedCycleUnreachableFromTheRoot) {
       "<link name=\"p\"/><link name=\"r\"/>"
       "<joint name=\"pr\" type=\"fixed\"><parent link=\"p\"/><child link=\"r\"/></joint>"
       "<joint name=\"rp\" type=\"fixed\"><parent link=\"r\"/><child link=\"p\"/></joint>";
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), cycle)),
+  EXPECT_THAT(refusal(twoLinks(soundArm(), cycle)),
               AllOf(HasSubstr("'p'"), HasSubstr("'r'"), HasSubstr("loop")));
 }
 
 TEST(BadModel, TwoRoots) {
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), "<link name=\"orphan\"/>")),
+  EXPECT_THAT(refusal(twoLinks(soundArm(), "<link name=\"orphan\"/>")),
               AllOf(HasSubstr("'base'"), HasSubstr("'orphan'"), HasSubstr("root")));
 }
 
 TEST(BadModel, UnknownLinkInJoint) {
-  const std::string ghost =
-      "<joint name=\"haunt\" type=\"fixed\"><parent link=\"arm\"/>"
-      "<child link=\"ghost\"/></joint>";
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), ghost)),
+  EXPECT_THAT(refusal(twoLinks(soundArm(), armJoint("haunt", "fixed", "ghost"))),
               AllOf(HasSubstr("'haunt'"), HasSubstr("'ghost'")));
 }
 
@@ -857,16 +822,15 @@ TEST(BadModel, MalformedXml) {
 TEST(BadModel, NonNumericAttribute) {
   EXPECT_THAT(refusal(twoLinks(inertial("heavy", "0.1", "0.1", "0.1"))),
               AllOf(HasSubstr("'arm'"), HasSubstr("'heavy'")));
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), "", "0 0 one")),
+  EXPECT_THAT(refusal(twoLinks(soundArm(), "", "0 0 one")),
               AllOf(HasSubstr("'shoulder'"), HasSubstr("'0 0 one'")));
 }
 
 TEST(BadModel, MimicOfUnknownJoint) {
-  const std::string finger =
-      "<link name=\"finger\"/>"
-      "<joint name=\"finger_joint\" type=\"prismatic\"><parent link=\"arm\"/>"
-      "<child link=\"finger\"/><mimic joint=\"no_such_joint\"/></joint>";
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), finger)),
+  const std::string finger = "<link name=\"finger\"/>" +
+                             armJoint("finger_joint", "prismatic", "finger",
+                                      "<mimic joint=\"no_such_joint\"/>");
+  EXPECT_THAT(refusal(twoLinks(soundArm(), finger)),
               AllOf(HasSubstr("'finger_joint'"), HasSubstr("'no_such_joint'")));
 }
 
@@ -876,20 +840,14 @@ TEST(BadModel, ZeroTotalMass) {
 }
 
 TEST(BadModel, PlanarJoint) {
-  const std::string plane =
-      "<link name=\"puck\"/>"
-      "<joint name=\"table\" type=\"planar\"><parent link=\"arm\"/>"
-      "<child link=\"puck\"/></joint>";
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), plane)),
+  const std::string plane = "<link name=\"puck\"/>" + armJoint("table", "planar", "puck");
+  EXPECT_THAT(refusal(twoLinks(soundArm(), plane)),
               AllOf(HasSubstr("'table'"), HasSubstr("planar")));
 }
 
 TEST(BadModel, FloatingJointBelowTheRoot) {
-  const std::string drone =
-      "<link name=\"drone\"/>"
-      "<joint name=\"hover\" type=\"floating\"><parent link=\"arm\"/>"
-      "<child link=\"drone\"/></joint>";
-  EXPECT_THAT(refusal(twoLinks(inertial("2", "0.1", "0.1", "0.1"), drone)),
+  const std::string drone = "<link name=\"drone\"/>" + armJoint("hover", "floating", "drone");
+  EXPECT_THAT(refusal(twoLinks(soundArm(), drone)),
               AllOf(HasSubstr("'hover'"), HasSubstr("floating")));
 }
 

@@ -2,8 +2,11 @@
 // by hand in the comments: what the plate reports (the foot's load on the plate, moment
 // about the plate origin) against the reaction the foot receives, the moment about the
 // plate origin against the centre of pressure and the free moment, a plate origin below
-// the surface, a plate whose own z axis points down, the contact threshold, bad input.
+// the surface, a plate whose own z axis points down, the contact threshold, bad input;
+// and the reaction applied to the foot (applyPlateReaction) in double and in float.
 #include <joint_load_estimator/force_plate.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 
@@ -11,6 +14,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace {
 
@@ -168,5 +172,55 @@ TEST(ForcePlate, NonFiniteInputIsNoContact) {
       EXPECT_TRUE(rm.moment_on_foot_plate.allFinite());
     }
 }
+
+// A foot of m = 2 kg (COM at (0.1, 0, -0.05)) on a fixed ankle about y at the world
+// origin, at rest, standing on a z-up plate whose surface (and origin) is at z = -0.08.
+// The foot presses m g down at (0.2, 0, -0.08): the plate reports F = (0, 0, -m g) and
+// M = (0.2, 0, 0) x F = (0, 0.2 m g, 0). The ankle holds the rest: F_ankle = 0 (the
+// reaction carries the weight) and, about the ankle, M + (0.2, 0, -0.08) x (0, 0, m g)
+// + (0.1, 0, -0.05) x (0, 0, -m g) = 0: M = (0, 0.1 m g, 0), the effort 0.1 m g.
+template <typename Scalar>
+void expectFootHeldByThePlate(double tol) {
+  const std::string urdf =
+      "<robot name=\"foot\"><link name=\"world\"/><link name=\"foot\"><inertial>"
+      "<origin xyz=\"0.1 0 -0.05\"/><mass value=\"2\"/>"
+      "<inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/>"
+      "</inertial></link><joint name=\"ankle\" type=\"revolute\"><parent link=\"world\"/>"
+      "<child link=\"foot\"/><axis xyz=\"0 1 0\"/>"
+      "<limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint></robot>";
+  const jle::Model<Scalar> model = jle::modelFromUrdfString(urdf).cast<Scalar>();
+  jle::Data<Scalar> data(model);
+  const jle::VectorX<Scalar> zero = jle::VectorX<Scalar>::Zero(model.nq);
+  const double g = 9.80665, m = 2.0;
+  jle::forwardKinematics(model, data, zero, zero, zero,
+                         Eigen::Matrix<Scalar, 3, 1>(0, 0, static_cast<Scalar>(-g)));
+  jle::ForcePlateConfig plate;
+  plate.link = "foot";
+  plate.p_world_plate = Vector3d(0.0, 0.0, -0.08);
+  plate.contact_threshold = 5.0;  // [N], below the foot's 19.6 N
+  const jle::PlateReading reading =
+      jle::readForcePlate(plate, Vector3d(0.0, 0.0, -m * g), Vector3d(0.0, 0.2 * m * g, 0.0));
+  ASSERT_TRUE(reading.contact);
+  jle::applyPlateReaction(model, data, model.frameIndex("foot"), plate, reading);
+  jle::inverseDynamics(model, data);
+  const int s = model.segmentOfJoint("ankle");
+  const jle::Wrench<Scalar> w = jle::jointWrench(model, data, s, jle::WrenchFrame::kWorld);
+  expectVector(w.force.template cast<double>(), Vector3d::Zero(), tol * m * g);
+  expectVector(w.moment.template cast<double>(), Vector3d(0.0, 0.1 * m * g, 0.0), tol * m * g);
+  EXPECT_NEAR(static_cast<double>(data.effort[s]), 0.1 * m * g, tol * m * g);
+
+  // Without contact nothing is applied: the ankle carries the whole weight.
+  jle::forwardKinematics(model, data, zero, zero, zero,
+                         Eigen::Matrix<Scalar, 3, 1>(0, 0, static_cast<Scalar>(-g)));
+  jle::applyPlateReaction(model, data, model.frameIndex("foot"), plate, jle::PlateReading());
+  jle::inverseDynamics(model, data);
+  EXPECT_NEAR(static_cast<double>(jle::jointWrench(model, data, s, jle::WrenchFrame::kWorld).force.z()),
+              m * g, tol * m * g);
+}
+
+// Tolerances relative to m g: a few roundings of numbers of order 20 in double (1e-14);
+// in float the model and the kinematics carry about 1e-7 each (1e-6).
+TEST(ForcePlate, ReactionHoldsTheFootInDouble) { expectFootHeldByThePlate<double>(1e-14); }
+TEST(ForcePlate, ReactionHoldsTheFootInFloat) { expectFootHeldByThePlate<float>(1e-6); }
 
 }  // namespace

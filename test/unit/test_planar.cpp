@@ -15,6 +15,7 @@
 #include <joint_load_estimator/planar.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "papers_foot.hpp"
 #include "random_models.hpp"
 
 #include <Eigen/Geometry>
@@ -326,33 +327,13 @@ TEST(Planar, OutOfPlaneWrenchSampleFallsBackTo6x6) {
 }
 
 // ---------------------------------------------------------------------------------
-// The paper's section 6 foot (test_closed_form.cpp's numbers and closed form) through
-// the planar path.
-
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+// The paper's section 6 foot (papers_foot.hpp: its numbers and closed form, as in
+// test_closed_form.cpp) through the planar path.
 
 TEST(Planar, PapersFootThroughThePlanarPath) {
-  const double m = 1.2, J_G = 0.0065;             // [kg], [kg m^2]
-  const double l = 0.09, beta = 0.6;              // ankle from G [m], [rad]
-  const double b = 0.11, d = 0.04;                // centre of pressure from G [m]
-  const Eigen::Vector2d ankle_world(0.05, 0.08);  // the fixed ankle [m]
-  const Eigen::Vector2d g(0, -kG);
-  const Eigen::Vector2d xi_A_foot = l * Eigen::Vector2d(-std::cos(beta), std::sin(beta));
-  const Eigen::Vector2d G_foot = -xi_A_foot;
-  const Eigen::Vector2d xi_P_foot(b, -d);
-  const Eigen::Vector2d P_foot = G_foot + xi_P_foot;
-  const std::string urdf =
-      "<robot name=\"foot\"><link name=\"world\"/><link name=\"foot\"><inertial><origin xyz=\"" +
-      vec(Vec3(G_foot.x(), G_foot.y(), 0)) + "\" rpy=\"0 0 0.3\"/><mass value=\"" + num(m) +
-      "\"/><inertia ixx=\"0.0012\" ixy=\"0\" ixz=\"0\" iyy=\"0.0058\" iyz=\"0\" izz=\"" + num(J_G) +
-      "\"/></inertial></link><link name=\"cop\"/>"
-      "<joint name=\"ankle\" type=\"revolute\"><parent link=\"world\"/><child link=\"foot\"/><origin xyz=\"" +
-      vec(Vec3(ankle_world.x(), ankle_world.y(), 0)) +
-      "\"/><axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>"
-      "<joint name=\"cop_joint\" type=\"fixed\"><parent link=\"foot\"/><child link=\"cop\"/><origin xyz=\"" +
-      vec(Vec3(P_foot.x(), P_foot.y(), 0)) + "\"/></joint></robot>";
-  const jle::Model<double> model = jle::modelFromUrdfString(urdf);
-  const Vec3 gravity(g.x(), g.y(), 0);
+  const jle_test::PapersFoot foot;
+  const jle::Model<double> model = jle::modelFromUrdfString(foot.urdf());
+  const Vec3 gravity(foot.g.x(), foot.g.y(), 0);
   const jle::PlanarCheck<double> check = jle::detectPlanar(model, gravity);
   ASSERT_TRUE(check.planar) << check.reason;
   const jle::PlanarModel<double> pm = jle::planarModel(model, check.normal);
@@ -361,42 +342,28 @@ TEST(Planar, PapersFootThroughThePlanarPath) {
   jle::Data<double> data(model);
   const int s = model.segmentOfJoint("ankle"), cop = model.frameIndex("cop");
   const std::vector<int> segments = allSegments(model);
-  const double theta0 = -0.1, A = 0.35, omega = 5.0;
   for (int k = 0; k <= 40; ++k) {
-    const double t = 0.025 * k;
-    const double theta = theta0 + A * std::sin(omega * t);
-    const double theta_d = A * omega * std::cos(omega * t);
-    const double theta_dd = -A * omega * omega * std::sin(omega * t);
-    const Eigen::Vector2d F_P(60.0 * std::sin(2 * omega * t), 700.0 * std::sin(M_PI * t) + 5.0);
-    const Eigen::Matrix2d Q = Eigen::Rotation2Dd(theta).toRotationMatrix();
-    const Eigen::Vector2d r = Q * G_foot;
-    const Eigen::Vector2d a_G(-theta_dd * r.y() - theta_d * theta_d * r.x(),
-                              theta_dd * r.x() - theta_d * theta_d * r.y());
-    const Eigen::Vector2d xi_A = Q * xi_A_foot, xi_P = Q * xi_P_foot;
-    const Eigen::Vector2d F_A = m * a_G - F_P - m * g;
-    const double M_A = J_G * theta_dd - cross2(xi_A, F_A) - cross2(xi_P, F_P);
-
+    const jle_test::PapersFoot::Instant i = foot.at(k);
+    const double t = i.t, theta = i.theta;
     jle::VectorX<double> q(1), qd(1), qdd(1);
     q << theta;
-    qd << theta_d;
-    qdd << theta_dd;
+    qd << i.theta_d;
+    qdd << i.theta_dd;
     jle::planarKinematics(model, pm, pd, q, qd, qdd, gravity, segments);
     // The plate's force in the cop frame (which turns with the foot).
-    const Eigen::Vector2d F_P_foot = Q.transpose() * F_P;
+    const Eigen::Vector2d F_P_foot = i.Q.transpose() * i.F_P;
     jle::planarAddExternalWrench(model, pm, pd, cop, Vec3(F_P_foot.x(), F_P_foot.y(), 0), Vec3(Vec3::Zero()));
     jle::planarInverseDynamics(model, pm, pd, data, segments);
     // Child frame -> world: the foot frame is turned by theta about z.
     const Vec3 F = Eigen::AngleAxisd(theta, Vec3::UnitZ()) * data.force[s];
     const Vec3 M = Eigen::AngleAxisd(theta, Vec3::UnitZ()) * data.moment[s];
-    const double force_scale = m * (a_G.norm() + kG) + F_P.norm();
-    const double moment_scale = J_G * std::abs(theta_dd) + l * F_A.norm() + xi_P.norm() * F_P.norm();
-    EXPECT_NEAR(F.x(), F_A.x(), kRel * force_scale) << "t " << t;
-    EXPECT_NEAR(F.y(), F_A.y(), kRel * force_scale) << "t " << t;
-    EXPECT_NEAR(M.z(), M_A, kRel * moment_scale) << "t " << t;
+    EXPECT_NEAR(F.x(), i.F_A.x(), kRel * i.force_scale) << "t " << t;
+    EXPECT_NEAR(F.y(), i.F_A.y(), kRel * i.force_scale) << "t " << t;
+    EXPECT_NEAR(M.z(), i.M_A, kRel * i.moment_scale) << "t " << t;
     EXPECT_EQ(F.z(), 0.0);  // nothing leaves the plane: exact zeros, not small numbers
     EXPECT_EQ(M.x(), 0.0);
     EXPECT_EQ(M.y(), 0.0);
-    EXPECT_NEAR(data.effort[s], M_A, kRel * moment_scale) << "t " << t;
+    EXPECT_NEAR(data.effort[s], i.M_A, kRel * i.moment_scale) << "t " << t;
   }
 }
 
