@@ -219,7 +219,9 @@ TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
       ++common;
       EXPECT_EQ(m.name, s.joints);
       expectSameLoads(m, it->second);
-      if (s.measured) EXPECT_FALSE(std::isnan(m.measured_effort[0]));
+      if (s.measured) {
+        EXPECT_FALSE(std::isnan(m.measured_effort[0]));
+      }
     }
     EXPECT_EQ(common, on.size()) << "stamps published by the node only";
   }
