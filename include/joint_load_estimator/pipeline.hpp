@@ -41,6 +41,11 @@ enum class Outcome : std::uint8_t {
 
 const char* toString(Outcome outcome);
 
+/// The same key for two problems (Pipeline::problem()) that differ only in their
+/// numbers (stamps, values, counts): what a front end throttles or says once per, so
+/// that one problem repeating is not said again and again while another is still said.
+std::size_t problemKey(const std::string& problem);
+
 /// The kinds of input message, for counting and for throttling messages per kind.
 enum class InputKind : std::uint8_t { kJointState, kWrench, kPlate, kCount };
 

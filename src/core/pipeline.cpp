@@ -48,6 +48,14 @@ const char* toString(Outcome outcome) {
   return "?";
 }
 
+std::size_t problemKey(const std::string& problem) {
+  // Digits (stamps, values, counts) do not make another problem; names do.
+  std::size_t h = 1469598103934665603ull;
+  for (char c : problem)
+    if (c < '0' || c > '9') h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return h;
+}
+
 long PipelineCounters::received(InputKind kind) const {
   long n = 0;
   for (long c : outcomes[static_cast<int>(kind)]) n += c;
@@ -198,21 +206,26 @@ bool Pipeline::checkJointState(const std::vector<std::string>& names,
                                const std::vector<double>& effort) {
   const std::string& topic = settings_.joint_states_topic;
   const std::size_t n = names.size();
-  const std::pair<const char*, const std::vector<double>*> fields[] = {
-      {"position", &position}, {"velocity", &velocity}, {"effort", &effort}};
-  for (const auto& field : fields) {
-    const std::size_t size = field.second->size();
-    if (size != n && (size != 0 || field.second == &position)) {
+  struct Field {
+    const char *name, *plural;
+    const std::vector<double>& values;
+  };
+  const Field fields[] = {
+      {"position", "positions", position}, {"velocity", "velocities", velocity},
+      {"effort", "efforts", effort}};
+  for (const Field& field : fields) {
+    const std::size_t size = field.values.size();
+    if (size != n && (size != 0 || &field.values == &position)) {
       problem_ = topic + ": " + std::to_string(n) + " names but " + std::to_string(size) + " " +
-                 field.first + " values: message dropped";
+                 field.plural + ": message dropped";
       return false;
     }
   }
   std::size_t bad = 0;
-  for (const auto& field : fields)
-    if (!allFinite(*field.second, bad)) {
-      problem_ = topic + ": " + field.first + " of joint '" + names[bad] + "' is " +
-                 std::to_string((*field.second)[bad]) + ": message dropped";
+  for (const Field& field : fields)
+    if (!allFinite(field.values, bad)) {
+      problem_ = topic + ": " + field.name + " of joint '" + names[bad] + "' is " +
+                 std::to_string(field.values[bad]) + ": message dropped";
       return false;
     }
   return true;

@@ -107,7 +107,7 @@ void EstimatorNode::subscribe() {
                              hints);
 }
 
-void EstimatorNode::report(InputKind kind, Outcome outcome) {
+void EstimatorNode::report(Outcome outcome) {
   if (pipeline_->jumped())
     ROS_WARN("time jumped back (from %.6f to %.6f): resetting the filters",
              toRosTime(pipeline_->jumpFrom()).toSec(), toRosTime(pipeline_->jumpTo()).toSec());
@@ -115,11 +115,13 @@ void EstimatorNode::report(InputKind kind, Outcome outcome) {
     ROS_WARN_THROTTLE(kThrottle, "%s: joint '%s' is not in the model: ignored",
                       settings_.joint_states_topic.c_str(), pipeline_->unknownJoint().c_str());
   if (pipeline_->problem().empty()) return;
-  double& last = last_log_[static_cast<int>(kind)][static_cast<int>(outcome)];
+  if (last_log_.size() > 1024) last_log_.clear();  // bounded: names come from the inputs
+  double& last = last_log_[problemKey(pipeline_->problem())];
   const double now = ros::WallTime::now().toSec();
-  if (now - last < kThrottle) return;
+  if (last != 0.0 && now - last < kThrottle) return;
   last = now;
-  if (outcome == Outcome::kInvalid || outcome == Outcome::kWaiting)
+  // What no later message repairs is an error; order, staleness, a missing pose are not.
+  if (outcome == Outcome::kInvalid || outcome == Outcome::kWaiting || outcome == Outcome::kFrame)
     ROS_ERROR("%s", pipeline_->problem().c_str());
   else
     ROS_WARN("%s", pipeline_->problem().c_str());
@@ -130,7 +132,7 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
   try {
     applyPendingBias();
     const Outcome outcome = feed(*pipeline_, *msg, received);
-    report(InputKind::kJointState, outcome);
+    report(outcome);
     if (outcome == Outcome::kPublished) publish(received);
   } catch (const std::exception& e) {
     // Nothing may leave a callback; the next message is processed as usual.
@@ -142,7 +144,7 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
 void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg) {
   try {
     applyPendingBias();
-    report(InputKind::kWrench, feedWrench(*pipeline_, static_cast<int>(k), *msg, ros::Time::now()));
+    report(feedWrench(*pipeline_, static_cast<int>(k), *msg, ros::Time::now()));
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "wrench input %zu: %s", k, e.what());
@@ -151,7 +153,7 @@ void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::
 
 void EstimatorNode::onPlate(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg) {
   try {
-    report(InputKind::kPlate, feedPlate(*pipeline_, static_cast<int>(k), *msg, ros::Time::now()));
+    report(feedPlate(*pipeline_, static_cast<int>(k), *msg, ros::Time::now()));
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "force plate input %zu: %s", k, e.what());

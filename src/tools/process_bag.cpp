@@ -22,7 +22,6 @@
 
 #include <unistd.h>
 
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -32,6 +31,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace {
@@ -258,7 +258,7 @@ class BagProcessor {
   void checkTopics(const rosbag::Bag& in, rosbag::View& view);
   void dispatch(const rosbag::MessageInstance& m);
   void onTf(const rosbag::MessageInstance& m, bool is_static);
-  void note(jle::InputKind kind, jle::Outcome outcome);
+  void note(jle::Outcome outcome);
   std::string noLoads() const;
   void summarize(double total_s) const;
   void printDrops() const;
@@ -276,10 +276,8 @@ class BagProcessor {
   geometry_msgs::WrenchStamped wrench_msg_;
   tf2_msgs::TFMessage tf_msg_;
   Clock::duration compute_{0};
-  // Each kind of problem is said once (the node throttles), its count in the summary.
-  std::array<std::array<bool, static_cast<int>(jle::Outcome::kCount)>,
-             static_cast<int>(jle::InputKind::kCount)>
-      said_{};
+  // Each problem (problemKey) is said once (the node throttles), its count in the summary.
+  std::unordered_set<std::size_t> said_;
   bool said_unknown_ = false;
 };
 
@@ -331,19 +329,17 @@ void BagProcessor::dispatch(const rosbag::MessageInstance& m) {
   if (joints) {
     const jle::Outcome outcome = jle::feed(pipeline_, joint_msg_, m.getTime());
     compute_ += Clock::now() - c0;
-    note(jle::InputKind::kJointState, outcome);
+    note(outcome);
     if (outcome == jle::Outcome::kPublished)
       outputs_->write(pipeline_.record(), pipeline_.counters().count(jle::Outcome::kPublished) - 1);
     return;
   }
   for (std::size_t k = 0; k < wrench_topics_.size(); ++k)
     if (topic == wrench_topics_[k])
-      note(jle::InputKind::kWrench,
-           jle::feedWrench(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
+      note(jle::feedWrench(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
   for (std::size_t k = 0; k < plate_topics_.size(); ++k)
     if (topic == plate_topics_[k])
-      note(jle::InputKind::kPlate,
-           jle::feedPlate(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
+      note(jle::feedPlate(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
   compute_ += Clock::now() - c0;
 }
 
@@ -358,7 +354,7 @@ void BagProcessor::onTf(const rosbag::MessageInstance& m, bool is_static) {
   }
 }
 
-void BagProcessor::note(jle::InputKind kind, jle::Outcome outcome) {
+void BagProcessor::note(jle::Outcome outcome) {
   if (!pipeline_.unknownJoint().empty() && !said_unknown_) {
     said_unknown_ = true;
     std::fprintf(stderr, "process_bag: warning: %s: joint '%s' is not in the model: ignored\n",
@@ -368,9 +364,7 @@ void BagProcessor::note(jle::InputKind kind, jle::Outcome outcome) {
   // Without /tf nothing can resolve the frame later: a data error, as the usage says.
   if ((outcome == jle::Outcome::kFrame || outcome == jle::Outcome::kNoBasePose) && !have_tf_)
     throw std::runtime_error(pipeline_.problem() + " (" + options_.bag + " has no /tf)");
-  bool& said = said_[static_cast<int>(kind)][static_cast<int>(outcome)];
-  if (said) return;
-  said = true;
+  if (said_.size() > 1024 || !said_.insert(jle::problemKey(pipeline_.problem())).second) return;
   std::fprintf(stderr, "process_bag: warning: %s (further ones counted in the summary)\n",
                pipeline_.problem().c_str());
 }

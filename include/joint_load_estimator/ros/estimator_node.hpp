@@ -19,12 +19,12 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace jle {
@@ -73,8 +73,8 @@ class EstimatorNode {
   void onJointState(const sensor_msgs::JointState::ConstPtr& msg);
   void onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
   void onPlate(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
-  // Logs what the pipeline said of the last message, throttled per kind and outcome.
-  void report(InputKind kind, Outcome outcome);
+  // Logs what the pipeline said of the last message, each problem throttled on its own.
+  void report(Outcome outcome);
   void publish(const ros::Time& received);
   void publishPlates(const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -105,10 +105,8 @@ class EstimatorNode {
   geometry_msgs::WrenchStamped wrench_msg_;
   geometry_msgs::PointStamped cop_msg_;
   diagnostic_updater::Updater updater_;
-  // Throttle of the log per input kind and outcome [wall s], and callbacks that threw.
-  std::array<std::array<double, static_cast<int>(Outcome::kCount)>,
-             static_cast<int>(InputKind::kCount)>
-      last_log_{};
+  // When each problem (problemKey) was last logged [wall s], and callbacks that threw.
+  std::unordered_map<std::size_t, double> last_log_;
   long exceptions_ = 0;
   long published_at_last_diag_ = 0, received_at_last_diag_ = 0;
   ros::WallTime last_diag_ = ros::WallTime::now();
