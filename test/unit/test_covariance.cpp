@@ -5,9 +5,10 @@
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/ground_truth.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include <jle_testing/ground_truth.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,7 @@
 // Random robot models as URDF strings, deterministic from a seed, and the error of the
 // joint loads computed in one scalar type against a more precise one on the same
-// inputs. Shared by test/unit/test_stability.cpp and bench/stability.cpp.
+// inputs. Part of the test support library (joint_load_estimator_testing): shared by
+// test/unit/test_stability.cpp, test/unit/test_planar.cpp and bench/ (stability, speed_core).
 #pragma once
 
 #include <joint_load_estimator/dynamics.hpp>
