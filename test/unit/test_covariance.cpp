@@ -892,7 +892,9 @@ TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
       EXPECT_LE(worst, kExtrapolationBound[robot] + 3.5 * config.uncertainty.gain_tolerance)
           << urdf << " jitter " << jitter;
       // Regular stamps: the guard never fires (one computed sample in 18, and the first).
-      if (jitter == 0.0) EXPECT_LT(equal, published / 10) << urdf;
+      if (jitter == 0.0) {
+        EXPECT_LT(equal, published / 10) << urdf;
+      }
     }
     ++robot;
   }
