@@ -4,8 +4,9 @@
 // configuration and joint plus an overall row per configuration; bench/plot_accuracy.py
 // turns it into docs/accuracy.md and the figures. tools/accuracy.sh runs both.
 #include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/ground_truth.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include <jle_testing/ground_truth.hpp>
 
 #include <Eigen/Core>
 

@@ -269,7 +269,7 @@ def main():
       "loads at the estimate's own stamp (always one of the sample stamps; nothing is "
       "interpolated): the analytic q, qd, qdd and wrenches of the scene through the core's "
       "forward kinematics, `addExternalWrench` and inverse dynamics "
-      "(include/joint_load_estimator/ground_truth.hpp).\n\n")
+      "(test/support/jle_testing/ground_truth.hpp).\n\n")
 
     w("## Metrics\n\n")
     w("- **effort**: error of the joint effort (axis . moment) [N m; N for prismatic joints]; "
@@ -332,7 +332,7 @@ def main():
     w("\nEncoder: 2^17 counts per revolution (4.8e-5 rad per count) after 5e-6 rad of "
       "Gaussian noise. Kalman filters get measurement_noise = sqrt(noise^2 + count^2 / 12) "
       "= 1.5e-5 rad (1e-6 rad for exact inputs). Trajectories, wrenches and sensors: "
-      "include/joint_load_estimator/ground_truth.hpp.\n\n")
+      "test/support/jle_testing/ground_truth.hpp.\n\n")
 
     w(f"## Main scene: `{MAIN}`, default savings\n\n")
     w(f"![RMS effort error vs run time]({os.path.basename(png_time)})\n\n")

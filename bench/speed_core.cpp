@@ -8,7 +8,7 @@
 #include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
-#include "../test/unit/random_models.hpp"
+#include <jle_testing/random_models.hpp>
 
 #include <benchmark/benchmark.h>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>

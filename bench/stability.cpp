@@ -10,7 +10,6 @@
 #include "stability_literal.hpp"
 #include "stability_quad.hpp"
 
-#include "../test/unit/random_models.hpp"
 #include "../test/unit/stability_bounds.hpp"
 
 #include <joint_load_estimator/differentiation.hpp>
@@ -18,6 +17,8 @@
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include <jle_testing/random_models.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>

@@ -13,7 +13,7 @@
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
 
-#include "../test/unit/random_models.hpp"
+#include <jle_testing/random_models.hpp>
 
 #include <Eigen/Core>
 

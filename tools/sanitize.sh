@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Builds the unit tests with AddressSanitizer + UndefinedBehaviorSanitizer in a second
-# catkin workspace and runs every gtest unit-test binary directly (the rostest node
-# tests, test_node_*, need a master and are left to tools/test.sh). Fails on a failed
-# test or on any sanitizer report.
+# catkin workspace and runs every gtest unit-test binary directly. The unit tests are
+# the ones CMake lists (test/CMakeLists.txt): every gtest registered with
+# catkin_add_gtest or jle_add_unit_test, which needs no master; the target
+# joint_load_estimator_unit_tests builds them and build/joint_load_estimator/unit_tests.txt
+# names their binaries. The rostest node tests (test_node_*) are left to tools/test.sh.
+# Fails on a failed test or on any sanitizer report.
 #   JLE_WS_SAN  workspace (default ~/.cache/joint_load_estimator/ws_asan)
 #   JLE_JOBS    parallel build jobs (default 2)
 set -euo pipefail
@@ -13,17 +16,11 @@ mkdir -p "$ws/src"
 ln -sfn "$repo" "$ws/src/joint_load_estimator"
 export PATH=/usr/bin:$PATH
 cd "$ws"
-# The unit tests only (the benchmarks and node tests are not rebuilt here).
-targets="test_urdf_reader test_closed_form test_invariance test_kdl test_cli
-  test_differentiation test_estimator test_savings test_ground_truth test_stability
-  test_no_allocation test_process_bag test_planar test_body test_force_plate
-  test_offline_formats test_covariance test_plates test_plates_offline test_sensor_joint
-  test_gait_csv"
 flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
-    -j"$jobs" $targets >"$ws/build.log" 2>&1; then
+    -j"$jobs" joint_load_estimator_unit_tests >"$ws/build.log" 2>&1; then
   tail -40 "$ws/build.log"
   echo "sanitizer build failed (log: $ws/build.log)"
   exit 1
@@ -34,13 +31,13 @@ fi
 # on unless JLE_SAN_LEAKS=0 (it then says "LeakSanitizer does not work under ptrace").
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=${JLE_SAN_LEAKS:-1}:detect_stack_use_after_return=1:strict_string_checks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-bin="$ws/devel/lib/joint_load_estimator"
+list="$ws/build/joint_load_estimator/unit_tests.txt"
+[ -s "$list" ] || { echo "no unit-test list at $list"; exit 1; }
 status=0
 ran=0
-for t in "$bin"/test_*; do
+while read -r t <&3; do
   name=$(basename "$t")
-  [ -x "$t" ] && [ -f "$t" ] || continue
-  case "$name" in test_node_*) continue ;; esac
+  [ -x "$t" ] && [ -f "$t" ] || { echo "FAIL  $name: listed but not built ($t)"; status=1; continue; }
   log="$ws/$name.log"
   start=$(date +%s)
   if "$t" >"$log" 2>&1 && ! grep -qE "ERROR: (Address|Leak)Sanitizer|runtime error:" "$log"; then
@@ -51,7 +48,7 @@ for t in "$bin"/test_*; do
     status=1
   fi
   ran=$((ran + 1))
-done
-[ "$ran" -gt 0 ] || { echo "no unit test binary in $bin"; exit 1; }
+done 3<"$list"
+[ "$ran" -gt 0 ] || { echo "no unit test binary in $list"; exit 1; }
 echo "sanitizers: $ran unit test binaries, $([ $status -eq 0 ] && echo clean || echo FAILED)"
 exit $status

@@ -6,8 +6,9 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 export JLE_WS=$ws
 bash "$repo/tools/install_deps.sh"
-bash "$repo/tools/build.sh" -j2
-bash "$repo/tools/build.sh" -j2 tests
+# Warnings are errors in CI (the option JLE_WERROR of CMakeLists.txt, OFF by default).
+bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON
+bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON tests
 export PATH=/usr/bin:$PATH
 cd "$ws"
 rm -rf build/test_results

@@ -5,11 +5,11 @@
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/ground_truth.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
-#include "random_models.hpp"
+#include <jle_testing/ground_truth.hpp>
+#include <jle_testing/random_models.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,8 @@
 // The ground-truth generator of the accuracy study: its derivatives are consistent
 // with its positions, its sensors have the stated statistics, its output is the same for
 // the same seed, and its scenes' loads match closed forms.
-#include <joint_load_estimator/ground_truth.hpp>
+#include <jle_testing/ground_truth.hpp>
+
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>

@@ -17,7 +17,7 @@
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
-#include "random_models.hpp"
+#include <jle_testing/random_models.hpp>
 
 #include <gtest/gtest.h>
 #include <kdl/chain.hpp>

@@ -16,7 +16,7 @@
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include "papers_foot.hpp"
-#include "random_models.hpp"
+#include <jle_testing/random_models.hpp>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>

@@ -6,7 +6,6 @@
 // The reference of the core's tests is the same computation in long double on the
 // same inputs (the model and state in double, converted). Against quad precision its
 // own error is below 2.5e-17 in every sweep, under 1/2000 of any double bound here.
-#include "random_models.hpp"
 #include "stability_bounds.hpp"
 
 #include <joint_load_estimator/differentiation.hpp>
@@ -14,6 +13,8 @@
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+
+#include <jle_testing/random_models.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,8 @@
 // Ground truth for the accuracy study and its tests: analytic joint trajectories with
 // exact derivatives, analytic external wrenches, the exact joint loads they imply, and a
 // model of the sensors that sample them (rate, encoder counts, noise, time-stamp
-// jitter, dropped samples, force/torque sensor bias). ROS-free.
+// jitter, dropped samples, force/torque sensor bias). ROS-free; part of the test support
+// library joint_load_estimator_testing (test/support, not installed).
 //
 // Everything is deterministic from a seed, and the same with every standard library:
 // the random numbers are jle::PortableRandom's (portable_random.hpp).

@@ -1,4 +1,4 @@
-#include <joint_load_estimator/ground_truth.hpp>
+#include <jle_testing/ground_truth.hpp>
 
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>

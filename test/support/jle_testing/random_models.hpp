@@ -1,7 +1,8 @@
 // The tests' random numbers (jle::PortableRandom with the draws tests need: vectors,
 // rotations, log-uniform numbers), random robot models as URDF strings, deterministic
 // from a seed, and the error of the joint loads computed in one scalar type against a
-// more precise one on the same inputs. Shared by the unit tests and bench/stability.cpp.
+// more precise one on the same inputs. Part of the test support library (joint_load_estimator_testing):
+// shared by the unit tests and bench/ (stability, speed_core).
 #pragma once
 
 #include <joint_load_estimator/dynamics.hpp>
