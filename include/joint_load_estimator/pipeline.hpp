@@ -152,6 +152,11 @@ class Pipeline {
   const Model<double>& model() const { return estimator_.model(); }
   /// The stamp [ns] of the estimator's time t [s].
   Stamp absolute(double t) const;
+  /// The origin of the estimator's time axis [ns]: the first stamp after the start or
+  /// after a stamp more than 2^52 ns (52 days) away from the previous origin. None until
+  /// a message has been taken.
+  bool hasTimeOrigin() const { return have_ref_; }
+  Stamp timeOrigin() const { return time_ref_; }
 
   /// Wrench input k's last resolved frame and its pose in the input's link (the
   /// sensor residual is re-expressed in it).

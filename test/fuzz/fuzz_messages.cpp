@@ -89,9 +89,8 @@ namespace {
 
 constexpr jle::Stamp kMaxStamp = 4294967295999999999;  // a ROS time: uint32 s, uint32 ns
 constexpr jle::Stamp kStart = 1700000000000000000;
-// Random stamps stay within 2^51 ns (26 days) of the start: the time axis (a double of
-// seconds since the first stamp) resolves 1 ns there; farther jumps re-anchor it
-// (test_pipeline checks that).
+// Random stamps within 2^51 ns (26 days) of the start; stamp 0 and small steps from it
+// reach the far end of time (a simulation clock from 0), which re-anchors the time axis.
 constexpr jle::Stamp kReach = jle::Stamp{1} << 51;
 
 // The settings from the first two bytes.
@@ -151,15 +150,24 @@ void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
   clock = std::min(kMaxStamp, clock + 1000000);
 }
 
-// The shadow of the pipeline's rules on stamps: the last joint state taken, resets.
+// The shadow of the pipeline's rules on stamps: the last joint state taken, resets (a
+// stamp more than time_jump_threshold back, the clock going back, a stamp 2^52 ns or
+// more from the time axis' origin, as the pipeline had it before the message).
 struct Shadow {
   jle::Stamp last = 0;  // 0: none since the start or a reset
   jle::Stamp last_clock = 0;
+  bool had_origin = false;
+  jle::Stamp origin = 0;
+  void before(const jle::Pipeline& p) {
+    had_origin = p.hasTimeOrigin();
+    origin = p.timeOrigin();
+  }
   void clockSeen(jle::Stamp stamp, jle::Stamp clock) {
     const bool clock_back = last_clock != 0 && clock < last_clock && !(stamp > last);
     const bool stamp_back = last != 0 && static_cast<double>(last - stamp) * 1e-9 > 1.0;
+    const bool far = had_origin && std::abs(stamp - origin) > (jle::Stamp{1} << 52);
     last_clock = clock;
-    if (clock_back || stamp_back) last = 0;
+    if (clock_back || stamp_back || far) last = 0;
   }
 };
 
@@ -229,6 +237,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::uint8_t kind = in.byte();
     advance(in, stamp, clock);
     ++messages;
+    shadow.before(p);
     const jle::Stamp effective = stamp == 0 ? clock : stamp;
     if (kind % 8 >= 6) {  // a wrench message, in a frame the URDF has or not
       Eigen::Vector3d f, mo;
