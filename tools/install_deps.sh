@@ -14,6 +14,7 @@ packages=(
   ros-robot-state-publisher rosbash
   python3-matplotlib
   clang libclang-rt-14-dev  # libFuzzer for test/fuzz/build_and_run.sh
+  clang-format              # tools/format.sh (the style is tuned on Debian's 14)
 )
 missing=()
 for p in "${packages[@]}"; do

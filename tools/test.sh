@@ -9,6 +9,12 @@ bash "$repo/tools/install_deps.sh"
 # Warnings are errors in CI (the option JLE_WERROR of CMakeLists.txt, OFF by default).
 bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON
 bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON tests
+# House style: no function over 80 lines in src/ and include/, every C++ file formatted
+# by the root .clang-format.
+style_status=0
+/usr/bin/python3 "$repo/tools/function_lengths.py" "$repo/src" "$repo/include" --limit 80 --top 3 ||
+  { echo "style: a function is over 80 lines"; style_status=1; }
+bash "$repo/tools/format.sh" --check || { echo "style: run bash tools/format.sh"; style_status=1; }
 export PATH=/usr/bin:$PATH
 cd "$ws"
 rm -rf build/test_results
@@ -55,4 +61,5 @@ if [ "$(echo "$summary" | awk '{gsub(",", ""); print $2}')" = "0" ]; then
   echo "no test ran"; exit 1
 fi
 [ "$bench_status" -eq 0 ] || exit 1
+[ "$style_status" -eq 0 ] || exit 1
 exit $status
