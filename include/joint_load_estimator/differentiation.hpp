@@ -183,8 +183,9 @@ class DifferentiatorBank {
   // time axis (its ulp is 1e-13 s at 1000 s), not information about the signal.
   bool sameSpacing(double mid, double half) {
     constexpr double kSameSpacing = 1e-10;  // [s]
+    const int w = config_.window;
     bool same = std::abs(half - half_prev_) <= kSameSpacing;
-    for (int k = 0; k < config_.window; ++k) {
+    for (int k = 0; k < w; ++k) {
       const double tau = (times_[ring(k)] - mid) / half;
       same = same && std::abs(tau - tau_prev_[k]) * half <= kSameSpacing;
       tau_[k] = tau;

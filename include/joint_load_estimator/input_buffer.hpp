@@ -47,9 +47,9 @@ class InputBuffer {
   /// Whether the input was stale at the last resample() (true after a reset).
   bool stale() const { return stale_; }
   /// Stale under the kZero policy: the input reads as zero.
-  bool zeroed() const;
+  bool zeroed() const { return stale_ && zero_when_stale_; }
   /// Stale under the kStop policy: no loads may be published.
-  bool stopped() const;
+  bool stopped() const { return stale_ && stop_when_stale_; }
   /// Forgets every sample (a backward jump of time).
   void reset();
 
@@ -62,7 +62,8 @@ class InputBuffer {
   int ring(int k) const { return (head_ - 1 - k + 2 * kHistory) % kHistory; }
 
   double timeout_ = 0.1;
-  StalePolicy policy_{};
+  bool zero_when_stale_ = false;  // StalePolicy::kZero
+  bool stop_when_stale_ = false;  // StalePolicy::kStop
   std::vector<double> times_;
   std::vector<Vector6> values_;
   int head_ = 0;

@@ -40,9 +40,15 @@ class PlateInputs {
   void setNeeded(const Model<double>& model, const std::vector<char>& dynamics);
 
   /// At the joint sample t [s]: every needed plate's value into its six channels.
-  void resample(double t, double* channels);
+  void resample(double t, double* channels) {
+    for (Plate& p : plates_) p.samples.resample(t, p.needed, channels + p.channel);
+  }
   /// Whether a plate with the kStop policy is stale.
-  bool stopped() const;
+  bool stopped() const {
+    for (const Plate& p : plates_)
+      if (p.samples.stopped()) return true;
+    return false;
+  }
   /// The contact of every needed plate on its raw signal at the estimate's stamp [s];
   /// true when any changed since the last call.
   bool updateContacts(double stamp);

@@ -7,7 +7,11 @@
 namespace jle {
 
 InputBuffer::InputBuffer(double timeout, StalePolicy policy)
-    : timeout_(timeout), policy_(policy), times_(kHistory, 0.0), values_(kHistory, Vector6::Zero()) {}
+    : timeout_(timeout),
+      zero_when_stale_(policy == StalePolicy::kZero),
+      stop_when_stale_(policy == StalePolicy::kStop),
+      times_(kHistory, 0.0),
+      values_(kHistory, Vector6::Zero()) {}
 
 bool InputBuffer::add(double t, const Vector6& value) {
   if (!std::isfinite(t) || !value.allFinite()) return false;
@@ -38,7 +42,7 @@ bool InputBuffer::staleAt(double t) const {
 }
 
 InputBuffer::Vector6 InputBuffer::valueAt(double t) const {
-  if (policy_ == StalePolicy::kZero && staleAt(t)) return Vector6::Zero();
+  if (zero_when_stale_ && staleAt(t)) return Vector6::Zero();
   return interpolate(t);
 }
 
@@ -51,10 +55,6 @@ void InputBuffer::resample(double t, bool needed, double* out) {
   const Vector6 value = valueAt(t);
   for (int j = 0; j < 6; ++j) out[j] = value[j];
 }
-
-bool InputBuffer::zeroed() const { return stale_ && policy_ == StalePolicy::kZero; }
-
-bool InputBuffer::stopped() const { return stale_ && policy_ == StalePolicy::kStop; }
 
 void InputBuffer::reset() {
   head_ = 0;

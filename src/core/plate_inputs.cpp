@@ -63,16 +63,6 @@ void PlateInputs::setNeeded(const Model<double>& model, const std::vector<char>&
     p.needed = dynamics[static_cast<std::size_t>(model.frames[static_cast<std::size_t>(p.frame)].segment)] != 0;
 }
 
-void PlateInputs::resample(double t, double* channels) {
-  for (Plate& p : plates_) p.samples.resample(t, p.needed, channels + p.channel);
-}
-
-bool PlateInputs::stopped() const {
-  for (const Plate& p : plates_)
-    if (p.samples.stopped()) return true;
-  return false;
-}
-
 bool PlateInputs::updateContacts(double stamp) {
   bool changed = false;
   for (Plate& p : plates_) {
