@@ -3,6 +3,7 @@
 // out. ROS-free.
 #pragma once
 
+#include <joint_load_estimator/base_channels.hpp>
 #include <joint_load_estimator/covariance.hpp>
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/differentiation.hpp>
@@ -177,9 +178,9 @@ struct BasePose {
 /// The online estimator: joint samples in (with the wrench, plate and base-pose samples
 /// between them), filtered kinematics and joint loads out. It composes the bank of
 /// filters, the wrench inputs' buffers (input_buffer.hpp), the force plates
-/// (plate_inputs.hpp), the sensor joints (sensor_joints.hpp), the covariance
-/// (covariance.hpp) and the planar path (planar.hpp). Memory is allocated in the
-/// constructor only.
+/// (plate_inputs.hpp), the sensor joints (sensor_joints.hpp), a floating base's channels
+/// (base_channels.hpp), the covariance (covariance.hpp) and the planar path (planar.hpp).
+/// Memory is allocated in the constructor only.
 class Estimator {
  public:
   /// Throws std::invalid_argument naming the bad field or link.

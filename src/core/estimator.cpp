@@ -1,6 +1,7 @@
 // The orchestrator: the joint samples and the bank of filters, composed with the input
 // buffers (input_buffer.hpp), the plates (plate_inputs.hpp), the sensor joints
-// (sensor_joints.hpp), the covariance (covariance.hpp) and the planar path (planar.hpp).
+// (sensor_joints.hpp), a floating base's channels (base_channels.hpp), the covariance
+// (covariance.hpp) and the planar path (planar.hpp).
 #include <joint_load_estimator/estimator.hpp>
 
 #include <joint_load_estimator/kinematics.hpp>
@@ -10,13 +11,6 @@
 
 namespace jle {
 namespace {
-
-// Vector part of a quaternion product a * b.
-Eigen::Vector3d productVector(const Eigen::Vector4d& a, const Eigen::Vector4d& b) {
-  // (w, x, y, z) layout.
-  const Eigen::Vector3d av = a.tail<3>(), bv = b.tail<3>();
-  return a[0] * bv + b[0] * av + av.cross(bv);
-}
 
 // The model with the flags of the disabled savings set to "compute everything".
 Model<double> withSavings(Model<double> model, const Savings& savings) {
@@ -31,46 +25,6 @@ Model<double> withSavings(Model<double> model, const Savings& savings) {
 int channelCount(const Model<double>& model, const EstimatorConfig& config) {
   return model.nq + (model.floating_base ? 7 : 0) + 6 * static_cast<int>(config.wrenches.size()) +
          6 * static_cast<int>(config.plates.size());
-}
-
-// A floating base's pose into its seven channels b: position, then the quaternion
-// (w, x, y, z), whose sign is kept continuous with the last one's: then its components
-// are smooth in time.
-void writeBasePose(const BasePose& base, Eigen::Quaterniond& last_orientation, double* b) {
-  Eigen::Quaterniond o = base.orientation.normalized();
-  if (o.coeffs().dot(last_orientation.coeffs()) < 0.0) o.coeffs() *= -1.0;
-  last_orientation = o;
-  b[0] = base.position.x();
-  b[1] = base.position.y();
-  b[2] = base.position.z();
-  b[3] = o.w();
-  b[4] = o.x();
-  b[5] = o.y();
-  b[6] = o.z();
-}
-
-// A floating base's state at the bank's stamp from its seven channels from b.
-BaseState<double> baseStateFromBank(const DifferentiatorBank& bank, int b) {
-  BaseState<double> base_state;
-  base_state.p_world_base << bank.value(b), bank.value(b + 1), bank.value(b + 2);
-  base_state.v_world << bank.rate(b), bank.rate(b + 1), bank.rate(b + 2);
-  base_state.a_world << bank.accel(b), bank.accel(b + 1), bank.accel(b + 2);
-  Eigen::Vector4d quat, quat_rate, quat_accel;
-  for (int j = 0; j < 4; ++j) {
-    quat[j] = bank.value(b + 3 + j);
-    quat_rate[j] = bank.rate(b + 3 + j);
-    quat_accel[j] = bank.accel(b + 3 + j);
-  }
-  const double norm = quat.norm();
-  quat /= norm;
-  quat_rate /= norm;
-  quat_accel /= norm;
-  const Eigen::Vector4d conj(quat[0], -quat[1], -quat[2], -quat[3]);
-  // q' = 1/2 w q  =>  w = 2 vec(q' q*);  alpha = 2 vec(q'' q*) (the rest is scalar).
-  base_state.omega_world = 2.0 * productVector(quat_rate, conj);
-  base_state.alpha_world = 2.0 * productVector(quat_accel, conj);
-  base_state.R_world_base = Eigen::Quaterniond(quat[0], quat[1], quat[2], quat[3]).toRotationMatrix();
-  return base_state;
 }
 
 }  // namespace
@@ -265,7 +219,8 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
   return SampleStatus::kPublished;
 }
 
-bool Estimator::accept(double t, const double* q, const BasePose* base, SampleStatus& refused) {
+// The steps of addJointSample, inline in it (out of line they cost 2% of a still sample).
+inline bool Estimator::accept(double t, const double* q, const BasePose* base, SampleStatus& refused) {
   if (model_.floating_base && base == nullptr)
     throw std::invalid_argument("a floating-base model needs the base pose with each sample");
   refused = SampleStatus::kNonFinite;
@@ -284,7 +239,7 @@ bool Estimator::accept(double t, const double* q, const BasePose* base, SampleSt
   return true;
 }
 
-void Estimator::fillChannels(double t, const double* q, const BasePose* base) {
+inline void Estimator::fillChannels(double t, const double* q, const BasePose* base) {
   for (int i = 0; i < model_.nq; ++i) channels_[static_cast<std::size_t>(i)] = q[i];
   if (model_.floating_base)
     writeBasePose(*base, last_orientation_, &channels_[static_cast<std::size_t>(base_channel_)]);
@@ -293,7 +248,7 @@ void Estimator::fillChannels(double t, const double* q, const BasePose* base) {
   plates_.resample(t, channels_.data());
 }
 
-BaseState<double> Estimator::readEstimate() {
+inline BaseState<double> Estimator::readEstimate() {
   for (int i = 0; i < model_.nq; ++i) {
     q_[i] = bank_.value(i);
     qd_[i] = bank_.rate(i);
@@ -303,7 +258,7 @@ BaseState<double> Estimator::readEstimate() {
   return baseStateFromBank(bank_, base_channel_);
 }
 
-bool Estimator::sameFilteredInputs(bool contacts_changed) {
+inline bool Estimator::sameFilteredInputs(bool contacts_changed) {
   bool same = have_result_ && !contacts_changed;
   const std::size_t c = channels_.size();
   for (std::size_t i = 0; i < c && same; ++i)
