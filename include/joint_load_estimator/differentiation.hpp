@@ -167,73 +167,14 @@ class DifferentiatorBank {
 
   void fitSavitzkyGolay() {
     const int w = config_.window;
-    const int eval = ring(config_.delay);
-    stamp_ = times_[eval];
+    stamp_ = times_[ring(config_.delay)];
     // Times centred on the window and scaled to [-1, 1], so that the Vandermonde matrix
     // stays well conditioned at any rate and any offset of the clock.
     const double newest = times_[ring(0)], oldest = times_[ring(w - 1)];
     const double mid = 0.5 * (newest + oldest), half = 0.5 * (newest - oldest);
-    // The same spacing as the last fit (a steady rate): the weights are reused. "Same"
-    // means every sample within kSameSpacing of where the last fit had it: stamps are
-    // integers of nanoseconds, so a smaller difference is the rounding of the double
-    // time axis (its ulp is 1e-13 s at 1000 s), not information about the signal.
-    constexpr double kSameSpacing = 1e-10;  // [s]
-    bool same = std::abs(half - half_prev_) <= kSameSpacing;
-    for (int k = 0; k < w; ++k) {
-      const double tau = (times_[ring(k)] - mid) / half;
-      same = same && std::abs(tau - tau_prev_[k]) * half <= kSameSpacing;
-      tau_[k] = tau;
-    }
-    if (!same) {
-      // Least squares by Householder QR of the Vandermonde V (w x n), V = Q R: the
-      // weights of derivative d are row d of E pinv(V) = (Q R^-T E^T)^T, where row d of
-      // E evaluates the d-th derivative of 1, tau, ..., tau^(n-1) at the stamp. Their
-      // error grows like cond(V), where the normal equations' grows like cond(V)^2: with
-      // one 1 us interval among 1 ms ones, the 3-point difference (V square) lost a
-      // factor 250 over what its inputs allow, and 1.3e6 at 0.1 ns (docs/stability.md).
-      // The centring and scaling keep cond(V) small for any spacing that is not
-      // degenerate, at any offset of the clock. The estimate is a fixed linear
-      // combination of the window: coeff row d . x is the d-th derivative at the stamp.
-      V_.resize(w, n_);
-      for (int k = 0; k < w; ++k) {
-        double p = 1.0;
-        for (int j = 0; j < n_; ++j, p *= tau_[k]) V_(k, j) = p;
-      }
-      // In place: R on and above the diagonal, the reflectors' essential parts below.
-      for (int j = 0; j < n_; ++j) {
-        double beta;
-        V_.col(j).tail(w - j).makeHouseholderInPlace(h_[j], beta);
-        V_(j, j) = beta;
-        if (j + 1 < n_)
-          V_.bottomRightCorner(w - j, n_ - j - 1)
-              .applyHouseholderOnTheLeft(V_.col(j).tail(w - j - 1), h_[j], work_.data());
-      }
-      const Vandermonde& QR = V_;
-      const double te = (stamp_ - mid) / half;
-      // Y = R^-T E^T (n x 3) by forward substitution.
-      Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxOrder + 1, 3> Y(n_, 3);
-      for (int j = 0; j < n_; ++j) {
-        Y(j, 0) = std::pow(te, j);
-        Y(j, 1) = j >= 1 ? j * std::pow(te, j - 1) : 0.0;
-        Y(j, 2) = j >= 2 ? j * (j - 1) * std::pow(te, j - 2) : 0.0;
-        for (int i = 0; i < j; ++i) Y.row(j) -= QR(i, j) * Y.row(i);
-        Y.row(j) /= QR(j, j);
-      }
-      // coeff^T = Q [Y; 0] (w x 3): the reflectors H_{n-1} .. H_0 applied in turn,
-      // H_j = I - h_j v_j v_j^T with v_j = (0 .. 0, 1, QR(j+1 .., j)).
-      coeff_t_.setZero(w, 3);
-      coeff_t_.topRows(n_) = Y;
-      for (int j = n_ - 1; j >= 0; --j) {
-        const int len = w - j - 1;
-        Eigen::Matrix<double, 1, 3> vx =
-            coeff_t_.row(j) + QR.col(j).segment(j + 1, len).transpose() * coeff_t_.bottomRows(len);
-        vx *= h_[j];
-        coeff_t_.row(j) -= vx;
-        coeff_t_.bottomRows(len).noalias() -= QR.col(j).segment(j + 1, len) * vx;
-      }
-      coeff_ = coeff_t_.transpose();
-      coeff_.row(1) /= half;
-      coeff_.row(2) /= half * half;
+    if (!sameSpacing(mid, half)) {
+      factorVandermonde();
+      weightsAt((stamp_ - mid) / half, half);
       tau_prev_.head(w) = tau_.head(w);
       half_prev_ = half;
     }
@@ -241,78 +182,98 @@ class DifferentiatorBank {
     for (int k = 0; k < w; ++k) out_.noalias() += coeff_.col(k) * values_.row(ring(k));
   }
 
+  // Fills tau_ with the window's times centred on mid and scaled by half; whether they
+  // have the same spacing as at the last fit (a steady rate: the weights are reused).
+  // "Same" means every sample within kSameSpacing of where the last fit had it: stamps
+  // are integers of nanoseconds, so a smaller difference is the rounding of the double
+  // time axis (its ulp is 1e-13 s at 1000 s), not information about the signal.
+  bool sameSpacing(double mid, double half) {
+    constexpr double kSameSpacing = 1e-10;  // [s]
+    const int w = config_.window;
+    bool same = std::abs(half - half_prev_) <= kSameSpacing;
+    for (int k = 0; k < w; ++k) {
+      const double tau = (times_[ring(k)] - mid) / half;
+      same = same && std::abs(tau - tau_prev_[k]) * half <= kSameSpacing;
+      tau_[k] = tau;
+    }
+    return same;
+  }
+
+  // Least squares by Householder QR of the Vandermonde V (w x n) of tau_, V = Q R: the
+  // weights of derivative d are row d of E pinv(V) = (Q R^-T E^T)^T, where row d of
+  // E evaluates the d-th derivative of 1, tau, ..., tau^(n-1) at the stamp. Their
+  // error grows like cond(V), where the normal equations' grows like cond(V)^2: with
+  // one 1 us interval among 1 ms ones, the 3-point difference (V square) lost a
+  // factor 250 over what its inputs allow, and 1.3e6 at 0.1 ns (docs/stability.md).
+  // The centring and scaling keep cond(V) small for any spacing that is not
+  // degenerate, at any offset of the clock. The estimate is a fixed linear
+  // combination of the window: coeff row d . x is the d-th derivative at the stamp.
+  // Factored in place in V_: R on and above the diagonal, the reflectors' essential
+  // parts below, their coefficients in h_.
+  void factorVandermonde() {
+    const int w = config_.window;
+    V_.resize(w, n_);
+    for (int k = 0; k < w; ++k) {
+      double p = 1.0;
+      for (int j = 0; j < n_; ++j, p *= tau_[k]) V_(k, j) = p;
+    }
+    for (int j = 0; j < n_; ++j) {
+      double beta;
+      V_.col(j).tail(w - j).makeHouseholderInPlace(h_[j], beta);
+      V_(j, j) = beta;
+      if (j + 1 < n_)
+        V_.bottomRightCorner(w - j, n_ - j - 1)
+            .applyHouseholderOnTheLeft(V_.col(j).tail(w - j - 1), h_[j], work_.data());
+    }
+  }
+
+  // The weights coeff_ (3 x w) of the value, rate and acceleration at the scaled stamp
+  // te from the factors of factorVandermonde(); half: the time scale [s].
+  void weightsAt(double te, double half) {
+    const int w = config_.window;
+    const Vandermonde& QR = V_;
+    // Y = R^-T E^T (n x 3) by forward substitution.
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxOrder + 1, 3> Y(n_, 3);
+    for (int j = 0; j < n_; ++j) {
+      Y(j, 0) = std::pow(te, j);
+      Y(j, 1) = j >= 1 ? j * std::pow(te, j - 1) : 0.0;
+      Y(j, 2) = j >= 2 ? j * (j - 1) * std::pow(te, j - 2) : 0.0;
+      for (int i = 0; i < j; ++i) Y.row(j) -= QR(i, j) * Y.row(i);
+      Y.row(j) /= QR(j, j);
+    }
+    // coeff^T = Q [Y; 0] (w x 3): the reflectors H_{n-1} .. H_0 applied in turn,
+    // H_j = I - h_j v_j v_j^T with v_j = (0 .. 0, 1, QR(j+1 .., j)).
+    coeff_t_.setZero(w, 3);
+    coeff_t_.topRows(n_) = Y;
+    for (int j = n_ - 1; j >= 0; --j) {
+      const int len = w - j - 1;
+      Eigen::Matrix<double, 1, 3> vx =
+          coeff_t_.row(j) + QR.col(j).segment(j + 1, len).transpose() * coeff_t_.bottomRows(len);
+      vx *= h_[j];
+      coeff_t_.row(j) -= vx;
+      coeff_t_.bottomRows(len).noalias() -= QR.col(j).segment(j + 1, len) * vx;
+    }
+    coeff_ = coeff_t_.transpose();
+    coeff_.row(1) /= half;
+    coeff_.row(2) /= half * half;
+  }
+
   bool updateKalman(double t, const double* x) {
     const int n = n_;
     if (count_ == 0) {
-      // Start at the first measurement, at rest, with a wide prior on the derivatives.
-      state_.setZero();
-      for (int c = 0; c < channels_; ++c) state_(0, c) = x[c];
-      P_.setZero();
-      const double r2 = config_.measurement_noise * config_.measurement_noise;
-      P_(0, 0) = r2;
-      for (int i = 1; i < n; ++i) P_(i, i) = 1e12 * r2;
-      K_.setZero(n);
-      gain_settled_ = false;
-      S_.setZero(n, n);
-      S_(0, 0) = 1.0;  // the state starts at the measurement
-      noise_settled_ = false;
-      prev_t_ = t;
-      count_ = 1;
-      stamp_ = t;
-      out_.topRows(std::min(3, n)) = state_.topRows(std::min(3, n));
+      startKalman(t, x);
       return false;
     }
     const double dt = t - prev_t_;
     prev_t_ = t;
-    // Exact discretisation for this dt: F = exp(A dt) of the integrator chain, Q the
-    // integrated white noise of density q on the highest derivative. Recomputed only
-    // when dt changes by more than the time axis resolves (see fitSavitzkyGolay).
-    bool changed = false;
-    if (!(std::abs(dt - dt_prev_) <= 1e-10)) {
-      changed = true;
-      double fact[2 * kMaxOrder + 2], dt_pow[2 * kMaxOrder + 2];
-      fact[0] = 1.0;
-      dt_pow[0] = 1.0;
-      for (int i = 1; i < 2 * kMaxOrder + 2; ++i) {
-        fact[i] = fact[i - 1] * i;
-        dt_pow[i] = dt_pow[i - 1] * dt;
-      }
-      F_.setIdentity(n, n);
-      Q_.resize(n, n);
-      for (int i = 0; i < n; ++i)
-        for (int j = i + 1; j < n; ++j) F_(i, j) = dt_pow[j - i] / fact[j - i];
-      const double q = config_.process_noise;
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          const int a = n - 1 - i, b = n - 1 - j;
-          Q_(i, j) = q * dt_pow[a + b + 1] / (fact[a] * fact[b] * (a + b + 1));
-        }
-      dt_prev_ = dt;
-    }
-    const SmallMatrix& F = F_;
-    const SmallMatrix& Q = Q_;
+    const bool changed = discretize(dt);
     // Predict, then update with the position measurement: the gain is the same for
     // every channel, so the covariance is propagated once; at a steady rate it reaches
     // its fixed point (the Riccati recursion converges), after which the gain stays.
     const bool steady = !changed && gain_settled_;
-    if (!steady) {
-      P_ = F * P_ * F.transpose() + Q;
-      const double S = P_(0, 0) + config_.measurement_noise * config_.measurement_noise;
-      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
-      P_ -= K * P_.row(0);
-      P_ = 0.5 * (P_ + P_.transpose()).eval();
-      gain_settled_ = count_ >= n && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
-      K_ = K;
-    }
+    if (!steady) updateKalmanGain();
     // Noise gain: kept once it no longer changes under a settled gain.
-    if (!(steady && noise_settled_)) {
-      SmallMatrix A = -K_ * F.row(0);
-      A += F;  // (I - K H) F with H = (1, 0, ..)
-      SmallMatrix S = A * S_ * A.transpose();
-      S += K_ * K_.transpose();
-      noise_settled_ = steady && (S - S_).cwiseAbs().maxCoeff() <= 1e-14 * S.cwiseAbs().maxCoeff();
-      S_ = S;
-    }
+    if (!(steady && noise_settled_)) updateNoiseGain(steady);
     if (n == 3)
       kalmanChannels<3>(x);
     else
@@ -321,6 +282,79 @@ class DifferentiatorBank {
     out_ = state_.topRows(3);
     if (count_ < n) ++count_;
     return count_ >= n;
+  }
+
+  // The first sample: the state starts at the measurement, at rest, with a wide prior on
+  // the derivatives.
+  void startKalman(double t, const double* x) {
+    const int n = n_;
+    state_.setZero();
+    for (int c = 0; c < channels_; ++c) state_(0, c) = x[c];
+    P_.setZero();
+    const double r2 = config_.measurement_noise * config_.measurement_noise;
+    P_(0, 0) = r2;
+    for (int i = 1; i < n; ++i) P_(i, i) = 1e12 * r2;
+    K_.setZero(n);
+    gain_settled_ = false;
+    S_.setZero(n, n);
+    S_(0, 0) = 1.0;  // the state starts at the measurement
+    noise_settled_ = false;
+    prev_t_ = t;
+    count_ = 1;
+    stamp_ = t;
+    out_.topRows(std::min(3, n)) = state_.topRows(std::min(3, n));
+  }
+
+  // Exact discretisation for this dt [s]: F = exp(A dt) of the integrator chain, Q the
+  // integrated white noise of density q on the highest derivative. Recomputed (true)
+  // only when dt changes by more than the time axis resolves (see sameSpacing).
+  bool discretize(double dt) {
+    if (std::abs(dt - dt_prev_) <= 1e-10) return false;
+    const int n = n_;
+    double fact[2 * kMaxOrder + 2], dt_pow[2 * kMaxOrder + 2];
+    fact[0] = 1.0;
+    dt_pow[0] = 1.0;
+    for (int i = 1; i < 2 * kMaxOrder + 2; ++i) {
+      fact[i] = fact[i - 1] * i;
+      dt_pow[i] = dt_pow[i - 1] * dt;
+    }
+    F_.setIdentity(n, n);
+    Q_.resize(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) F_(i, j) = dt_pow[j - i] / fact[j - i];
+    const double q = config_.process_noise;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int a = n - 1 - i, b = n - 1 - j;
+        Q_(i, j) = q * dt_pow[a + b + 1] / (fact[a] * fact[b] * (a + b + 1));
+      }
+    dt_prev_ = dt;
+    return true;
+  }
+
+  // The covariance P_ predicted and updated, and the gain K_ (settled once it no longer
+  // changes).
+  void updateKalmanGain() {
+    const SmallMatrix& F = F_;
+    const SmallMatrix& Q = Q_;
+    P_ = F * P_ * F.transpose() + Q;
+    const double S = P_(0, 0) + config_.measurement_noise * config_.measurement_noise;
+    const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
+    P_ -= K * P_.row(0);
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    gain_settled_ = count_ >= n_ && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
+    K_ = K;
+  }
+
+  // The noise gain S_ = A S_ A^T + K K^T with A = (I - K H) F (noiseGain()).
+  void updateNoiseGain(bool steady) {
+    const SmallMatrix& F = F_;
+    SmallMatrix A = -K_ * F.row(0);
+    A += F;  // (I - K H) F with H = (1, 0, ..)
+    SmallMatrix S = A * S_ * A.transpose();
+    S += K_ * K_.transpose();
+    noise_settled_ = steady && (S - S_).cwiseAbs().maxCoeff() <= 1e-14 * S.cwiseAbs().maxCoeff();
+    S_ = S;
   }
 
   // x <- F x + K (measurement - (F x)_0) for every channel, at fixed size N.

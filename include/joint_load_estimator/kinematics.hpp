@@ -31,6 +31,19 @@ struct BaseState {
   Vector3 omega_world = Vector3::Zero();   ///< [rad/s]
   Vector3 a_world = Vector3::Zero();       ///< acceleration of the base origin [m/s^2]
   Vector3 alpha_world = Vector3::Zero();   ///< [rad/s^2]
+
+  /// The same state in another scalar type.
+  template <typename Other>
+  BaseState<Other> cast() const {
+    BaseState<Other> out;
+    out.R_world_base = R_world_base.template cast<Other>();
+    out.p_world_base = p_world_base.template cast<Other>();
+    out.v_world = v_world.template cast<Other>();
+    out.omega_world = omega_world.template cast<Other>();
+    out.a_world = a_world.template cast<Other>();
+    out.alpha_world = alpha_world.template cast<Other>();
+    return out;
+  }
 };
 
 /// Rotation by angle q [rad] about the unit vector u (Rodrigues).

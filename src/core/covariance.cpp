@@ -23,9 +23,9 @@
 // so each term is an outer product (J F)(J F)^T.
 // y is linear in qdd, in the inputs and in the mass and inertia: those parts are exact;
 // its dependence on q and qd (and on the centre of mass) is linearised at the estimate.
-#include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/covariance.hpp>
 
-#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/estimator.hpp>  // UncertaintyConfig, WrenchInputConfig
 
 #include <Eigen/Cholesky>
 
@@ -39,6 +39,13 @@ namespace {
 
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// uncertainty.period: a gap of more than kGapPeriods periods (or a stamp not after the
+// last computed one) starts the history again: the quadratic is not trusted that far.
+// "A period past" to a millionth of it (kSamePeriod): a stamp difference carries the
+// rounding of the double time axis, and 18 samples at 1 kHz should be 18 ms, not
+// sometimes 19 samples.
+constexpr double kGapPeriods = 3.0, kSamePeriod = 1e-6;
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d S;
@@ -69,285 +76,423 @@ void addForceCongruence(const Eigen::Matrix3d& R, const Eigen::Vector3d& r, cons
   out.bottomRightCorner<3, 3>() += SB + SB.transpose() + Y.bottomRightCorner<3, 3>();
 }
 
+// out += J J^T, or only its diagonal.
+template <typename Jacobian>
+void addOuterProduct(bool diagonal, const Jacobian& J, Matrix6& out) {
+  if (diagonal)
+    out.diagonal() += J.cwiseAbs2().rowwise().sum();
+  else
+    out.noalias() += J * J.transpose();
+}
+
+// Per segment: the end of its subtree, [i, end). Segments are numbered depth first: each
+// subtree is a range of indices.
+std::vector<int> subtreeEnds(const Model<double>& model) {
+  const int n = model.nsegments();
+  std::vector<int> end(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) end[i] = i + 1;
+  for (int i = n - 1; i > 0; --i) end[model.parent[i]] = std::max(end[model.parent[i]], end[i]);
+  for (int i = 0; i < n; ++i)
+    for (int k = i + 1; k < end[i]; ++k)
+      if (model.parent[k] < i) throw std::logic_error("covariance: segments are not numbered depth first");
+  return end;
+}
+
+std::vector<char> membership(int n, const std::vector<int>& segments) {
+  std::vector<char> in(static_cast<std::size_t>(n), 0);
+  for (int i : segments) in[i] = 1;
+  return in;
+}
+
+// Coordinate j's sweep: the segments it moves (the subtrees of the joints it drives,
+// which the loads need), and, when it drives several disjoint subtrees (mimic joints),
+// the computed segments above them, which see the sum of their effects. `mark`: scratch.
+void setUpSweep(const Model<double>& model, CovarianceModel& cm, int j, std::vector<char>& mark) {
+  const int n = model.nsegments();
+  mark.assign(mark.size(), 0);
+  bool needed = false;
+  for (int s : cm.kinematics_segments) {
+    if (model.coordinate[s] != j || !isMoving(model.joint_type[s])) continue;
+    for (int k = s; k < cm.subtree_end[s]; ++k) {
+      mark[k] = cm.in_kinematics[k];
+      needed = needed || cm.in_dynamics[k];
+    }
+  }
+  if (!needed) return;  // moves nothing whose loads are computed
+  int roots = 0;
+  for (int k = 0; k < n; ++k) {
+    if (!mark[k]) continue;
+    cm.sweep[j].push_back(k);
+    if (model.parent[k] < 0 || !mark[model.parent[k]]) ++roots;
+  }
+  cm.single_root[j] = roots == 1;
+  if (roots <= 1) return;
+  std::vector<char> above(mark.size(), 0);
+  for (int k : cm.sweep[j])
+    if (model.parent[k] >= 0 && !mark[model.parent[k]])
+      for (int p = model.parent[k]; p >= 0; p = model.parent[p]) above[p] = 1;
+  for (int k = n - 1; k >= 0; --k)
+    if (above[k] && cm.in_dynamics[k]) cm.sweep_ancestors[j].push_back(k);
+}
+
 }  // namespace
 
-void Estimator::setUpCovariance() {
-  const UncertaintyConfig& u = config_.uncertainty;
-  const int n = model_.nsegments();
-  const std::size_t ns = static_cast<std::size_t>(n);
-  covariance_.assign(ns, Matrix6::Zero());
-  cov_history_ = 0;
-  if (!u.enabled) return;
-  if (u.period > 0.0) {
-    for (auto* c : {&cov_last_, &cov_prev_, &cov_prev2_}) c->assign(ns, Matrix6::Zero());
+CovarianceModel::CovarianceModel(const Model<double>& model, const UncertaintyConfig& uncertainty,
+                                 const std::vector<WrenchInputConfig>& wrenches,
+                                 const std::vector<int>& input_frames,
+                                 const std::vector<int>& kinematics_segments,
+                                 const std::vector<int>& dynamics_segments)
+    : enabled(uncertainty.enabled),
+      diagonal_only(uncertainty.diagonal_only),
+      linearize_state(uncertainty.linearize_state),
+      var_position(uncertainty.position_noise * uncertainty.position_noise),
+      mass_fraction(uncertainty.mass_fraction),
+      com_offset(uncertainty.com_offset),
+      inertia_fraction(uncertainty.inertia_fraction),
+      period(uncertainty.period),
+      gain_tolerance(uncertainty.gain_tolerance),
+      kinematics_segments(kinematics_segments),
+      dynamics_segments(dynamics_segments) {
+  // The noises are checked by validate(EstimatorConfig).
+  if (!enabled) return;
+  for (std::size_t k = 0; k < wrenches.size(); ++k) {
+    const WrenchInputConfig& c = wrenches[k];
+    if (input_frames[k] < 0 || (c.force_noise == 0.0 && c.moment_noise == 0.0)) continue;
+    inputs.push_back({input_frames[k], c.force_noise * c.force_noise, c.moment_noise * c.moment_noise});
   }
-  local_.assign(ns, Matrix6::Zero());
-  for (auto* t : {&t_w_, &t_al_, &t_acc_, &t_f_, &t_n_}) t->assign(ns, Eigen::Matrix3d::Zero());
-  jacobian_.assign(ns, Eigen::Matrix<double, 6, 3>::Zero());
-  // Segments are numbered depth first: each subtree is a range of indices.
-  subtree_end_.resize(ns);
-  for (int i = 0; i < n; ++i) subtree_end_[i] = i + 1;
-  for (int i = n - 1; i > 0; --i)
-    subtree_end_[model_.parent[i]] = std::max(subtree_end_[model_.parent[i]], subtree_end_[i]);
-  for (int i = 0; i < n; ++i)
-    for (int k = i + 1; k < subtree_end_[i]; ++k)
-      if (model_.parent[k] < i)
-        throw std::logic_error("covariance: segments are not numbered depth first");
-  in_dynamics_.assign(ns, 0);
-  for (int i : dynamics_segments_) in_dynamics_[i] = 1;
-  in_kinematics_.assign(ns, 0);
-  for (int i : kinematics_segments_) in_kinematics_[i] = 1;
-  sweep_mark_.assign(ns, 0);
-  // Per coordinate: the segments it moves (the subtrees of the joints it drives, which
-  // the loads need), and, when it drives several disjoint subtrees (mimic joints), the
-  // computed segments above them, which see the sum of their effects.
-  const std::size_t nq = static_cast<std::size_t>(model_.nq);
-  sweep_.assign(nq, {});
-  sweep_ancestors_.assign(nq, {});
-  single_root_.assign(nq, 1);
-  std::vector<char> mark(ns);
-  for (int j = 0; j < model_.nq; ++j) {
-    mark.assign(ns, 0);
-    bool needed = false;
-    for (int s : kinematics_segments_) {
-      if (model_.coordinate[s] != j || !isMoving(model_.joint_type[s])) continue;
-      for (int k = s; k < subtree_end_[s]; ++k) {
-        mark[k] = in_kinematics_[k];
-        needed = needed || in_dynamics_[k];
-      }
-    }
-    if (!needed) continue;  // moves nothing whose loads are computed
-    int roots = 0;
-    for (int k = 0; k < n; ++k) {
-      if (!mark[k]) continue;
-      sweep_[j].push_back(k);
-      if (model_.parent[k] < 0 || !mark[model_.parent[k]]) ++roots;
-    }
-    single_root_[j] = roots == 1;
-    if (roots > 1) {
-      std::vector<char> above(ns, 0);
-      for (int k : sweep_[j])
-        if (model_.parent[k] >= 0 && !mark[model_.parent[k]])
-          for (int p = model_.parent[k]; p >= 0; p = model_.parent[p]) above[p] = 1;
-      for (int k = n - 1; k >= 0; --k)
-        if (above[k] && in_dynamics_[k]) sweep_ancestors_[j].push_back(k);
-    }
-  }
+  const int n = model.nsegments();
+  subtree_end = subtreeEnds(model);
+  in_dynamics = membership(n, dynamics_segments);
+  in_kinematics = membership(n, kinematics_segments);
+  const std::size_t nq = static_cast<std::size_t>(model.nq);
+  sweep.assign(nq, {});
+  sweep_ancestors.assign(nq, {});
+  single_root.assign(nq, 1);
+  std::vector<char> mark(static_cast<std::size_t>(n));
+  for (int j = 0; j < model.nq; ++j) setUpSweep(model, *this, j, mark);
 }
 
-void Estimator::loadsPass(Data<double>& data, const VectorX<double>& q, const VectorX<double>& qd,
-                          const BaseState<double>& base_state) {
-  forwardKinematics(model_, data, q, qd, qdd_, config_.gravity_world, base_state,
-                    kinematics_segments_, false);
-  for (std::size_t k = 0; k < inputs_.size(); ++k) {
-    if (!inputs_[k].needed) continue;
-    const int c = wrench_channel_ + 6 * static_cast<int>(k);
-    const Eigen::Vector3d f(bank_.value(c), bank_.value(c + 1), bank_.value(c + 2));
-    const Eigen::Vector3d m(bank_.value(c + 3), bank_.value(c + 4), bank_.value(c + 5));
-    addExternalWrench(model_, data, inputs_[k].frame, f, m, WrenchFrame::kLocal);
-  }
-  inverseDynamics(model_, data, dynamics_segments_);
+CovarianceWorkspace::CovarianceWorkspace(const CovarianceModel& cm, int segments) {
+  const std::size_t ns = static_cast<std::size_t>(segments);
+  covariance.assign(ns, Matrix6::Zero());
+  if (!cm.enabled) return;
+  if (cm.period > 0.0)
+    for (auto* c : {&last, &prev, &prev2}) c->assign(ns, Matrix6::Zero());
+  local.assign(ns, Matrix6::Zero());
+  for (auto* t : {&t_w, &t_al, &t_acc, &t_f, &t_n}) t->assign(ns, Eigen::Matrix3d::Zero());
+  jacobian.assign(ns, Eigen::Matrix<double, 6, 3>::Zero());
+  sweep_mark.assign(ns, 0);
 }
+
+namespace {
 
 // One coordinate's sweep: the derivatives of the kinematics and of the joint wrenches of
 // every segment it moves, along the NC noise directions of the columns of F (rows: q,
 // qd, qdd; kState false: the q-ddot direction only, one column). Each computed segment
 // of the sweep gets its outer product; the wrench handed out of the sweep goes to the
-// parent's local_ (one root) or is carried up explicitly (several roots: mimics).
+// parent's local (one root) or is carried up explicitly (several roots: mimics).
+template <bool kState>
+class Sweep {
+ public:
+  static constexpr int NC = kState ? 3 : 1;
+  using M = Eigen::Matrix<double, 3, NC>;
+  using Row = Eigen::Matrix<double, 1, NC>;
+  using J6 = Eigen::Matrix<double, 6, NC>;
+
+  Sweep(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
+        const Data<double>& nom, int j, const M& F)
+      : cm_(cm), ws_(ws), model_(model), nom_(nom), j_(j), tag_(j + 1), F_(F) {}
+
+  void run();
+
+ private:
+  void forward(int k);
+  void fromParent(int k);
+  void jointTerms(int k, bool driven);
+  void backward(int k);
+  void inertialTangent(int k);
+  void handToParent(int k);
+  void ancestor(int a);
+
+  const CovarianceModel& cm_;
+  CovarianceWorkspace& ws_;
+  const Model<double>& model_;
+  const Data<double>& nom_;
+  const int j_, tag_;
+  const M& F_;
+};
+
 template <bool kState>
 #if defined(__GNUC__)
 // Inline every small fixed-size Eigen product (GCC leaves many out of line): 2x faster.
 __attribute__((flatten))
 #endif
-void Estimator::sweepCoordinate(int j, const Data<double>& nom,
-                                const Eigen::Matrix<double, 3, kState ? 3 : 1>& F) {
-  constexpr int NC = kState ? 3 : 1;
-  using M = Eigen::Matrix<double, 3, NC>;
-  using Row = Eigen::Matrix<double, 1, NC>;
-  using J6 = Eigen::Matrix<double, 6, NC>;
-  const bool diagonal = config_.uncertainty.diagonal_only;
-  const std::vector<int>& sweep = sweep_[j];
-  const int tag = j + 1;
-  for (int k : sweep) sweep_mark_[k] = tag;
-
+void Sweep<kState>::run() {
+  const std::vector<int>& sweep = cm_.sweep[j_];
+  for (int k : sweep) ws_.sweep_mark[k] = tag_;
   // Forward: the tangent of omega, alpha and the origin acceleration, segment frame.
-  for (int k : sweep) {
-    const int p = model_.parent[k];
-    const Eigen::Matrix3d& R = nom.R_parent_child[k];
-    const Eigen::Vector3d& r = nom.p_parent_child[k];
-    const Eigen::Vector3d& u = model_.axis[k];
-    const double qd_k = nom.qd[k];
-    auto w = t_w_[k].leftCols<NC>();
-    auto al = t_al_[k].leftCols<NC>();
-    auto acc = t_acc_[k].leftCols<NC>();
-    if (p >= 0 && sweep_mark_[p] == tag) {
-      const auto w_p = t_w_[p].leftCols<NC>();
-      const auto al_p = t_al_[p].leftCols<NC>();
-      M a_point = t_acc_[p].leftCols<NC>();
-      a_point.noalias() -= skew(r) * al_p;  // al_p x r
-      if (kState) {
-        const Eigen::Vector3d& wn_p = nom.omega[p];
-        // d(w x (w x r)) = dw x (w x r) + w x (dw x r)
-        a_point.noalias() -= (skew(wn_p.cross(r)) + skew(wn_p) * skew(r)) * w_p;
-        w.noalias() = R.transpose() * w_p;
-      } else {
-        w.setZero();
-      }
-      al.noalias() = R.transpose() * al_p;
-      acc.noalias() = R.transpose() * a_point;
-    } else {
-      w.setZero();
-      al.setZero();
-      acc.setZero();
-    }
-    const bool driven = model_.coordinate[k] == j && isMoving(model_.joint_type[k]);
-    const double mu = model_.multiplier[k];
-    const Eigen::Vector3d& wn = nom.omega[k];
-    if (model_.joint_type[k] == JointType::kRevolute) {
-      if (driven) {
-        // The joint rotation R(theta) enters as R^T: d(R^T x)/d theta = -u x R^T x.
-        const Row a = mu * F.row(0), b = mu * F.row(1), c = mu * F.row(2);
-        if (kState) {
-          const Eigen::Vector3d Rt_wp = wn - u * qd_k;
-          w.noalias() += (-u.cross(Rt_wp)) * a + u * b;
-          const Eigen::Vector3d Rt_alp = nom.alpha[k] - u * nom.qdd[k] - wn.cross(u * qd_k);
-          al.noalias() += (-u.cross(Rt_alp)) * a + wn.cross(u) * b;
-          acc.noalias() += (-u.cross(nom.acc[k])) * a;
-        }
-        al.noalias() += u * c;
-      }
-      if (kState && qd_k != 0.0) al.noalias() -= skew(u * qd_k) * w;  // dw x u qd
-    } else if (model_.joint_type[k] == JointType::kPrismatic) {
-      if (driven) {
-        const Row a = mu * F.row(0), b = mu * F.row(1), c = mu * F.row(2);
-        if (kState) {
-          const Eigen::Vector3d& aln = nom.alpha[k];
-          acc.noalias() += (aln.cross(u) + wn.cross(wn.cross(u))) * a + (2.0 * wn.cross(u)) * b;
-        }
-        acc.noalias() += u * c;
-      }
-      if (kState && qd_k != 0.0) acc.noalias() -= skew(2.0 * qd_k * u) * w;  // 2 dw x u qd
-    }
-    t_f_[k].leftCols<NC>().setZero();
-    t_n_[k].leftCols<NC>().setZero();
-  }
-
+  for (int k : sweep) forward(k);
   // Backward: the tangent of each joint wrench, its outer product, handed to the parent.
-  const std::vector<int>& ancestors = sweep_ancestors_[j];
-  for (int a : ancestors) jacobian_[a].leftCols<NC>().setZero();
-  for (auto it = sweep.rbegin(); it != sweep.rend(); ++it) {
-    const int k = *it;
-    if (!in_dynamics_[k]) continue;
-    auto f = t_f_[k].leftCols<NC>();
-    auto nmo = t_n_[k].leftCols<NC>();
-    if (model_.has_inertia[k]) {
-      const double m = model_.mass[k];
-      const Eigen::Vector3d& c = model_.com[k];
-      const Eigen::Matrix3d& I = model_.inertia_com[k];
-      const Eigen::Matrix3d C = skew(c);
-      const auto al = t_al_[k].leftCols<NC>();
-      M dacom = t_acc_[k].leftCols<NC>();
-      dacom.noalias() -= C * al;
-      if (kState) {
-        const Eigen::Vector3d& wn = nom.omega[k];
-        const auto w = t_w_[k].leftCols<NC>();
-        dacom.noalias() -= (skew(wn.cross(c)) + skew(wn) * C) * w;
-        if (model_.gyroscopic[k]) nmo.noalias() += (skew(wn) * I - skew(I * wn)) * w;
-      }
-      const M df = m * dacom;
-      f += df;
-      nmo.noalias() += I * al;
-      nmo.noalias() += C * df;
-    }
-    J6 Jk;
-    Jk << f, nmo;
-    if (diagonal)
-      covariance_[k].diagonal() += Jk.cwiseAbs2().rowwise().sum();
-    else
-      covariance_[k].noalias() += Jk * Jk.transpose();
-    const int p = model_.parent[k];
-    if (p < 0 || !in_dynamics_[p]) continue;
-    // The wrench handed to the parent, X (f, n), and its change with the joint's own
-    // coordinate: d(R f)/d theta = R (u x f) (revolute); d(r x R f)/d d = R (u x f) (prismatic).
-    const Eigen::Matrix3d& R = nom.R_parent_child[k];
-    const Eigen::Vector3d& r = nom.p_parent_child[k];
-    M f_p = R * f;
-    M n_p = R * nmo;
-    if (kState && model_.coordinate[k] == j && isMoving(model_.joint_type[k])) {
-      const Row a = model_.multiplier[k] * F.row(0);
-      const Eigen::Vector3d& u = model_.axis[k];
-      if (model_.joint_type[k] == JointType::kRevolute) {
-        f_p.noalias() += (R * u.cross(nom.force[k])) * a;
-        n_p.noalias() += (R * u.cross(nom.moment[k])) * a;
-      } else {
-        n_p.noalias() += (R * u.cross(nom.force[k])) * a;
-      }
-    }
-    n_p.noalias() += skew(r) * f_p;
-    if (sweep_mark_[p] == tag) {
-      t_f_[p].leftCols<NC>() += f_p;
-      t_n_[p].leftCols<NC>() += n_p;
-    } else if (single_root_[j]) {
-      J6 g;
-      g << f_p, n_p;
-      local_[p].noalias() += g * g.transpose();
-    } else {
-      jacobian_[p].topLeftCorner<3, NC>() += f_p;
-      jacobian_[p].bottomLeftCorner<3, NC>() += n_p;
-    }
-  }
+  const std::vector<int>& ancestors = cm_.sweep_ancestors[j_];
+  for (int a : ancestors) ws_.jacobian[a].leftCols<NC>().setZero();
+  for (auto it = sweep.rbegin(); it != sweep.rend(); ++it) backward(*it);
   // Several roots (a mimic driving disjoint subtrees): their effects add before the
   // outer product, so the segments above are done here.
-  for (int a : ancestors) {
-    const J6 Ja = jacobian_[a].leftCols<NC>();
-    if (diagonal)
-      covariance_[a].diagonal() += Ja.cwiseAbs2().rowwise().sum();
-    else
-      covariance_[a].noalias() += Ja * Ja.transpose();
-    const int p = model_.parent[a];
-    if (p < 0 || !in_dynamics_[p]) continue;
-    const Eigen::Matrix3d& R = nom.R_parent_child[a];
-    const M f_p = R * Ja.template topRows<3>();
-    jacobian_[p].topLeftCorner<3, NC>() += f_p;
-    jacobian_[p].bottomLeftCorner<3, NC>().noalias() += R * Ja.template bottomRows<3>();
-    jacobian_[p].bottomLeftCorner<3, NC>().noalias() += skew(nom.p_parent_child[a]) * f_p;
-  }
-  for (int k : sweep) sweep_mark_[k] = 0;
+  for (int a : ancestors) ancestor(a);
+  for (int k : sweep) ws_.sweep_mark[k] = 0;
 }
 
-// uncertainty.period, between two computations: the quadratic through the last three
-// computed covariances C_0, C_1, C_2 at their stamps t_0 > t_1 > t_2 (Lagrange, at any
-// spacing), at the stamp t: with x = t - t_0, a = t_1 - t_0, b = t_2 - t_0,
-//    C = (x-a)(x-b)/(a b) C_0 + x(x-b)/(a (a-b)) C_1 + x(x-a)/(b (b-a)) C_2
-// (equal spacing h, s = x/h: (1+s)(2+s)/2 C_0 - s(2+s) C_1 + s(1+s)/2 C_2).
-// The covariance is a smooth function of the state, so this is exact to third order in
-// the time since t_0 (holding C_0: first order; the straight line through the last two:
-// second order, which overshoots where a variance turns round near its minimum;
-// docs/uncertainty.md measures the three). Elementwise, so as symmetric as the computed
-// ones. A variance extrapolated below 0 is set to 0, and its row and column with it (no
-// covariance without variance).
-void Estimator::extrapolateCovariance(double t) {
-  const double x = t - cov_time_[0], a = cov_time_[1] - cov_time_[0],
-               b = cov_time_[2] - cov_time_[0];
-  const double w0 = (x - a) * (x - b) / (a * b), w1 = x * (x - b) / (a * (a - b)),
-               w2 = x * (x - a) / (b * (b - a));
-  const bool diagonal = config_.uncertainty.diagonal_only;
-  for (int i : dynamics_segments_) {
-    Matrix6& out = covariance_[i];
-    if (diagonal)
-      out.diagonal() = w0 * cov_last_[i].diagonal() + w1 * cov_prev_[i].diagonal() +
-                       w2 * cov_prev2_[i].diagonal();
-    else
-      out = w0 * cov_last_[i] + w1 * cov_prev_[i] + w2 * cov_prev2_[i];
-    for (int r = 0; r < 6; ++r) {
-      if (out(r, r) >= 0.0) continue;
-      out.row(r).setZero();
-      out.col(r).setZero();
+template <bool kState>
+void Sweep<kState>::forward(int k) {
+  fromParent(k);
+  const JointType type = model_.joint_type[k];
+  if (type == JointType::kRevolute || type == JointType::kPrismatic)
+    jointTerms(k, model_.coordinate[k] == j_ && isMoving(type));
+  ws_.t_f[k].leftCols<NC>().setZero();
+  ws_.t_n[k].leftCols<NC>().setZero();
+}
+
+// The tangents the parent's carry over to segment k (zero at a root of the sweep).
+template <bool kState>
+void Sweep<kState>::fromParent(int k) {
+  const int p = model_.parent[k];
+  auto w = ws_.t_w[k].leftCols<NC>();
+  auto al = ws_.t_al[k].leftCols<NC>();
+  auto acc = ws_.t_acc[k].leftCols<NC>();
+  if (!(p >= 0 && ws_.sweep_mark[p] == tag_)) {
+    w.setZero();
+    al.setZero();
+    acc.setZero();
+    return;
+  }
+  const Eigen::Matrix3d& R = nom_.R_parent_child[k];
+  const Eigen::Vector3d& r = nom_.p_parent_child[k];
+  const auto w_p = ws_.t_w[p].leftCols<NC>();
+  const auto al_p = ws_.t_al[p].leftCols<NC>();
+  M a_point = ws_.t_acc[p].leftCols<NC>();
+  a_point.noalias() -= skew(r) * al_p;  // al_p x r
+  if (kState) {
+    const Eigen::Vector3d& wn_p = nom_.omega[p];
+    // d(w x (w x r)) = dw x (w x r) + w x (dw x r)
+    a_point.noalias() -= (skew(wn_p.cross(r)) + skew(wn_p) * skew(r)) * w_p;
+    w.noalias() = R.transpose() * w_p;
+  } else {
+    w.setZero();
+  }
+  al.noalias() = R.transpose() * al_p;
+  acc.noalias() = R.transpose() * a_point;
+}
+
+// A revolute or prismatic joint's own terms: its coordinate's (driven) and its rate's.
+template <bool kState>
+void Sweep<kState>::jointTerms(int k, bool driven) {
+  const bool revolute = model_.joint_type[k] == JointType::kRevolute;
+  auto w = ws_.t_w[k].leftCols<NC>();
+  auto al = ws_.t_al[k].leftCols<NC>();
+  auto acc = ws_.t_acc[k].leftCols<NC>();
+  const Eigen::Vector3d& u = model_.axis[k];
+  const Eigen::Vector3d& wn = nom_.omega[k];
+  const double qd_k = nom_.qd[k];
+  if (driven) {
+    const double mu = model_.multiplier[k];
+    const Row a = mu * F_.row(0), b = mu * F_.row(1), c = mu * F_.row(2);
+    if (kState && revolute) {
+      // The joint rotation R(theta) enters as R^T: d(R^T x)/d theta = -u x R^T x.
+      const Eigen::Vector3d Rt_wp = wn - u * qd_k;
+      w.noalias() += (-u.cross(Rt_wp)) * a + u * b;
+      const Eigen::Vector3d Rt_alp = nom_.alpha[k] - u * nom_.qdd[k] - wn.cross(u * qd_k);
+      al.noalias() += (-u.cross(Rt_alp)) * a + wn.cross(u) * b;
+      acc.noalias() += (-u.cross(nom_.acc[k])) * a;
+    } else if (kState) {
+      const Eigen::Vector3d& aln = nom_.alpha[k];
+      acc.noalias() += (aln.cross(u) + wn.cross(wn.cross(u))) * a + (2.0 * wn.cross(u)) * b;
+    }
+    (revolute ? al : acc).noalias() += u * c;
+  }
+  if (!kState || qd_k == 0.0) return;
+  if (revolute)
+    al.noalias() -= skew(u * qd_k) * w;  // dw x u qd
+  else
+    acc.noalias() -= skew(2.0 * qd_k * u) * w;  // 2 dw x u qd
+}
+
+template <bool kState>
+void Sweep<kState>::backward(int k) {
+  if (!cm_.in_dynamics[k]) return;
+  if (model_.has_inertia[k]) inertialTangent(k);
+  J6 Jk;
+  Jk << ws_.t_f[k].leftCols<NC>(), ws_.t_n[k].leftCols<NC>();
+  addOuterProduct(cm_.diagonal_only, Jk, ws_.covariance[k]);
+  const int p = model_.parent[k];
+  if (p >= 0 && cm_.in_dynamics[p]) handToParent(k);
+}
+
+// Segment k's own inertial wrench, its tangent added to what its children handed it.
+template <bool kState>
+void Sweep<kState>::inertialTangent(int k) {
+  auto f = ws_.t_f[k].leftCols<NC>();
+  auto nmo = ws_.t_n[k].leftCols<NC>();
+  const double m = model_.mass[k];
+  const Eigen::Vector3d& c = model_.com[k];
+  const Eigen::Matrix3d& I = model_.inertia_com[k];
+  const Eigen::Matrix3d C = skew(c);
+  const auto al = ws_.t_al[k].leftCols<NC>();
+  M dacom = ws_.t_acc[k].leftCols<NC>();
+  dacom.noalias() -= C * al;
+  if (kState) {
+    const Eigen::Vector3d& wn = nom_.omega[k];
+    const auto w = ws_.t_w[k].leftCols<NC>();
+    dacom.noalias() -= (skew(wn.cross(c)) + skew(wn) * C) * w;
+    if (model_.gyroscopic[k]) nmo.noalias() += (skew(wn) * I - skew(I * wn)) * w;
+  }
+  const M df = m * dacom;
+  f += df;
+  nmo.noalias() += I * al;
+  nmo.noalias() += C * df;
+}
+
+// The wrench handed to the parent, X (f, n), and its change with the joint's own
+// coordinate: d(R f)/d theta = R (u x f) (revolute); d(r x R f)/d d = R (u x f) (prismatic).
+template <bool kState>
+void Sweep<kState>::handToParent(int k) {
+  const int p = model_.parent[k];
+  const Eigen::Matrix3d& R = nom_.R_parent_child[k];
+  const Eigen::Vector3d& r = nom_.p_parent_child[k];
+  M f_p = R * ws_.t_f[k].leftCols<NC>();
+  M n_p = R * ws_.t_n[k].leftCols<NC>();
+  if (kState && model_.coordinate[k] == j_ && isMoving(model_.joint_type[k])) {
+    const Row a = model_.multiplier[k] * F_.row(0);
+    const Eigen::Vector3d& u = model_.axis[k];
+    if (model_.joint_type[k] == JointType::kRevolute) {
+      f_p.noalias() += (R * u.cross(nom_.force[k])) * a;
+      n_p.noalias() += (R * u.cross(nom_.moment[k])) * a;
+    } else {
+      n_p.noalias() += (R * u.cross(nom_.force[k])) * a;
     }
   }
+  n_p.noalias() += skew(r) * f_p;
+  if (ws_.sweep_mark[p] == tag_) {
+    ws_.t_f[p].leftCols<NC>() += f_p;
+    ws_.t_n[p].leftCols<NC>() += n_p;
+  } else if (cm_.single_root[j_]) {
+    J6 g;
+    g << f_p, n_p;
+    ws_.local[p].noalias() += g * g.transpose();
+  } else {
+    ws_.jacobian[p].topLeftCorner<3, NC>() += f_p;
+    ws_.jacobian[p].bottomLeftCorner<3, NC>() += n_p;
+  }
 }
 
-namespace {
+// A computed segment above a mimic's disjoint subtrees: the sum of their effects.
+template <bool kState>
+void Sweep<kState>::ancestor(int a) {
+  const J6 Ja = ws_.jacobian[a].leftCols<NC>();
+  addOuterProduct(cm_.diagonal_only, Ja, ws_.covariance[a]);
+  const int p = model_.parent[a];
+  if (p < 0 || !cm_.in_dynamics[p]) return;
+  const Eigen::Matrix3d& R = nom_.R_parent_child[a];
+  const M f_p = R * Ja.template topRows<3>();
+  ws_.jacobian[p].topLeftCorner<3, NC>() += f_p;
+  ws_.jacobian[p].bottomLeftCorner<3, NC>().noalias() += R * Ja.template bottomRows<3>();
+  ws_.jacobian[p].bottomLeftCorner<3, NC>().noalias() += skew(nom_.p_parent_child[a]) * f_p;
+}
+
+// The state part, coordinate by coordinate (false: no position noise).
+bool addStateTerms(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
+                   const Data<double>& nom, const Eigen::Matrix3d& G) {
+  const double var_q = cm.var_position;
+  if (!(var_q > 0.0)) return false;
+  if (cm.linearize_state) {
+    // Sigma = var_q G = F F^T (G may be singular: the Kalman filter's first sample).
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(G);
+    Eigen::Matrix3d F = ldlt.transpositionsP().transpose() * Eigen::Matrix3d(ldlt.matrixL());
+    for (int c = 0; c < 3; ++c) F.col(c) *= std::sqrt(var_q * std::max(ldlt.vectorD()[c], 0.0));
+    for (int j = 0; j < model.nq; ++j)
+      if (!cm.sweep[j].empty()) Sweep<true>(cm, ws, model, nom, j, F).run();
+  } else {
+    const Eigen::Vector3d F(0.0, 0.0, std::sqrt(var_q * G(2, 2)));
+    for (int j = 0; j < model.nq; ++j)
+      if (!cm.sweep[j].empty()) Sweep<false>(cm, ws, model, nom, j, F).run();
+  }
+  return true;
+}
+
+// The wrench inputs acting on each segment, filtered like the positions (value output:
+// g00 the noise gain of the value). False: no input with noise.
+bool addInputTerms(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
+                   double g00) {
+  for (const CovarianceModel::InputNoise& in : cm.inputs) {
+    const Frame<double>& fr = model.frames[in.frame];
+    Matrix6 D = Matrix6::Zero();
+    D.diagonal() << Eigen::Vector3d::Constant(in.var_force * g00), Eigen::Vector3d::Constant(in.var_moment * g00);
+    addForceCongruence(fr.R_segment_frame, fr.p_segment_frame, D, ws.local[fr.segment]);
+  }
+  return !cm.inputs.empty();
+}
+
+// Segment i's inertial parameters: mass (exact: the loads are linear in m), centre of
+// mass (linearised: the moment is quadratic in c) and inertia (exact: linear in the
+// tensor's scale).
+void addInertialTerms(const CovarianceModel& cm, const Model<double>& model, const Data<double>& nom,
+                      int i, Matrix6& local) {
+  const double m = model.mass[i];
+  const Eigen::Vector3d& c = model.com[i];
+  const Eigen::Vector3d& w = nom.omega[i];
+  const Eigen::Vector3d& al = nom.alpha[i];
+  const Eigen::Vector3d a_com = nom.acc[i] + al.cross(c) + w.cross(w.cross(c));
+  Vector6 d;
+  if (cm.mass_fraction > 0.0 && m > 0.0) {
+    d << a_com, c.cross(a_com);
+    local.noalias() += (cm.mass_fraction * cm.mass_fraction * m * m) * d * d.transpose();
+  }
+  if (cm.com_offset > 0.0 && m > 0.0) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const Eigen::Vector3d e = Eigen::Vector3d::Unit(axis);
+      const Eigen::Vector3d df = m * (al.cross(e) + w.cross(w.cross(e)));
+      d << df, e.cross(m * a_com) + c.cross(df);
+      local.noalias() += (cm.com_offset * cm.com_offset) * d * d.transpose();
+    }
+  }
+  if (cm.inertia_fraction > 0.0) {
+    const Eigen::Matrix3d& I = model.inertia_com[i];
+    Eigen::Vector3d dn = I * al;
+    if (model.gyroscopic[i]) dn += w.cross(I * w);
+    d << Eigen::Vector3d::Zero(), dn;
+    local.noalias() += (cm.inertia_fraction * cm.inertia_fraction) * d * d.transpose();
+  }
+}
+
+// Up the tree: each segment's wrench carries the covariance of its whole subtree.
+void addSubtrees(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
+                 const Data<double>& nom) {
+  for (auto it = cm.dynamics_segments.rbegin(); it != cm.dynamics_segments.rend(); ++it) {
+    const int i = *it, p = model.parent[i];
+    if (cm.diagonal_only)
+      ws.covariance[i].diagonal() += ws.local[i].diagonal();
+    else
+      ws.covariance[i] += ws.local[i];
+    if (p >= 0 && cm.in_dynamics[p])
+      addForceCongruence(nom.R_parent_child[i], nom.p_parent_child[i], ws.local[i], ws.local[p]);
+  }
+}
+
+// The three the extrapolation starts from, a period apart: while the history fills
+// (after a start, a gap or a change of the noise gain), the samples in between are
+// computed but not kept, so that the quadratic never reaches far beyond its nodes.
+void keepForExtrapolation(const CovarianceModel& cm, CovarianceWorkspace& ws,
+                          const Eigen::Matrix3d& G, double t) {
+  if (!(cm.period > 0.0 && (ws.history == 0 || t - ws.time[0] >= (1.0 - kSamePeriod) * cm.period)))
+    return;
+  ws.prev2.swap(ws.prev);
+  ws.prev.swap(ws.last);
+  for (int i : cm.dynamics_segments) ws.last[i] = ws.covariance[i];
+  ws.time[2] = ws.time[1];
+  ws.time[1] = ws.time[0];
+  ws.time[0] = t;
+  ws.gain = G;
+  ws.history = std::min(ws.history + 1, 3);
+}
 
 // Whether the noise gain G is within `tolerance` of G0, entry by entry relative to the
 // standard deviations of G0 (an entry of G0 with a zero diagonal must stay exact).
@@ -359,131 +504,71 @@ bool sameNoiseGain(const Eigen::Matrix3d& G, const Eigen::Matrix3d& G0, double t
   return true;
 }
 
-}  // namespace
-
-void Estimator::computeCovariance(const BaseState<double>& base_state) {
-  const UncertaintyConfig& u = config_.uncertainty;
-  // uncertainty.period: computed once the stamp is a period past the last computed one;
-  // in between, extrapolated from the last three (once there are three). A gap of more
-  // than kGapPeriods periods (or a stamp not after the last) starts the history again:
-  // the quadratic is not trusted that far.
-  // "A period past" to a millionth of it: a stamp difference carries the rounding of the
-  // double time axis, and 18 samples at 1 kHz should be 18 ms, not sometimes 19 samples.
-  constexpr double kGapPeriods = 3.0, kSamePeriod = 1e-6;
-  const double period = u.period;
-  const double t = stamp_;
-  if (period > 0.0) {
-    const double since = t - cov_time_[0];
-    if (cov_history_ > 0 && !(since > 0.0 && since <= kGapPeriods * period)) cov_history_ = 0;
-    if (cov_history_ == 3 && since < (1.0 - kSamePeriod) * period) {
-      if (sameNoiseGain(bank_.noiseGain(), cov_gain_, u.gain_tolerance)) {
-        extrapolateCovariance(t);
-        return;
-      }
-      cov_history_ = 0;  // the past covariances belong to another noise gain
+// The quadratic through the last three computed covariances C_0, C_1, C_2 at their stamps
+// t_0 > t_1 > t_2 (Lagrange, at any spacing), at the stamp t: with x = t - t_0,
+// a = t_1 - t_0, b = t_2 - t_0,
+//    C = (x-a)(x-b)/(a b) C_0 + x(x-b)/(a (a-b)) C_1 + x(x-a)/(b (b-a)) C_2
+// (equal spacing h, s = x/h: (1+s)(2+s)/2 C_0 - s(2+s) C_1 + s(1+s)/2 C_2).
+// The covariance is a smooth function of the state, so this is exact to third order in
+// the time since t_0 (holding C_0: first order; the straight line through the last two:
+// second order, which overshoots where a variance turns round near its minimum;
+// docs/uncertainty.md measures the three). Elementwise, so as symmetric as the computed
+// ones. A variance extrapolated below 0 is set to 0, and its row and column with it (no
+// covariance without variance).
+void quadraticThroughLastThree(const CovarianceModel& cm, CovarianceWorkspace& ws, double t) {
+  const double x = t - ws.time[0], a = ws.time[1] - ws.time[0], b = ws.time[2] - ws.time[0];
+  const double w0 = (x - a) * (x - b) / (a * b), w1 = x * (x - b) / (a * (a - b)),
+               w2 = x * (x - a) / (b * (b - a));
+  for (int i : cm.dynamics_segments) {
+    Matrix6& out = ws.covariance[i];
+    if (cm.diagonal_only)
+      out.diagonal() = w0 * ws.last[i].diagonal() + w1 * ws.prev[i].diagonal() + w2 * ws.prev2[i].diagonal();
+    else
+      out = w0 * ws.last[i] + w1 * ws.prev[i] + w2 * ws.prev2[i];
+    for (int r = 0; r < 6; ++r) {
+      if (out(r, r) >= 0.0) continue;
+      out.row(r).setZero();
+      out.col(r).setZero();
     }
-  }
-  // The kinematics in double: data_ itself, or a double pass beside the float one.
-  if (config_.precision == Precision::kFloat) loadsPass(cov_nominal_, q_, qd_, base_state);
-  const Data<double>& nom = config_.precision == Precision::kFloat ? cov_nominal_ : data_;
-  const Eigen::Matrix3d G = bank_.noiseGain();
-  for (int i : dynamics_segments_) {
-    covariance_[i].setZero();
-    local_[i].setZero();
-  }
-  bool any_local = false;
-
-  // The state part, coordinate by coordinate.
-  const double var_q = u.position_noise * u.position_noise;
-  if (var_q > 0.0) {
-    any_local = true;
-    if (u.linearize_state) {
-      // Sigma = var_q G = F F^T (G may be singular: the Kalman filter's first sample).
-      const Eigen::LDLT<Eigen::Matrix3d> ldlt(G);
-      Eigen::Matrix3d F = ldlt.transpositionsP().transpose() * Eigen::Matrix3d(ldlt.matrixL());
-      for (int c = 0; c < 3; ++c) F.col(c) *= std::sqrt(var_q * std::max(ldlt.vectorD()[c], 0.0));
-      for (int j = 0; j < model_.nq; ++j)
-        if (!sweep_[j].empty()) sweepCoordinate<true>(j, nom, F);
-    } else {
-      const Eigen::Vector3d F(0.0, 0.0, std::sqrt(var_q * G(2, 2)));
-      for (int j = 0; j < model_.nq; ++j)
-        if (!sweep_[j].empty()) sweepCoordinate<false>(j, nom, F);
-    }
-  }
-
-  // Each segment's own terms: the wrench inputs acting on it and its inertial parameters.
-  const double g00 = G(0, 0);  // the inputs are filtered like the positions (value output)
-  for (std::size_t k = 0; k < inputs_.size(); ++k) {
-    const WrenchInputConfig& c = inputs_[k].config;
-    if (!inputs_[k].needed || (c.force_noise == 0.0 && c.moment_noise == 0.0)) continue;
-    const Frame<double>& fr = model_.frames[inputs_[k].frame];
-    Matrix6 D = Matrix6::Zero();
-    D.diagonal() << Eigen::Vector3d::Constant(c.force_noise * c.force_noise * g00),
-        Eigen::Vector3d::Constant(c.moment_noise * c.moment_noise * g00);
-    addForceCongruence(fr.R_segment_frame, fr.p_segment_frame, D, local_[fr.segment]);
-    any_local = true;
-  }
-  if (u.mass_fraction > 0.0 || u.com_offset > 0.0 || u.inertia_fraction > 0.0) {
-    any_local = true;
-    for (int i : dynamics_segments_) {
-      const double m = model_.mass[i];
-      const Eigen::Vector3d& c = model_.com[i];
-      const Eigen::Vector3d& w = nom.omega[i];
-      const Eigen::Vector3d& al = nom.alpha[i];
-      const Eigen::Vector3d a_com = nom.acc[i] + al.cross(c) + w.cross(w.cross(c));
-      Vector6 d;
-      if (u.mass_fraction > 0.0 && m > 0.0) {  // exact: the loads are linear in m
-        d << a_com, c.cross(a_com);
-        local_[i].noalias() += (u.mass_fraction * u.mass_fraction * m * m) * d * d.transpose();
-      }
-      if (u.com_offset > 0.0 && m > 0.0) {  // linearised: the moment is quadratic in c
-        for (int axis = 0; axis < 3; ++axis) {
-          const Eigen::Vector3d e = Eigen::Vector3d::Unit(axis);
-          const Eigen::Vector3d df = m * (al.cross(e) + w.cross(w.cross(e)));
-          d << df, e.cross(m * a_com) + c.cross(df);
-          local_[i].noalias() += (u.com_offset * u.com_offset) * d * d.transpose();
-        }
-      }
-      if (u.inertia_fraction > 0.0) {  // exact: linear in the tensor's scale
-        const Eigen::Matrix3d& I = model_.inertia_com[i];
-        Eigen::Vector3d dn = I * al;
-        if (model_.gyroscopic[i]) dn += w.cross(I * w);
-        d << Eigen::Vector3d::Zero(), dn;
-        local_[i].noalias() += (u.inertia_fraction * u.inertia_fraction) * d * d.transpose();
-      }
-    }
-  }
-  if (any_local) {
-    // Up the tree: each segment's wrench carries the covariance of its whole subtree.
-    for (auto it = dynamics_segments_.rbegin(); it != dynamics_segments_.rend(); ++it) {
-      const int i = *it, p = model_.parent[i];
-      if (u.diagonal_only)
-        covariance_[i].diagonal() += local_[i].diagonal();
-      else
-        covariance_[i] += local_[i];
-      if (p >= 0 && in_dynamics_[p])
-        addForceCongruence(nom.R_parent_child[i], nom.p_parent_child[i], local_[i], local_[p]);
-    }
-  }
-  // The three the extrapolation starts from, a period apart: while the history fills
-  // (after a start, a gap or a change of the noise gain), the samples in between are
-  // computed but not kept, so that the quadratic never reaches far beyond its nodes.
-  if (period > 0.0 && (cov_history_ == 0 || t - cov_time_[0] >= (1.0 - kSamePeriod) * period)) {
-    cov_prev2_.swap(cov_prev_);
-    cov_prev_.swap(cov_last_);
-    for (int i : dynamics_segments_) cov_last_[i] = covariance_[i];
-    cov_time_[2] = cov_time_[1];
-    cov_time_[1] = cov_time_[0];
-    cov_time_[0] = t;
-    cov_gain_ = G;
-    cov_history_ = std::min(cov_history_ + 1, 3);
   }
 }
 
-double Estimator::effortVariance(int segment) const {
-  const Matrix6& C = covariance_[static_cast<std::size_t>(segment)];
-  const Eigen::Vector3d& u = model_.axis[static_cast<std::size_t>(segment)];
-  switch (model_.joint_type[static_cast<std::size_t>(segment)]) {
+}  // namespace
+
+bool extrapolateCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws,
+                           const Eigen::Matrix3d& gain, double t) {
+  if (!(cm.period > 0.0)) return false;
+  const double since = t - ws.time[0];
+  if (ws.history > 0 && !(since > 0.0 && since <= kGapPeriods * cm.period)) ws.history = 0;
+  if (!(ws.history == 3 && since < (1.0 - kSamePeriod) * cm.period)) return false;
+  if (!sameNoiseGain(gain, ws.gain, cm.gain_tolerance)) {
+    ws.history = 0;  // the past covariances belong to another noise gain
+    return false;
+  }
+  quadraticThroughLastThree(cm, ws, t);
+  return true;
+}
+
+void computeCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
+                       const Data<double>& nominal, const Eigen::Matrix3d& gain, double t) {
+  for (int i : cm.dynamics_segments) {
+    ws.covariance[i].setZero();
+    ws.local[i].setZero();
+  }
+  bool any_local = addStateTerms(cm, ws, model, nominal, gain);
+  // Each segment's own terms: the wrench inputs acting on it and its inertial parameters.
+  if (addInputTerms(cm, ws, model, gain(0, 0))) any_local = true;
+  if (cm.mass_fraction > 0.0 || cm.com_offset > 0.0 || cm.inertia_fraction > 0.0) {
+    any_local = true;
+    for (int i : cm.dynamics_segments) addInertialTerms(cm, model, nominal, i, ws.local[i]);
+  }
+  if (any_local) addSubtrees(cm, ws, model, nominal);
+  keepForExtrapolation(cm, ws, gain, t);
+}
+
+double effortVariance(const Model<double>& model, const Eigen::Matrix<double, 6, 6>& C, int segment) {
+  const Eigen::Vector3d& u = model.axis[static_cast<std::size_t>(segment)];
+  switch (model.joint_type[static_cast<std::size_t>(segment)]) {
     case JointType::kRevolute: return std::max(0.0, u.dot(C.bottomRightCorner<3, 3>() * u));
     case JointType::kPrismatic: return std::max(0.0, u.dot(C.topLeftCorner<3, 3>() * u));
     default: return 0.0;

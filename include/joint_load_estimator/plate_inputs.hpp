@@ -1,0 +1,104 @@
+// The force plates of the estimator (PlateInputConfig): their samples, their contact at
+// the estimate's stamp, and the decoded reaction applied to the foot. ROS-free.
+#pragma once
+
+#include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/force_plate.hpp>
+#include <joint_load_estimator/input_buffer.hpp>
+#include <joint_load_estimator/model.hpp>
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace jle {
+
+struct PlateInputConfig;  // config.hpp
+
+/// The force plates of one estimator, each filtered in six bank channels (force, moment:
+/// what the foot applies to the plate, plate frame, about its origin). A sample below the
+/// contact threshold enters the filter as zero; the reaction is applied only where the
+/// raw signal is in contact at the estimate's stamp, decoded from the filtered wrench.
+class PlateInputs {
+ public:
+  PlateInputs() = default;
+  /// Plate k is filtered in channels first_channel + 6 k .. + 5. Throws
+  /// std::invalid_argument naming the plate (link, timeout, threshold, surface, pose).
+  PlateInputs(const Model<double>& model, const std::vector<PlateInputConfig>& configs,
+              int first_channel);
+
+  int size() const { return static_cast<int>(plates_.size()); }
+  /// A sample of plate k at time t [s] (PlateInputConfig). Dropped (false) unless newer
+  /// than the newest held and finite.
+  bool add(int k, double t, const Eigen::Vector3d& force_plate, const Eigen::Vector3d& moment_plate);
+  /// The pose of plate k in the world [m]. Throws naming the plate unless a finite
+  /// rotation and position.
+  void setPose(int k, const Eigen::Matrix3d& R_world_plate, const Eigen::Vector3d& p_world_plate);
+  /// Which plates act on a computed segment: dynamics[s] != 0 for the computed segments s.
+  void setNeeded(const Model<double>& model, const std::vector<char>& dynamics);
+
+  /// At the joint sample t [s]: every needed plate's value into its six channels.
+  void resample(double t, double* channels) {
+    for (Plate& p : plates_) p.samples.resample(t, p.needed, channels + p.channel);
+  }
+  /// Whether a plate with the kStop policy is stale.
+  bool stopped() const {
+    for (const Plate& p : plates_)
+      if (p.samples.stopped()) return true;
+    return false;
+  }
+  /// The contact of every needed plate on its raw signal at the estimate's stamp [s];
+  /// true when any changed since the last call.
+  bool updateContacts(double stamp);
+  /// The reaction of every plate in contact at the stamp, decoded from its filtered
+  /// wrench, added to its foot (after forwardKinematics, before inverseDynamics).
+  template <typename Scalar>
+  void apply(const Model<Scalar>& model, Data<Scalar>& data, const DifferentiatorBank& bank);
+  /// Forgets every sample and contact.
+  void reset();
+
+  /// Plate k as applied at the last apply() (no contact: nothing was applied).
+  const PlateReading& reading(int k) const { return plates_[static_cast<std::size_t>(k)].reading; }
+  /// Whether plate k was stale at the last joint sample.
+  bool stale(int k) const { return plates_[static_cast<std::size_t>(k)].samples.stale(); }
+  /// Whether plate k's foot is on a computed segment.
+  bool needed(int k) const { return plates_[static_cast<std::size_t>(k)].needed; }
+
+ private:
+  struct Plate {
+    ForcePlateConfig raw;       // as configured (the threshold acts on the raw signal)
+    ForcePlateConfig filtered;  // raw with a zero threshold: decodes the filtered wrench
+    InputBuffer samples;        // zero below the threshold
+    int frame = 0;              // the foot
+    int channel = 0;
+    bool needed = true;
+    bool contact = false;  // raw signal in contact at the estimate's stamp
+    PlateReading reading;
+  };
+  std::vector<Plate> plates_;
+};
+
+template <typename Scalar>
+void PlateInputs::apply(const Model<Scalar>& model, Data<Scalar>& data, const DifferentiatorBank& bank) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  for (Plate& p : plates_) {
+    p.reading = PlateReading();
+    if (!p.needed || !p.contact) continue;
+    const Wrench<double> w = filteredWrench(bank, p.channel);
+    // In contact at the stamp; the filtered wrench still pressing into the plate.
+    p.reading = readForcePlate(p.filtered, w.force, w.moment);
+    if (!p.reading.contact) continue;
+    const Frame<Scalar>& frame = model.frames[static_cast<std::size_t>(p.frame)];
+    const int s = frame.segment;
+    const Eigen::Vector3d foot_world =
+        (data.p_world[s] + data.R_world[s] * frame.p_segment_frame).template cast<double>();
+    Eigen::Vector3d force_world, moment_world;
+    plateReactionInWorld(p.filtered, p.reading, foot_world, force_world, moment_world);
+    addExternalWrench(model, data, p.frame, Vector3(force_world.template cast<Scalar>()),
+                      Vector3(moment_world.template cast<Scalar>()), WrenchFrame::kWorld);
+  }
+}
+
+}  // namespace jle
