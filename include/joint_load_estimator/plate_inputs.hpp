@@ -82,22 +82,13 @@ class PlateInputs {
 
 template <typename Scalar>
 void PlateInputs::apply(const Model<Scalar>& model, Data<Scalar>& data, const DifferentiatorBank& bank) {
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   for (Plate& p : plates_) {
     p.reading = PlateReading();
     if (!p.needed || !p.contact) continue;
     const Wrench<double> w = filteredWrench(bank, p.channel);
     // In contact at the stamp; the filtered wrench still pressing into the plate.
     p.reading = readForcePlate(p.filtered, w.force, w.moment);
-    if (!p.reading.contact) continue;
-    const Frame<Scalar>& frame = model.frames[static_cast<std::size_t>(p.frame)];
-    const int s = frame.segment;
-    const Eigen::Vector3d foot_world =
-        (data.p_world[s] + data.R_world[s] * frame.p_segment_frame).template cast<double>();
-    Eigen::Vector3d force_world, moment_world;
-    plateReactionInWorld(p.filtered, p.reading, foot_world, force_world, moment_world);
-    addExternalWrench(model, data, p.frame, Vector3(force_world.template cast<Scalar>()),
-                      Vector3(moment_world.template cast<Scalar>()), WrenchFrame::kWorld);
+    applyPlateReaction(model, data, p.frame, p.filtered, p.reading);  // joint_loads' code too
   }
 }
 

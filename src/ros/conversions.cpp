@@ -6,9 +6,16 @@
 namespace jle {
 namespace {
 
-void fromMsg(const geometry_msgs::WrenchStamped& msg, Eigen::Vector3d& f, Eigen::Vector3d& m) {
-  f << msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z;
-  m << msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z;
+// Pipeline::onWrench or Pipeline::onPlate: one shape for both.
+using WrenchInput = Outcome (Pipeline::*)(int, Stamp, Stamp, const std::string&,
+                                          const Eigen::Vector3d&, const Eigen::Vector3d&);
+
+Outcome feedWrenchStamped(Pipeline& pipeline, WrenchInput input, int k,
+                          const geometry_msgs::WrenchStamped& msg, const ros::Time& clock) {
+  const auto& w = msg.wrench;
+  return (pipeline.*input)(k, toStamp(msg.header.stamp), toStamp(clock), msg.header.frame_id,
+                           Eigen::Vector3d(w.force.x, w.force.y, w.force.z),
+                           Eigen::Vector3d(w.torque.x, w.torque.y, w.torque.z));
 }
 
 }  // namespace
@@ -32,18 +39,12 @@ Outcome feed(Pipeline& pipeline, const sensor_msgs::JointState& msg, const ros::
 
 Outcome feedWrench(Pipeline& pipeline, int k, const geometry_msgs::WrenchStamped& msg,
                    const ros::Time& clock) {
-  Eigen::Vector3d f, m;
-  fromMsg(msg, f, m);
-  return pipeline.onWrench(k, toStamp(msg.header.stamp), toStamp(clock), msg.header.frame_id, f,
-                           m);
+  return feedWrenchStamped(pipeline, &Pipeline::onWrench, k, msg, clock);
 }
 
 Outcome feedPlate(Pipeline& pipeline, int k, const geometry_msgs::WrenchStamped& msg,
                   const ros::Time& clock) {
-  Eigen::Vector3d f, m;
-  fromMsg(msg, f, m);
-  return pipeline.onPlate(k, toStamp(msg.header.stamp), toStamp(clock), msg.header.frame_id, f,
-                          m);
+  return feedWrenchStamped(pipeline, &Pipeline::onPlate, k, msg, clock);
 }
 
 void prepare(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {

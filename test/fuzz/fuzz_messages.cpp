@@ -6,6 +6,8 @@
 // of the clock. Checks the documented outcome of every message against a shadow of
 // the rules (invalid sizes and values, stamp order, resets), that every message is
 // counted once, and the published record. Built by build_and_run.sh.
+#include "fuzz_check.hpp"
+
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -73,15 +75,6 @@ const jle::Model<double>& model() {
       jle::modelFromUrdfFile(JLE_FUZZ_DATA "/urdf/chains/ur5_chain.urdf");
   return m;
 }
-
-// An oracle failure: names the check, then aborts (the fuzzer's crash).
-#define JLE_FUZZ_CHECK(ok) \
-  do { \
-    if (!(ok)) { \
-      std::fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #ok); \
-      std::abort(); \
-    } \
-  } while (false)
 
 }  // namespace
 

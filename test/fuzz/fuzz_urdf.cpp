@@ -1,6 +1,8 @@
 // libFuzzer target: the URDF loader. Any input must either give a model that keeps the
 // model.hpp invariants and on which the dynamics run, or throw jle::ModelError; any
 // other exception, a crash or a sanitizer report is a bug. Built by build_and_run.sh.
+#include "fuzz_check.hpp"
+
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -12,15 +14,6 @@
 #include <string>
 
 namespace {
-
-// An oracle failure: names the check, then aborts (the fuzzer's crash).
-#define JLE_FUZZ_CHECK(ok) \
-  do { \
-    if (!(ok)) { \
-      std::fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #ok); \
-      std::abort(); \
-    } \
-  } while (false)
 
 }  // namespace
 

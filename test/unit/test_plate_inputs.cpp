@@ -3,6 +3,7 @@
 // policies and the refused configurations, against numbers worked by hand.
 #include <joint_load_estimator/estimator.hpp>  // PlateInputConfig
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/plate_inputs.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -182,15 +183,29 @@ TEST(PlateInputs, RefusedConfigurationsNameThePlate) {
     }
     return std::string("accepted");
   };
+  // The model-free checks are the configuration's one validate(), which the Estimator
+  // runs before it builds its plates.
+  auto validated = [](const jle::PlateInputConfig& c) {
+    jle::EstimatorConfig config;
+    config.plates = {c};
+    try {
+      jle::validate(config);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
   jle::PlateInputConfig c = plateConfig();
   c.plate.link = "hand";
   EXPECT_NE(message(c).find("force plate 'plate1'"), std::string::npos) << message(c);
   c = plateConfig();
   c.timeout = 0.0;
-  EXPECT_NE(message(c).find("timeout"), std::string::npos);
+  EXPECT_NE(validated(c).find("force_plates[0]/timeout"), std::string::npos) << validated(c);
   c = plateConfig();
   c.plate.contact_threshold = -1.0;
-  EXPECT_NE(message(c).find("contact_threshold"), std::string::npos);
+  EXPECT_NE(validated(c).find("force_plates[0]/contact_threshold"), std::string::npos)
+      << validated(c);
+  EXPECT_EQ(validated(plateConfig()), "accepted");
   c = plateConfig();
   c.plate.R_world_plate(0, 0) = 2.0;
   EXPECT_NE(message(c).find("the pose is not a finite rotation"), std::string::npos);
