@@ -70,7 +70,9 @@ struct Differentiator {
 std::vector<Differentiator> differentiators(bool quick) {
   std::vector<Differentiator> out;
   auto add = [&](const std::string& label, const std::string& family,
-                 const jle::DifferentiatorConfig& c) { out.push_back({label, family, c, 0.0}); };
+                 const jle::DifferentiatorConfig& c) {
+    out.push_back({label, family, c, 0.0});
+  };
   for (int delay : {0, 1}) {
     jle::DifferentiatorConfig c;
     c.type = jle::DifferentiatorType::kFiniteDifference;
@@ -88,17 +90,19 @@ std::vector<Differentiator> differentiators(bool quick) {
         c.window = w;
         c.order = o;
         c.delay = centred ? (w - 1) / 2 : 0;
-        add("SG w" + std::to_string(w) + " o" + std::to_string(o) + (centred ? " centred" : " causal"),
+        add("SG w" + std::to_string(w) + " o" + std::to_string(o) +
+                (centred ? " centred" : " causal"),
             "sg", c);
       }
   // Process-noise densities: white jerk [rad^2/s^5] (CA) or snap [rad^2/s^7] (CJ). With
   // the encoder's r = 1.5e-5 rad the CA settings put the filter's bandwidth (q/r^2)^(1/6)
   // near 41, 87, 190 and 410 rad/s; the CJ ones ((q/r^2)^(1/8)) near 21, 29, 38, 51, 68,
   // 90, 160 and 290 rad/s.
-  const std::vector<double> ca = quick ? std::vector<double>{1e2} : std::vector<double>{1e0, 1e2, 1e4, 1e6};
-  const std::vector<double> cj =
-      quick ? std::vector<double>{1e6}
-            : std::vector<double>{1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e8, 1e10};
+  const std::vector<double> ca =
+      quick ? std::vector<double>{1e2} : std::vector<double>{1e0, 1e2, 1e4, 1e6};
+  const std::vector<double> cj = quick
+                                     ? std::vector<double>{1e6}
+                                     : std::vector<double>{1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e8, 1e10};
   for (double q : ca) {
     jle::DifferentiatorConfig c;
     c.type = jle::DifferentiatorType::kKalman;
@@ -124,8 +128,9 @@ std::vector<Differentiator> differentiators(bool quick) {
     // the node's default since). Only q / r^2 matters to the gain.
     const jle::DifferentiatorConfig defaults;
     for (auto model : {jle::KalmanModel::kConstantAcceleration, jle::KalmanModel::kConstantJerk})
-      for (double q : model == jle::KalmanModel::kConstantAcceleration ? std::vector<double>{1e3}
-                                                                       : std::vector<double>{1e2, 1e4}) {
+      for (double q : model == jle::KalmanModel::kConstantAcceleration
+                          ? std::vector<double>{1e3}
+                          : std::vector<double>{1e2, 1e4}) {
         jle::DifferentiatorConfig c;
         c.type = jle::DifferentiatorType::kKalman;
         c.kalman_model = model;
@@ -192,17 +197,17 @@ struct SceneSpec {
   double duration = 10.0;
   jle::SensorModel sensor;
   std::vector<std::string> wrench_links;
-  bool planar_wrench = false;    // forces across plane_normal, moment along it only
-  int plane_normal = 1;          // with planar_wrench: the plane's normal axis in the link frame
-  bool planar_sensor = false;    // the F/T reports only the in-plane components (3-axis)
+  bool planar_wrench = false;  // forces across plane_normal, moment along it only
+  int plane_normal = 1;        // with planar_wrench: the plane's normal axis in the link frame
+  bool planar_sensor = false;  // the F/T reports only the in-plane components (3-axis)
   Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.80665);  // [m/s^2], world
   bool expect_planar = false;    // self-check: default savings take the planar path throughout
   bool constant_wrench = false;  // no sinusoidal part
   std::uint64_t seed = 1;
-  bool both_precisions = false;  // float as well as double
-  bool savings_sweep = false;    // every savings variant for the differentiators of sweepsSavings
-  bool timed = false;            // each configuration run --repeat times, the fastest counts
-  bool exact = false;            // exact inputs: checked to 1e-9 relative
+  bool both_precisions = false;   // float as well as double
+  bool savings_sweep = false;     // every savings variant for the differentiators of sweepsSavings
+  bool timed = false;             // each configuration run --repeat times, the fastest counts
+  bool exact = false;             // exact inputs: checked to 1e-9 relative
   std::vector<std::string> only;  // differentiators to run (labels); empty: all
 };
 
@@ -211,13 +216,13 @@ struct Scene {
   SceneSpec spec;
   std::unique_ptr<jle::GroundTruth> truth;
   jle::SensorReadings readings;
-  std::vector<double> stamps;      // readings.joints[k].stamp
-  Eigen::MatrixXd true_effort;     // nmoving x N
-  Eigen::MatrixXd true_force;      // 3 nmoving x N
-  Eigen::MatrixXd true_moment;     // 3 nmoving x N
-  double grid_step = 2.5e-4;       // [s] grid of the true qdd for the lag search
-  Eigen::MatrixXd true_qdd_grid;   // nq x G, at (g - grid_offset) * grid_step
-  int grid_offset = 0;             // grid samples before t = 0
+  std::vector<double> stamps;       // readings.joints[k].stamp
+  Eigen::MatrixXd true_effort;      // nmoving x N
+  Eigen::MatrixXd true_force;       // 3 nmoving x N
+  Eigen::MatrixXd true_moment;      // 3 nmoving x N
+  double grid_step = 2.5e-4;        // [s] grid of the true qdd for the lag search
+  Eigen::MatrixXd true_qdd_grid;    // nq x G, at (g - grid_offset) * grid_step
+  int grid_offset = 0;              // grid samples before t = 0
   double measurement_noise = 1e-6;  // for the Kalman filters [rad]
   double settle = 0.5;              // [s] stamps before this are not scored
 };
@@ -239,12 +244,12 @@ jle::SensorModel realisticSensor() {
   s.counts_per_revolution = 131072.0;  // 2^17: 4.79e-5 rad per count
   s.position_noise = 5e-6;             // [rad], about 0.1 count
   s.velocity_noise = 1e-3;
-  s.sample_jitter = 1e-5;              // hardware-timed, stamped exactly
+  s.sample_jitter = 1e-5;  // hardware-timed, stamped exactly
   s.drop_probability = 1e-3;
   s.wrench_rate = 1000.0;
-  s.wrench_offset = 2.5e-4;            // F/T clock out of phase with the joints
-  s.force_noise = 0.1;                 // [N]
-  s.moment_noise = 5e-3;               // [N m]
+  s.wrench_offset = 2.5e-4;  // F/T clock out of phase with the joints
+  s.force_noise = 0.1;       // [N]
+  s.moment_noise = 5e-3;     // [N m]
   return s;
 }
 
@@ -253,9 +258,10 @@ jle::SensorModel realisticSensor() {
 // to every sample. Savings and precision swept, timed.
 SceneSpec planarSavings(const std::string& data, SceneSpec s) {
   s.name = "planar_savings";
-  s.description = "12-link planar chain, gravity in the plane (-y), stop-and-go, in-plane tip "
-                  "load read by a 3-axis F/T (fx, fy, mz), sensors otherwise as panda; "
-                  "savings and precision swept, timed";
+  s.description =
+      "12-link planar chain, gravity in the plane (-y), stop-and-go, in-plane tip "
+      "load read by a 3-axis F/T (fx, fy, mz), sensors otherwise as panda; "
+      "savings and precision swept, timed";
   s.urdf = readFile(data + "/urdf/planar_chain.urdf");
   s.motion = jle::MotionKind::kStopAndGo;
   s.wrench_links = {"tool"};
@@ -350,8 +356,9 @@ std::vector<SceneSpec> sceneSpecs(const std::string& data, bool quick) {
     s.seed = 4;
     specs.push_back(s);
     s.name = "talos";
-    s.description = "TALOS reduced, pelvis fixed, 32 joints, sums of sines, 5 s, wrenches at "
-                    "both soles and the left wrist F/T";
+    s.description =
+        "TALOS reduced, pelvis fixed, 32 joints, sums of sines, 5 s, wrenches at "
+        "both soles and the left wrist F/T";
     s.urdf = readFile(data + "/urdf/talos_reduced.urdf");
     s.motion = jle::MotionKind::kSines;
     s.duration = 5.0;
@@ -420,7 +427,8 @@ Scene buildScene(const SceneSpec& spec) {
       jle::randomMotion(model, spec.motion, spec.duration, jle::deriveSeed(spec.seed, 100));
   std::vector<jle::WrenchMotion> wrenches;
   for (std::size_t i = 0; i < spec.wrench_links.size(); ++i) {
-    jle::WrenchMotion w = jle::randomWrench(spec.wrench_links[i], jle::deriveSeed(spec.seed, 300 + i));
+    jle::WrenchMotion w =
+        jle::randomWrench(spec.wrench_links[i], jle::deriveSeed(spec.seed, 300 + i));
     if (spec.constant_wrench) w.amplitude.setZero();
     if (spec.planar_wrench)
       for (int c = 0; c < 6; ++c)
@@ -461,7 +469,8 @@ Scene buildScene(const SceneSpec& spec) {
   }
   // The true qdd on a fine grid reaching 0.5 s before the start, for the lag search.
   scene.grid_offset = static_cast<int>(std::ceil(0.5 / scene.grid_step));
-  const int g = scene.grid_offset + static_cast<int>(std::ceil(spec.duration / scene.grid_step)) + 2;
+  const int g =
+      scene.grid_offset + static_cast<int>(std::ceil(spec.duration / scene.grid_step)) + 2;
   scene.true_qdd_grid.resize(m.nq, g);
   jle::VectorX<double> q, qd, qdd;
   for (int i = 0; i < g; ++i) {
@@ -472,9 +481,9 @@ Scene buildScene(const SceneSpec& spec) {
       spec.sensor.counts_per_revolution > 0.0 ? kTwoPi / spec.sensor.counts_per_revolution : 0.0;
   // What a user would configure: the encoder's rounding (uniform, std res/sqrt(12)) and
   // its noise; a floor for exact inputs, where the filter still needs a positive value.
-  scene.measurement_noise = std::max(
-      1e-6, std::sqrt(spec.sensor.position_noise * spec.sensor.position_noise +
-                      resolution * resolution / 12.0));
+  scene.measurement_noise =
+      std::max(1e-6, std::sqrt(spec.sensor.position_noise * spec.sensor.position_noise +
+                               resolution * resolution / 12.0));
   return scene;
 }
 
@@ -499,7 +508,8 @@ double threadCpuSeconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config, const std::vector<int>& segments) {
+Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
+                const std::vector<int>& segments) {
   const jle::Model<double>& model = scene.truth->model();
   const jle::SensorReadings& r = scene.readings;
   const std::size_t n = r.joints.size();
@@ -536,7 +546,8 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config, const st
   }
   const auto stop = std::chrono::steady_clock::now();
   const double cpu_stop = threadCpuSeconds();
-  out.wall_us = std::chrono::duration<double, std::micro>(stop - start).count() / static_cast<double>(n);
+  out.wall_us =
+      std::chrono::duration<double, std::micro>(stop - start).count() / static_cast<double>(n);
   out.cpu_us = 1e6 * (cpu_stop - cpu_start) / static_cast<double>(n);
   out.qdd.conservativeResize(Eigen::NoChange, published);
   out.planar = estimator.planar();
@@ -552,7 +563,7 @@ struct Score {
 };
 
 struct RunResult {
-  std::vector<Score> joints;  // evaluated joints, then ALL
+  std::vector<Score> joints;                                 // evaluated joints, then ALL
   double wall_us = std::numeric_limits<double>::infinity();  // fastest run
   double cpu_us = std::numeric_limits<double>::infinity();
   double stamp_lag_ms = 0;             // mean of (newest sample stamp - estimate stamp)
@@ -603,7 +614,8 @@ double phaseLag(const Scene& scene, const std::vector<double>& stamps, const Eig
     varies = var > 1e-18 * scale && var > 0.0;
     return varies ? cov / std::sqrt(var) : 0.0;
   };
-  const int lo = static_cast<int>(std::lround(-0.04 / h)), hi = static_cast<int>(std::lround(0.3 / h));
+  const int lo = static_cast<int>(std::lround(-0.04 / h)),
+            hi = static_cast<int>(std::lround(0.3 / h));
   const int coarse = std::max(1, static_cast<int>(std::lround(0.002 / h)));
   int best = 0;
   double best_value = -std::numeric_limits<double>::infinity();
@@ -670,8 +682,9 @@ RunResult score(const Scene& scene, const Outputs& out, const std::vector<int>& 
   }
   for (int j = 0; j <= nseg; ++j) {
     Score& s = scores[static_cast<std::size_t>(j)];
-    s.joint = j < nseg ? model.joint_name[static_cast<std::size_t>(segments[static_cast<std::size_t>(j)])]
-                       : "ALL";
+    s.joint =
+        j < nseg ? model.joint_name[static_cast<std::size_t>(segments[static_cast<std::size_t>(j)])]
+                 : "ALL";
     const double count = static_cast<double>(std::max<long>(1, s.samples));
     for (double* x : {&s.rms_effort, &s.rms_force, &s.rms_moment, &s.rms_true_effort,
                       &s.rms_true_force, &s.rms_true_moment})
@@ -691,7 +704,6 @@ RunResult score(const Scene& scene, const Outputs& out, const std::vector<int>& 
 }
 
 double relative(double error, double scale) { return scale > 0.0 ? error / scale : 0.0; }
-
 
 // The differentiators whose savings are swept: the shipped default, the noisiest, the
 // most accurate Savitzky-Golay and constant-acceleration Kalman filters, and the
@@ -729,8 +741,8 @@ void writeRows(std::FILE* csv, const SceneSpec& spec, const Differentiator& diff
                const RunResult& result, bool& described) {
   const jle::DifferentiatorConfig& c = diff.config;
   const bool kalman = c.type == jle::DifferentiatorType::kKalman;
-  const int window = c.type == jle::DifferentiatorType::kFiniteDifference ? c.order + 1
-                                                                          : (kalman ? 0 : c.window);
+  const int window =
+      c.type == jle::DifferentiatorType::kFiniteDifference ? c.order + 1 : (kalman ? 0 : c.window);
   const int order =
       kalman ? (c.kalman_model == jle::KalmanModel::kConstantAcceleration ? 2 : 3) : c.order;
   const double delay_ms =
@@ -741,9 +753,9 @@ void writeRows(std::FILE* csv, const SceneSpec& spec, const Differentiator& diff
                  "%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%g,%d,%.4g,\"%s\"\n",
                  spec.name.c_str(), diff.label.c_str(), diff.family.c_str(), window, order,
                  kalman ? 0 : c.delay, kalman ? c.process_noise : 0.0,
-                 kalman ? measurement_noise : 0.0, precision, savings.c_str(),
-                 s.joint.c_str(), s.samples, s.rms_effort, s.max_effort, s.rms_force, s.max_force,
-                 s.rms_moment, s.max_moment, relative(s.rms_effort, s.rms_true_effort),
+                 kalman ? measurement_noise : 0.0, precision, savings.c_str(), s.joint.c_str(),
+                 s.samples, s.rms_effort, s.max_effort, s.rms_force, s.max_force, s.rms_moment,
+                 s.max_moment, relative(s.rms_effort, s.rms_true_effort),
                  relative(s.rms_force, s.rms_true_force), relative(s.rms_moment, s.rms_true_moment),
                  result.stamp_lag_ms, result.phase_lag_ms, delay_ms, result.wall_us, result.cpu_us,
                  spec.sensor.rate, isShippedDefault(diff) ? 1 : 0, result.planar_share,
@@ -795,12 +807,13 @@ int main(int argc, char** argv) {
   try {
     std::FILE* csv = std::fopen(csv_path.c_str(), "w");
     if (!csv) throw std::runtime_error("cannot write " + csv_path);
-    std::fprintf(csv,
-                 "scene,config,family,window,order,delay_samples,process_noise,measurement_noise,precision,"
-                 "savings,joint,samples,rms_effort,max_effort,rms_force,max_force,rms_moment,"
-                 "max_moment,rel_rms_effort,rel_rms_force,rel_rms_moment,stamp_lag_ms,"
-                 "phase_lag_ms,delay_ms,time_per_sample_us,cpu_per_sample_us,rate_hz,"
-                 "shipped_default,planar_share,scene_description\n");
+    std::fprintf(
+        csv,
+        "scene,config,family,window,order,delay_samples,process_noise,measurement_noise,precision,"
+        "savings,joint,samples,rms_effort,max_effort,rms_force,max_force,rms_moment,"
+        "max_moment,rel_rms_effort,rel_rms_force,rel_rms_moment,stamp_lag_ms,"
+        "phase_lag_ms,delay_ms,time_per_sample_us,cpu_per_sample_us,rate_hz,"
+        "shipped_default,planar_share,scene_description\n");
     bool exact_ok = true;
     bool planar_ok = true;      // the planar self-checks (expect_planar, "planar off")
     double worst_planar = 0.0;  // largest relative difference of "planar off" from default
@@ -839,8 +852,9 @@ int main(int argc, char** argv) {
             std::find(spec.only.begin(), spec.only.end(), diff.label) == spec.only.end())
           continue;
         const std::vector<SavingsVariant> group =
-            spec.savings_sweep && sweepsSavings(diff.label) ? variants
-                                                            : std::vector<SavingsVariant>{variants.front()};
+            spec.savings_sweep && sweepsSavings(diff.label)
+                ? variants
+                : std::vector<SavingsVariant>{variants.front()};
         double phase_lag_ms = std::nan("");
         // Every (precision, savings) pair of the differentiator; they take turns, `repeats`
         // times, so that a slow spell of a shared machine hits them alike, and each keeps
@@ -860,7 +874,8 @@ int main(int argc, char** argv) {
             config.gravity_world = scene.truth->gravity();
             segments.push_back(variant.distal_only ? distal : model.moving_segments);
             if (variant.distal_only)
-              for (int s : distal) config.joints.push_back(model.joint_name[static_cast<std::size_t>(s)]);
+              for (int s : distal)
+                config.joints.push_back(model.joint_name[static_cast<std::size_t>(s)]);
             configs.push_back(config);
             labels.push_back(variant.label);
           }
@@ -876,22 +891,23 @@ int main(int argc, char** argv) {
               results[v] = score(scene, out, segments[v], v == 0);
               if (v == 0) phase_lag_ms = results[v].phase_lag_ms;
               results[v].phase_lag_ms = phase_lag_ms;
-              results[v].planar_share =
-                  out.stamps.empty() ? 0.0
-                                     : static_cast<double>(out.planar_published) /
-                                           static_cast<double>(out.stamps.size());
+              results[v].planar_share = out.stamps.empty()
+                                            ? 0.0
+                                            : static_cast<double>(out.planar_published) /
+                                                  static_cast<double>(out.stamps.size());
               if (v == 0) default_loads = out.loads;
               const bool is_double = configs[v].precision == jle::Precision::kDouble;
               const bool planar_wanted =
                   is_double && configs[v].savings.planar != jle::PlanarMode::kOff;
               if (spec.expect_planar &&
                   (out.planar != planar_wanted ||
-                   out.planar_published != (planar_wanted ? static_cast<long>(out.stamps.size()) : 0L))) {
+                   out.planar_published !=
+                       (planar_wanted ? static_cast<long>(out.stamps.size()) : 0L))) {
                 planar_ok = false;
-                std::fprintf(stderr, "accuracy: %s, %s, %s: the 3x3 path %s, %ld of %zu estimates\n",
-                             spec.name.c_str(), diff.label.c_str(), labels[v].c_str(),
-                             out.planar ? "in use" : "not in use", out.planar_published,
-                             out.stamps.size());
+                std::fprintf(
+                    stderr, "accuracy: %s, %s, %s: the 3x3 path %s, %ld of %zu estimates\n",
+                    spec.name.c_str(), diff.label.c_str(), labels[v].c_str(),
+                    out.planar ? "in use" : "not in use", out.planar_published, out.stamps.size());
               }
               if (is_double && labels[v] == "planar off") {
                 // savings.planar is exact: the loads with and without it agree to rounding.
@@ -932,9 +948,10 @@ int main(int argc, char** argv) {
         }
       }
       std::fflush(csv);
-      std::fprintf(stderr, "accuracy: scene %-18s %4d runs, %6zu samples, %.1f s\n",
-                   spec.name.c_str(), runs, scene.readings.joints.size(),
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - scene_start).count());
+      std::fprintf(
+          stderr, "accuracy: scene %-18s %4d runs, %6zu samples, %.1f s\n", spec.name.c_str(), runs,
+          scene.readings.joints.size(),
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - scene_start).count());
     }
     if (std::fclose(csv) != 0) throw std::runtime_error("cannot write " + csv_path);
     if (exact_runs > 0)
@@ -946,8 +963,9 @@ int main(int argc, char** argv) {
                  "accuracy: savings.planar off vs on: loads differ by at most %.3g of the "
                  "largest load (double)\n",
                  worst_planar);
-    std::fprintf(stderr, "accuracy: study %.1f s\n",
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - study_start).count());
+    std::fprintf(
+        stderr, "accuracy: study %.1f s\n",
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - study_start).count());
     return exact_ok && planar_ok ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "accuracy: %s\n", e.what());

@@ -10,9 +10,9 @@
 #include <sensor_msgs/JointState.h>
 
 #include <algorithm>
-#include <mutex>
 #include <cmath>
 #include <cstdio>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -84,7 +84,9 @@ int main(int argc, char** argv) {
   wrench.header.frame_id = "panda_link8";
   geometry_msgs::WrenchStamped handle;
   handle.header.frame_id = "panda_link5";
-  std::printf("| input rate [Hz] | sent | loads received | lost | latency median [us] | p99 [us] | max [us] |\n");
+  std::printf(
+      "| input rate [Hz] | sent | loads received | lost | latency median [us] | p99 [us] | max "
+      "[us] |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   double t_sim = 0.0;
   for (double rate : rates) {

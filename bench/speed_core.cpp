@@ -66,7 +66,9 @@ void coreLoads(benchmark::State& state, const std::string& file) {
   state.counters["segments"] = model.nsegments();
 }
 
-void coreDouble(benchmark::State& state, const std::string& file) { coreLoads<double>(state, file); }
+void coreDouble(benchmark::State& state, const std::string& file) {
+  coreLoads<double>(state, file);
+}
 void coreFloat(benchmark::State& state, const std::string& file) { coreLoads<float>(state, file); }
 void coreLongDouble(benchmark::State& state, const std::string& file) {
   coreLoads<long double>(state, file);
@@ -215,7 +217,8 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
   jle::EstimatorConfig c;
   c.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;  // 9 samples, causal
   const std::string gy = "_gy";
-  if (variant.size() > gy.size() && variant.compare(variant.size() - gy.size(), gy.size(), gy) == 0) {
+  if (variant.size() > gy.size() &&
+      variant.compare(variant.size() - gy.size(), gy.size(), gy) == 0) {
     c.gravity_world = Eigen::Vector3d(0.0, -9.80665, 0.0);
     variant.resize(variant.size() - gy.size());
   }
@@ -284,35 +287,46 @@ void estimatorStep(benchmark::State& state, const std::string& file, const std::
 
 // Savings: each switched off (or on) against the defaults, where it applies and where
 // it does not.
-#define JLE_SAVING(name, file, joints, still)                                              \
-  BENCHMARK_CAPTURE(estimatorStep, name##_defaults, file, joints, still, "defaults");     \
-  BENCHMARK_CAPTURE(estimatorStep, name##_none, file, joints, still, "none");             \
-  BENCHMARK_CAPTURE(estimatorStep, name##_prune_off, file, joints, still, "prune_off");   \
-  BENCHMARK_CAPTURE(estimatorStep, name##_massless_off, file, joints, still, "massless_off"); \
+#define JLE_SAVING(name, file, joints, still)                                                     \
+  BENCHMARK_CAPTURE(estimatorStep, name##_defaults, file, joints, still, "defaults");             \
+  BENCHMARK_CAPTURE(estimatorStep, name##_none, file, joints, still, "none");                     \
+  BENCHMARK_CAPTURE(estimatorStep, name##_prune_off, file, joints, still, "prune_off");           \
+  BENCHMARK_CAPTURE(estimatorStep, name##_massless_off, file, joints, still, "massless_off");     \
   BENCHMARK_CAPTURE(estimatorStep, name##_gyroscopic_off, file, joints, still, "gyroscopic_off"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_reuse_off, file, joints, still, "reuse_off");   \
-  BENCHMARK_CAPTURE(estimatorStep, name##_static_on, file, joints, still, "static_on");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_reuse_off, file, joints, still, "reuse_off");           \
+  BENCHMARK_CAPTURE(estimatorStep, name##_static_on, file, joints, still, "static_on");           \
   BENCHMARK_CAPTURE(estimatorStep, name##_float, file, joints, still, "float")
 BENCHMARK_CAPTURE(scaling, chain, false)
-    ->RangeMultiplier(10)->Range(1, 1000)->Arg(300)->Arg(30)->Arg(3)->Complexity(benchmark::oN);
+    ->RangeMultiplier(10)
+    ->Range(1, 1000)
+    ->Arg(300)
+    ->Arg(30)
+    ->Arg(3)
+    ->Complexity(benchmark::oN);
 BENCHMARK_CAPTURE(scaling, tree, true)
-    ->RangeMultiplier(10)->Range(1, 1000)->Arg(300)->Arg(30)->Arg(3)->Complexity(benchmark::oN);
+    ->RangeMultiplier(10)
+    ->Range(1, 1000)
+    ->Arg(300)
+    ->Arg(30)
+    ->Arg(3)
+    ->Complexity(benchmark::oN);
 
 // The covariance of the loads against the same step without it.
-#define JLE_COVARIANCE(name, file)                                                         \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_off, file, "", false, "defaults");          \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full, file, "", false, "cov_full");         \
+#define JLE_COVARIANCE(name, file)                                                          \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_off, file, "", false, "defaults");            \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full, file, "", false, "cov_full");           \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag, file, "", false, "cov_full_diag"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd, file, "", false, "cov_qdd");           \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag");  \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p8, file, "", false, "cov_full_p8");  \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p12, file, "", false, "cov_full_p12"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p16, file, "", false, "cov_full_p16"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p17, file, "", false, "cov_full_p17"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p18, file, "", false, "cov_full_p18"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p20, file, "", false, "cov_full_p20"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p24, file, "", false, "cov_full_p24"); \
-  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag_p16, file, "", false, "cov_full_diag_p16"); \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd, file, "", false, "cov_qdd");             \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_qdd_diag, file, "", false, "cov_qdd_diag");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p8, file, "", false, "cov_full_p8");     \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p12, file, "", false, "cov_full_p12");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p16, file, "", false, "cov_full_p16");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p17, file, "", false, "cov_full_p17");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p18, file, "", false, "cov_full_p18");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p20, file, "", false, "cov_full_p20");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p24, file, "", false, "cov_full_p24");   \
+  BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_diag_p16, file, "", false,               \
+                    "cov_full_diag_p16");                                                   \
   BENCHMARK_CAPTURE(estimatorStep, name##_cov_full_p1000, file, "", false, "cov_full_p1000")
 JLE_COVARIANCE(panda, "/urdf/panda.urdf");
 JLE_COVARIANCE(talos, "/urdf/talos_reduced.urdf");
@@ -327,12 +341,18 @@ JLE_SAVING(panda_chain_still, "/urdf/chains/panda_chain.urdf", "", true);
 // their plane) with the 3x3 path (auto detects it) and without; a spatial arm, where
 // detection refuses at construction, with auto and off (what detection costs per
 // sample: nothing).
-BENCHMARK_CAPTURE(estimatorStep, planar_arm_vertical_planar_auto, "/urdf/planar_arm.urdf", "", false, "defaults_gy");
-BENCHMARK_CAPTURE(estimatorStep, planar_arm_vertical_planar_off, "/urdf/planar_arm.urdf", "", false, "planar_off_gy");
-BENCHMARK_CAPTURE(estimatorStep, planar_chain_vertical_planar_auto, "/urdf/planar_chain.urdf", "", false, "defaults_gy");
-BENCHMARK_CAPTURE(estimatorStep, planar_chain_vertical_planar_off, "/urdf/planar_chain.urdf", "", false, "planar_off_gy");
-BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_auto, "/urdf/chains/panda_chain.urdf", "", false, "defaults");
-BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/panda_chain.urdf", "", false, "planar_off");
+BENCHMARK_CAPTURE(estimatorStep, planar_arm_vertical_planar_auto, "/urdf/planar_arm.urdf", "",
+                  false, "defaults_gy");
+BENCHMARK_CAPTURE(estimatorStep, planar_arm_vertical_planar_off, "/urdf/planar_arm.urdf", "", false,
+                  "planar_off_gy");
+BENCHMARK_CAPTURE(estimatorStep, planar_chain_vertical_planar_auto, "/urdf/planar_chain.urdf", "",
+                  false, "defaults_gy");
+BENCHMARK_CAPTURE(estimatorStep, planar_chain_vertical_planar_off, "/urdf/planar_chain.urdf", "",
+                  false, "planar_off_gy");
+BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_auto, "/urdf/chains/panda_chain.urdf",
+                  "", false, "defaults");
+BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/panda_chain.urdf", "",
+                  false, "planar_off");
 
 BENCHMARK_CAPTURE(coreDouble, panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",
@@ -353,7 +373,8 @@ BENCHMARK_CAPTURE(coreKinematicsOnly, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreDynamicsOnly, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreKinematicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(coreDynamicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
-BENCHMARK_CAPTURE(differentiation, finite_difference, jle::DifferentiatorType::kFiniteDifference, 3);
+BENCHMARK_CAPTURE(differentiation, finite_difference, jle::DifferentiatorType::kFiniteDifference,
+                  3);
 BENCHMARK_CAPTURE(differentiation, savitzky_golay_9, jle::DifferentiatorType::kSavitzkyGolay, 9);
 BENCHMARK_CAPTURE(differentiation, kalman, jle::DifferentiatorType::kKalman, 1);
 

@@ -68,22 +68,22 @@ enum class Sign { kAny, kNonNegative, kPositive };
 /// `text` (an option's value) as a finite number: strtod must read all of it. Throws
 /// UsageError "KEY: 'TEXT' is not a finite number", ending " >= 0" or " > 0" with a
 /// `sign` it does not have.
-inline double parseNumber(const std::string& key, const std::string& text,
-                          Sign sign = Sign::kAny) {
+inline double parseNumber(const std::string& key, const std::string& text, Sign sign = Sign::kAny) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   const bool ok = end != text.c_str() && *end == '\0' && std::isfinite(v) &&
                   (sign == Sign::kAny || (sign == Sign::kNonNegative ? v >= 0.0 : v > 0.0));
   if (!ok)
     throw UsageError(key + ": '" + text + "' is not a finite number" +
-                     (sign == Sign::kAny ? "" : sign == Sign::kNonNegative ? " >= 0" : " > 0"));
+                     (sign == Sign::kAny           ? ""
+                      : sign == Sign::kNonNegative ? " >= 0"
+                                                   : " > 0"));
   return v;
 }
 
 /// parseNumber, within [lo, hi]: beyond, throws UsageError "KEY: TEXT is outside LO .. HI"
 /// (the bounds with 4 significant digits).
-inline double parseNumberIn(const std::string& key, const std::string& text, double lo,
-                            double hi) {
+inline double parseNumberIn(const std::string& key, const std::string& text, double lo, double hi) {
   const double v = parseNumber(key, text);
   if (v < lo || v > hi) {
     char range[64];
@@ -102,8 +102,8 @@ inline unsigned long long parseInteger(const std::string& key, const std::string
   const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
   if (text.empty() || text[0] < '0' || text[0] > '9' || *end != '\0' || errno != 0 || v < lo ||
       v > hi)
-    throw UsageError(key + ": '" + text + "' is not an integer in " + std::to_string(lo) +
-                     " .. " + std::to_string(hi));
+    throw UsageError(key + ": '" + text + "' is not an integer in " + std::to_string(lo) + " .. " +
+                     std::to_string(hi));
   return v;
 }
 

@@ -41,7 +41,8 @@ struct WrenchInputConfig {
   /// URDF link the wrench acts on; samples are given in its frame. Required, but for a
   /// sensor input (sensor_joint), whose link defaults to the joint's child link.
   std::string link;
-  double sign = 1.0;  ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies (force plate)
+  double sign = 1.0;     ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies
+                         ///< (force plate)
   double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale
   StalePolicy stale_policy = StalePolicy::kHold;
   /// Non-empty: the input is a force/torque sensor mounted at this FIXED joint of the

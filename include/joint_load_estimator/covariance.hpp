@@ -35,16 +35,17 @@ struct CovarianceModel {
   /// uncertainty or of a wrench input) that is negative or not finite. With the
   /// uncertainty disabled only the checks are made.
   CovarianceModel(const Model<double>& model, const UncertaintyConfig& uncertainty,
-                  const std::vector<WrenchInputConfig>& wrenches, const std::vector<int>& input_frames,
-                  const std::vector<int>& kinematics_segments, const std::vector<int>& dynamics_segments);
+                  const std::vector<WrenchInputConfig>& wrenches,
+                  const std::vector<int>& input_frames, const std::vector<int>& kinematics_segments,
+                  const std::vector<int>& dynamics_segments);
 
   bool enabled = false;
   bool diagonal_only = false;
   bool linearize_state = true;
-  double var_position = 0.0;  ///< [rad^2 or m^2]
+  double var_position = 0.0;                                             ///< [rad^2 or m^2]
   double mass_fraction = 0.0, com_offset = 0.0, inertia_fraction = 0.0;  ///< UncertaintyConfig
-  double period = 0.0, gain_tolerance = 0.0;                            ///< [s], relative
-  std::vector<InputNoise> inputs;  ///< those with noise
+  double period = 0.0, gain_tolerance = 0.0;                             ///< [s], relative
+  std::vector<InputNoise> inputs;                                        ///< those with noise
   std::vector<int> kinematics_segments, dynamics_segments;
   std::vector<int> subtree_end;  ///< per segment: its subtree is [i, subtree_end[i])
   std::vector<char> in_dynamics, in_kinematics;  ///< per segment
@@ -91,11 +92,13 @@ bool extrapolateCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws,
 /// The covariance of the joint wrenches of `nominal` (the loads just computed, in double,
 /// with the kinematics of the estimate) at stamp t [s], with the filter's noise gain
 /// `gain` (DifferentiatorBank::noiseGain); kept for the extrapolation a period apart.
-void computeCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
-                       const Data<double>& nominal, const Eigen::Matrix3d& gain, double t);
+void computeCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws,
+                       const Model<double>& model, const Data<double>& nominal,
+                       const Eigen::Matrix3d& gain, double t);
 
 /// The variance of a joint's effort [N^2 m^2 or N^2] from its wrench covariance C
 /// (0 for a joint that does not move; clamped at 0: an extrapolated C may be indefinite).
-double effortVariance(const Model<double>& model, const Eigen::Matrix<double, 6, 6>& C, int segment);
+double effortVariance(const Model<double>& model, const Eigen::Matrix<double, 6, 6>& C,
+                      int segment);
 
 }  // namespace jle

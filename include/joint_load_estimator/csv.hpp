@@ -181,8 +181,7 @@ inline constexpr std::array<const char*, 6> kWrenchComponents = {"fx", "fy", "fz
                                                                  "mx", "my", "mz"};
 /// The columns of a force plate in a joint-load file: plate@NAME.contact (1 or 0) and the
 /// centre of pressure in the world, plate@NAME.cop_x, .cop_y, .cop_z [m].
-inline constexpr std::array<const char*, 4> kPlateOutputs = {"contact", "cop_x", "cop_y",
-                                                             "cop_z"};
+inline constexpr std::array<const char*, 4> kPlateOutputs = {"contact", "cop_x", "cop_y", "cop_z"};
 
 /// What a joint-load file holds beside t and the seven columns of each joint.
 struct LoadColumnLayout {

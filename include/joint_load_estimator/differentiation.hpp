@@ -69,7 +69,8 @@ inline void validate(const DifferentiatorConfig& c) {
     if (c.delay < 0 || c.delay >= window)
       fail("delay", "must be 0..window-1, it is " + std::to_string(c.delay));
   }
-  if (!(c.max_gap > 0.0) || !std::isfinite(c.max_gap)) fail("max_gap", "must be finite and > 0 [s]");
+  if (!(c.max_gap > 0.0) || !std::isfinite(c.max_gap))
+    fail("max_gap", "must be finite and > 0 [s]");
 }
 
 /// A bank of identical filters over `channels` signals sampled at common times.
@@ -81,8 +82,8 @@ inline void validate(const DifferentiatorConfig& c) {
 class DifferentiatorBank {
  public:
   static constexpr int kMaxOrder = 5;
-  using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1,
-                                    kMaxOrder + 1>;
+  using SmallMatrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, kMaxOrder + 1>;
 
   DifferentiatorBank(const DifferentiatorConfig& config, int channels)
       : config_(config), channels_(channels) {
@@ -123,8 +124,7 @@ class DifferentiatorBank {
   bool update(double t, const double* x) {
     if (count_ > 0) {
       const double dt = t - last_time_;
-      if (!(dt > 0.0))
-        throw std::invalid_argument("differentiator: sample time does not increase");
+      if (!(dt > 0.0)) throw std::invalid_argument("differentiator: sample time does not increase");
       if (dt > config_.max_gap) reset();
     }
     last_time_ = t;
@@ -342,7 +342,8 @@ class DifferentiatorBank {
     const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
     P_ -= K * P_.row(0);
     P_ = 0.5 * (P_ + P_.transpose()).eval();
-    gain_settled_ = count_ >= n_ && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
+    gain_settled_ =
+        count_ >= n_ && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
     K_ = K;
   }
 
@@ -396,7 +397,7 @@ class DifferentiatorBank {
   Eigen::Matrix<double, kMaxOrder + 1, 1> h_;     // Householder coefficients
   Eigen::Matrix<double, kMaxOrder + 1, 1> work_;  // workspace of applyHouseholderOnTheLeft
   Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 101, 3> coeff_t_;  // w x 3
-  Eigen::MatrixXd state_;  // Kalman: n x channels
+  Eigen::MatrixXd state_;                                        // Kalman: n x channels
   SmallMatrix P_;
 };
 

@@ -79,8 +79,11 @@ class Estimator {
                       const Eigen::Vector3d& moment_plate);
   /// Sets the pose of plate k's frame in the world [m] (the root frame for a fixed base);
   /// the configured pose until then. plateConfig(k) and config().plates[k] follow it.
-  void setPlatePose(int k, const Eigen::Matrix3d& R_world_plate, const Eigen::Vector3d& p_world_plate);
-  const PlateInputConfig& plateConfig(int k) const { return config_.plates[static_cast<std::size_t>(k)]; }
+  void setPlatePose(int k, const Eigen::Matrix3d& R_world_plate,
+                    const Eigen::Vector3d& p_world_plate);
+  const PlateInputConfig& plateConfig(int k) const {
+    return config_.plates[static_cast<std::size_t>(k)];
+  }
   /// Plate k as applied at the last published sample: contact, COP (plate frame), free
   /// moment, reaction on the foot. No contact: nothing was applied.
   const PlateReading& plateReading(int k) const { return plates_.reading(k); }
@@ -145,7 +148,6 @@ class Estimator {
   const std::string& planarReason() const { return planar_reason_; }
   bool lastWasPlanar() const { return last_planar_; }
 
-
  private:
   // A wrench input: its samples (sign applied), the frame it acts at, the first of its
   // six bank channels, and whether a computed segment needs it.
@@ -180,7 +182,8 @@ class Estimator {
   // The loads in Scalar (double, or float for Precision::kFloat): the one 6x6 path.
   template <typename Scalar>
   void computeLoads(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
-                    const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd, const BaseState<Scalar>& base);
+                    const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                    const BaseState<Scalar>& base);
   void computeInFloat(const BaseState<double>& base_state);
   // The planar path for this sample; false (nothing done) when a wrench leaves the plane.
   bool computePlanar();

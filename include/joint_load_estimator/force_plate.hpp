@@ -53,7 +53,8 @@ struct PlateReading {
 
 /// Decodes a plate sample: the wrench the foot applies to the plate (plate frame,
 /// moment about the plate origin). Non-finite input gives no contact.
-inline PlateReading readForcePlate(const ForcePlateConfig& plate, const Eigen::Vector3d& force_plate,
+inline PlateReading readForcePlate(const ForcePlateConfig& plate,
+                                   const Eigen::Vector3d& force_plate,
                                    const Eigen::Vector3d& moment_plate) {
   PlateReading r;
   if (!force_plate.allFinite() || !moment_plate.allFinite()) return r;
@@ -67,8 +68,8 @@ inline PlateReading readForcePlate(const ForcePlateConfig& plate, const Eigen::V
   r.cop_plate.x() = (h * force_plate.x() - moment_plate.y()) / fz;
   r.cop_plate.y() = (moment_plate.x() + h * force_plate.y()) / fz;
   r.cop_plate.z() = h;
-  r.free_moment = moment_plate.z() -
-                  (r.cop_plate.x() * force_plate.y() - r.cop_plate.y() * force_plate.x());
+  r.free_moment =
+      moment_plate.z() - (r.cop_plate.x() * force_plate.y() - r.cop_plate.y() * force_plate.x());
   r.force_on_foot_plate = -force_plate;
   r.moment_on_foot_plate = -moment_plate;
   return r;

@@ -72,10 +72,9 @@ template <typename Scalar>
 void checkCoordinates(const Model<Scalar>& model, const VectorX<Scalar>& q,
                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd) {
   if (q.size() != model.nq || qd.size() != model.nq || qdd.size() != model.nq)
-    throw std::invalid_argument("coordinate vectors have sizes " + std::to_string(q.size()) +
-                                ", " + std::to_string(qd.size()) + ", " +
-                                std::to_string(qdd.size()) + "; the model has " +
-                                std::to_string(model.nq) + " coordinates");
+    throw std::invalid_argument("coordinate vectors have sizes " + std::to_string(q.size()) + ", " +
+                                std::to_string(qd.size()) + ", " + std::to_string(qdd.size()) +
+                                "; the model has " + std::to_string(model.nq) + " coordinates");
 }
 
 namespace detail {
@@ -159,9 +158,8 @@ inline void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i
 /// [rad, rad/s, rad/s^2 or m, m/s, m/s^2]. gravity_world [m/s^2]. Fills the kinematic
 /// fields of data and clears its external wrenches.
 template <typename Scalar>
-void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
-                       const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
-                       const VectorX<Scalar>& qdd,
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
                        const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
                        const BaseState<Scalar>& base = BaseState<Scalar>()) {
   checkCoordinates(model, q, qd, qdd);
@@ -175,9 +173,8 @@ void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
 /// the caller asserts zero joint velocities and accelerations and a base that does
 /// not rotate, and the velocity terms are skipped.
 template <typename Scalar>
-void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data,
-                       const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
-                       const VectorX<Scalar>& qdd,
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
                        const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
                        const BaseState<Scalar>& base, const std::vector<int>& segments,
                        bool statics) {
@@ -208,8 +205,7 @@ Eigen::Matrix<Scalar, 3, 1> alphaWorld(const Data<Scalar>& data, int i) {
 
 /// Centre of mass of segment i in the world frame [m].
 template <typename Scalar>
-Eigen::Matrix<Scalar, 3, 1> comWorld(const Model<Scalar>& model, const Data<Scalar>& data,
-                                     int i) {
+Eigen::Matrix<Scalar, 3, 1> comWorld(const Model<Scalar>& model, const Data<Scalar>& data, int i) {
   return data.p_world[i] + data.R_world[i] * model.com[i];
 }
 
@@ -221,8 +217,7 @@ Eigen::Matrix<Scalar, 3, 1> comAccelerationWorld(const Model<Scalar>& model,
                                                  const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
   const Eigen::Matrix<Scalar, 3, 1>& c = model.com[i];
   const Eigen::Matrix<Scalar, 3, 1>& w = data.omega[i];
-  const Eigen::Matrix<Scalar, 3, 1> a =
-      data.acc[i] + data.alpha[i].cross(c) + w.cross(w.cross(c));
+  const Eigen::Matrix<Scalar, 3, 1> a = data.acc[i] + data.alpha[i].cross(c) + w.cross(w.cross(c));
   return data.R_world[i] * a + gravity_world;
 }
 

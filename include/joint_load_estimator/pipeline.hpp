@@ -27,15 +27,15 @@ using Stamp = std::int64_t;
 /// What became of one input message. Every message is either used or counted under
 /// the reason it was not (PipelineCounters).
 enum class Outcome : std::uint8_t {
-  kUsed,          ///< taken (a joint state entered the filters; no loads for it yet)
-  kPublished,     ///< a joint state: loads computed, record() holds them
-  kInvalid,       ///< sizes disagree, or a non-finite value
-  kOrder,         ///< same or older stamp than the input's previous one
-  kFrame,         ///< frame neither rigid to the link in the URDF nor known to the FrameSource
-  kNoBasePose,    ///< floating base: no pose of the base at the stamp
-  kWaiting,       ///< a coordinate the computed loads need has had no position yet
-  kStale,         ///< an input with stale_policy stop is stale: no loads
-  kUnchanged,     ///< same filtered inputs as the last loads and republish_unchanged off
+  kUsed,        ///< taken (a joint state entered the filters; no loads for it yet)
+  kPublished,   ///< a joint state: loads computed, record() holds them
+  kInvalid,     ///< sizes disagree, or a non-finite value
+  kOrder,       ///< same or older stamp than the input's previous one
+  kFrame,       ///< frame neither rigid to the link in the URDF nor known to the FrameSource
+  kNoBasePose,  ///< floating base: no pose of the base at the stamp
+  kWaiting,     ///< a coordinate the computed loads need has had no position yet
+  kStale,       ///< an input with stale_policy stop is stale: no loads
+  kUnchanged,   ///< same filtered inputs as the last loads and republish_unchanged off
   kCount
 };
 
@@ -167,7 +167,7 @@ class Pipeline {
 
  private:
   struct WrenchInput {
-    std::string frame;  // last resolved frame
+    std::string frame;   // last resolved frame
     bool rigid = false;  // `frame` is a URDF frame rigid to the link: pose cached
     Eigen::Isometry3d X_link_frame = Eigen::Isometry3d::Identity();
     Eigen::Vector3d bias_force = Eigen::Vector3d::Zero(), bias_torque = Eigen::Vector3d::Zero();

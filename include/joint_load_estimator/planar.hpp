@@ -93,9 +93,9 @@ struct PlanarModel {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
 
-  Vector3 normal = Vector3::UnitZ();      ///< n in the root frame
-  Matrix3 E = Matrix3::Identity();        ///< root plane basis [e1 e2 n], root frame
-  bool offsets = false;                   ///< some point lies off the plane of its joint (S needed)
+  Vector3 normal = Vector3::UnitZ();  ///< n in the root frame
+  Matrix3 E = Matrix3::Identity();    ///< root plane basis [e1 e2 n], root frame
+  bool offsets = false;               ///< some point lies off the plane of its joint (S needed)
   // Per segment, size nsegments().
   std::vector<Matrix3> K;          ///< segment frame -> plane frame
   std::vector<Scalar> sign;        ///< revolute: axis = sign * n; else 0
@@ -106,9 +106,9 @@ struct PlanarModel {
   std::vector<Scalar> com_height;  ///< ... and its offset along n [m]
   std::vector<Scalar> inertia_n;   ///< n . J_G n [kg m^2]
   // Per model frame (Model::frames), size frames.size().
-  std::vector<Matrix3> K_frame;           ///< link frame -> plane frame of its segment
-  std::vector<Vector2> frame_origin;      ///< link origin in the plane frame, in-plane part [m]
-  std::vector<Scalar> frame_height;       ///< ... and its offset along n [m]
+  std::vector<Matrix3> K_frame;       ///< link frame -> plane frame of its segment
+  std::vector<Vector2> frame_origin;  ///< link origin in the plane frame, in-plane part [m]
+  std::vector<Scalar> frame_height;   ///< ... and its offset along n [m]
 };
 
 /// Per-sample workspace of the planar passes (allocated once).
@@ -136,8 +136,8 @@ struct PlanarData {
   /// Backward pass: joint force (in-plane), moment along n about the joint origin, and
   /// S = sum of height * force (the in-plane moment is n x S). Before the pass they hold
   /// minus the applied wrenches (planarAddExternalWrench).
-  std::vector<Vector2> force;   ///< [N]
-  std::vector<Scalar> moment;   ///< [N m]
+  std::vector<Vector2> force;         ///< [N]
+  std::vector<Scalar> moment;         ///< [N m]
   std::vector<Vector2> first_moment;  ///< [N m]
 };
 
@@ -153,7 +153,9 @@ Eigen::Matrix<Scalar, 3, 3> planeBasis(const Eigen::Matrix<Scalar, 3, 1>& n) {
   if (n.x() == Scalar(0) && n.y() == Scalar(0)) {
     e1 = Vector3::UnitX();
   } else {
-    e1 = (std::abs(n.x()) < std::abs(n.y()) ? Vector3::UnitX() : Vector3::UnitY()).cross(n).normalized();
+    e1 = (std::abs(n.x()) < std::abs(n.y()) ? Vector3::UnitX() : Vector3::UnitY())
+             .cross(n)
+             .normalized();
   }
   E.col(0) = e1;
   E.col(1) = n.cross(e1);
@@ -186,7 +188,8 @@ PlanarCheck<Scalar> detectPlanar(const Model<Scalar>& model,
   std::vector<Matrix3> R(static_cast<std::size_t>(n), Matrix3::Identity());
   for (int i : *list) {
     if (i > 0) R[i] = R[model.parent[i]] * model.R_parent_joint[i];
-    if (model.joint_type[i] == JointType::kRevolute && out.normal.isZero()) out.normal = R[i] * model.axis[i];
+    if (model.joint_type[i] == JointType::kRevolute && out.normal.isZero())
+      out.normal = R[i] * model.axis[i];
   }
   if (model.floating_base) {
     out.reason = "the base is floating";
@@ -206,7 +209,8 @@ PlanarCheck<Scalar> detectPlanar(const Model<Scalar>& model,
     const Vector3 n_i = R[i].transpose() * out.normal;
     const Vector3& u = model.axis[i];
     if (model.joint_type[i] == JointType::kRevolute && u.cross(n_i).norm() > tol) {
-      out.reason = "joint '" + model.joint_name[i] + "' turns about an axis not parallel to the plane normal";
+      out.reason = "joint '" + model.joint_name[i] +
+                   "' turns about an axis not parallel to the plane normal";
       return out;
     }
     if (model.joint_type[i] == JointType::kPrismatic && std::abs(u.dot(n_i)) > tol) {
@@ -228,7 +232,8 @@ PlanarCheck<Scalar> detectPlanar(const Model<Scalar>& model,
 /// The constant planar data for normal n (root frame, unit; detectPlanar's). The
 /// conditions are not checked here: out-of-plane components are dropped.
 template <typename Scalar>
-PlanarModel<Scalar> planarModel(const Model<Scalar>& model, const Eigen::Matrix<Scalar, 3, 1>& normal) {
+PlanarModel<Scalar> planarModel(const Model<Scalar>& model,
+                                const Eigen::Matrix<Scalar, 3, 1>& normal) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
   // A height that is rounding of an in-plane placement (within the tolerance of the
@@ -259,7 +264,8 @@ PlanarModel<Scalar> planarModel(const Model<Scalar>& model, const Eigen::Matrix<
       pm.height[i] = inPlaneOrHeight(o);
     }
     const Vector3 u = pm.K[i] * model.axis[i];
-    if (model.joint_type[i] == JointType::kRevolute) pm.sign[i] = u.z() < Scalar(0) ? Scalar(-1) : Scalar(1);
+    if (model.joint_type[i] == JointType::kRevolute)
+      pm.sign[i] = u.z() < Scalar(0) ? Scalar(-1) : Scalar(1);
     if (model.joint_type[i] == JointType::kPrismatic) {
       pm.slide[i] = u.template head<2>();
       // A forced model may slide partly along n: keep the in-plane unit direction.
@@ -288,9 +294,10 @@ PlanarModel<Scalar> planarModel(const Model<Scalar>& model, const Eigen::Matrix<
 /// caller); gravity_root [m/s^2] in the root frame (its n component is dropped). Clears
 /// the applied wrenches.
 template <typename Scalar>
-void planarKinematics(const Model<Scalar>& model, const PlanarModel<Scalar>& pm, PlanarData<Scalar>& pd,
-                      const VectorX<Scalar>& q, const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
-                      const Eigen::Matrix<Scalar, 3, 1>& gravity_root, const std::vector<int>& segments) {
+void planarKinematics(const Model<Scalar>& model, const PlanarModel<Scalar>& pm,
+                      PlanarData<Scalar>& pd, const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                      const VectorX<Scalar>& qdd, const Eigen::Matrix<Scalar, 3, 1>& gravity_root,
+                      const std::vector<int>& segments) {
   using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
   using std::cos;
   using std::sin;
@@ -333,7 +340,8 @@ void planarKinematics(const Model<Scalar>& model, const PlanarModel<Scalar>& pm,
       pd.cos_phi[i] = c;
       pd.sin_phi[i] = s;
       if (model.joint_type[i] == JointType::kPrismatic) {
-        const Vector2 d(c * pm.slide[i].x() - s * pm.slide[i].y(), s * pm.slide[i].x() + c * pm.slide[i].y());
+        const Vector2 d(c * pm.slide[i].x() - s * pm.slide[i].y(),
+                        s * pm.slide[i].x() + c * pm.slide[i].y());
         r += qi * d;
         a = pd.acc[p] + Vector2(-al_p * r.y(), al_p * r.x()) - (w_p * w_p) * r;
         // Slide acceleration and Coriolis 2 omega n x (d qd).
@@ -354,7 +362,8 @@ void planarKinematics(const Model<Scalar>& model, const PlanarModel<Scalar>& pm,
 /// frame, lies in the plane: force perpendicular to n and moment along n, to the
 /// tolerance relative to its own magnitude. A wrench that does not must take the 6x6 path.
 template <typename Scalar>
-bool planarWrenchInPlane(const PlanarModel<Scalar>& pm, int frame, const Eigen::Matrix<Scalar, 3, 1>& force,
+bool planarWrenchInPlane(const PlanarModel<Scalar>& pm, int frame,
+                         const Eigen::Matrix<Scalar, 3, 1>& force,
                          const Eigen::Matrix<Scalar, 3, 1>& moment) {
   const Eigen::Matrix<Scalar, 3, 3>& K = pm.K_frame[frame];
   const Scalar tol = planarTolerance<Scalar>();
@@ -369,7 +378,8 @@ bool planarWrenchInPlane(const PlanarModel<Scalar>& pm, int frame, const Eigen::
 /// where the rest matters).
 template <typename Scalar>
 void planarAddExternalWrench(const Model<Scalar>& model, const PlanarModel<Scalar>& pm,
-                             PlanarData<Scalar>& pd, int frame, const Eigen::Matrix<Scalar, 3, 1>& force,
+                             PlanarData<Scalar>& pd, int frame,
+                             const Eigen::Matrix<Scalar, 3, 1>& force,
                              const Eigen::Matrix<Scalar, 3, 1>& moment) {
   using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
   const Eigen::Matrix<Scalar, 3, 3>& K = pm.K_frame[frame];
@@ -390,8 +400,9 @@ void planarAddExternalWrench(const Model<Scalar>& model, const PlanarModel<Scala
 /// children), then the 6-D joint wrenches into data.force, data.moment (child frame,
 /// moment about the joint origin) and data.effort, exactly as inverseDynamics would.
 template <typename Scalar>
-void planarInverseDynamics(const Model<Scalar>& model, const PlanarModel<Scalar>& pm, PlanarData<Scalar>& pd,
-                           Data<Scalar>& data, const std::vector<int>& segments) {
+void planarInverseDynamics(const Model<Scalar>& model, const PlanarModel<Scalar>& pm,
+                           PlanarData<Scalar>& pd, Data<Scalar>& data,
+                           const std::vector<int>& segments) {
   using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
   for (auto it = segments.rbegin(); it != segments.rend(); ++it) {
     const int i = *it;
@@ -403,7 +414,8 @@ void planarInverseDynamics(const Model<Scalar>& model, const PlanarModel<Scalar>
       const Vector2& cc = pm.com[i];
       const Vector2 c_w(c * cc.x() - s * cc.y(), s * cc.x() + c * cc.y());
       const Scalar w = pd.omega[i], al = pd.alpha[i];
-      const Vector2 m_a = model.mass[i] * (pd.acc[i] + Vector2(-al * c_w.y(), al * c_w.x()) - (w * w) * c_w);
+      const Vector2 m_a =
+          model.mass[i] * (pd.acc[i] + Vector2(-al * c_w.y(), al * c_w.x()) - (w * w) * c_w);
       f += m_a;
       m += pm.inertia_n[i] * al + (c_w.x() * m_a.y() - c_w.y() * m_a.x());
       if (pm.offsets) pd.first_moment[i] += pm.com_height[i] * m_a;
@@ -420,7 +432,9 @@ void planarInverseDynamics(const Model<Scalar>& model, const PlanarModel<Scalar>
     }
     switch (model.joint_type[i]) {
       case JointType::kRevolute: data.effort[i] = pm.sign[i] * m; break;
-      case JointType::kPrismatic: data.effort[i] = pm.slide[i].x() * fx + pm.slide[i].y() * fy; break;
+      case JointType::kPrismatic:
+        data.effort[i] = pm.slide[i].x() * fx + pm.slide[i].y() * fy;
+        break;
       default: data.effort[i] = Scalar(0); break;
     }
     const int p = model.parent[i];

@@ -32,7 +32,8 @@ class PlateInputs {
   int size() const { return static_cast<int>(plates_.size()); }
   /// A sample of plate k at time t [s] (PlateInputConfig). Dropped (false) unless newer
   /// than the newest held and finite.
-  bool add(int k, double t, const Eigen::Vector3d& force_plate, const Eigen::Vector3d& moment_plate);
+  bool add(int k, double t, const Eigen::Vector3d& force_plate,
+           const Eigen::Vector3d& moment_plate);
   /// The pose of plate k in the world [m]. Throws naming the plate unless a finite
   /// rotation and position.
   void setPose(int k, const Eigen::Matrix3d& R_world_plate, const Eigen::Vector3d& p_world_plate);
@@ -81,7 +82,8 @@ class PlateInputs {
 };
 
 template <typename Scalar>
-void PlateInputs::apply(const Model<Scalar>& model, Data<Scalar>& data, const DifferentiatorBank& bank) {
+void PlateInputs::apply(const Model<Scalar>& model, Data<Scalar>& data,
+                        const DifferentiatorBank& bank) {
   for (Plate& p : plates_) {
     p.reading = PlateReading();
     if (!p.needed || !p.contact) continue;

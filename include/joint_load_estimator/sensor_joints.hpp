@@ -50,7 +50,9 @@ class SensorJoints {
   /// Sensor k's joint wrench according to the model at the last backward pass (child
   /// link frame, moment about the joint origin [N, N m]), and whether the measurement
   /// replaced it.
-  const Wrench<double>& predicted(int k) const { return inputs_[static_cast<std::size_t>(k)].predicted; }
+  const Wrench<double>& predicted(int k) const {
+    return inputs_[static_cast<std::size_t>(k)].predicted;
+  }
   bool used(int k) const { return inputs_[static_cast<std::size_t>(k)].used; }
   /// Measured minus predicted for sensor k, with `data` the result of the backward pass
   /// (same frame and point); zero for an applied wrench or an unused sensor.
@@ -84,7 +86,8 @@ void SensorJoints::atSegment(Data<Scalar>& data, const Model<Scalar>& model, int
   const Frame<Scalar>& fr = model.frames[static_cast<std::size_t>(input.frame)];
   const Eigen::Matrix<Scalar, 3, 1> f = fr.R_segment_frame * w.force.template cast<Scalar>();
   data.force[segment] = f;
-  data.moment[segment] = fr.R_segment_frame * w.moment.template cast<Scalar>() + fr.p_segment_frame.cross(f);
+  data.moment[segment] =
+      fr.R_segment_frame * w.moment.template cast<Scalar>() + fr.p_segment_frame.cross(f);
 }
 
 }  // namespace jle

@@ -47,7 +47,8 @@ BaseState<double> baseStateFromBank(const DifferentiatorBank& bank, int channel)
   // q' = 1/2 w q  =>  w = 2 vec(q' q*);  alpha = 2 vec(q'' q*) (the rest is scalar).
   base_state.omega_world = 2.0 * productVector(quat_rate, conj);
   base_state.alpha_world = 2.0 * productVector(quat_accel, conj);
-  base_state.R_world_base = Eigen::Quaterniond(quat[0], quat[1], quat[2], quat[3]).toRotationMatrix();
+  base_state.R_world_base =
+      Eigen::Quaterniond(quat[0], quat[1], quat[2], quat[3]).toRotationMatrix();
   return base_state;
 }
 

@@ -46,9 +46,12 @@ void validateSavings(const Savings& s) {
 
 void validateUncertainty(const UncertaintyConfig& u) {
   const std::pair<const char*, double> values[] = {
-      {"uncertainty/position_noise", u.position_noise}, {"uncertainty/mass_fraction", u.mass_fraction},
-      {"uncertainty/com_offset", u.com_offset},         {"uncertainty/inertia_fraction", u.inertia_fraction},
-      {"uncertainty/period", u.period},                 {"uncertainty/gain_tolerance", u.gain_tolerance}};
+      {"uncertainty/position_noise", u.position_noise},
+      {"uncertainty/mass_fraction", u.mass_fraction},
+      {"uncertainty/com_offset", u.com_offset},
+      {"uncertainty/inertia_fraction", u.inertia_fraction},
+      {"uncertainty/period", u.period},
+      {"uncertainty/gain_tolerance", u.gain_tolerance}};
   for (const auto& kv : values) nonNegative(kv.first, kv.second);
 }
 
@@ -125,8 +128,8 @@ void validate(const Settings& settings) {
   positive("diagnostic_period", settings.diagnostic_period);
   const double m = settings.body_mass;
   if (!((m >= 0.0 && std::isfinite(m)) || m == -1.0))
-    fail("body_mass", "must be a mass > 0 [kg], 0 (off) or -1 (the URDF's total mass), it is " +
-                          number(m));
+    fail("body_mass",
+         "must be a mass > 0 [kg], 0 (off) or -1 (the URDF's total mass), it is " + number(m));
   validateWrenchTopics(settings);
   validatePlateTopics(settings);
 }

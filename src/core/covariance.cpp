@@ -94,7 +94,8 @@ std::vector<int> subtreeEnds(const Model<double>& model) {
   for (int i = n - 1; i > 0; --i) end[model.parent[i]] = std::max(end[model.parent[i]], end[i]);
   for (int i = 0; i < n; ++i)
     for (int k = i + 1; k < end[i]; ++k)
-      if (model.parent[k] < i) throw std::logic_error("covariance: segments are not numbered depth first");
+      if (model.parent[k] < i)
+        throw std::logic_error("covariance: segments are not numbered depth first");
   return end;
 }
 
@@ -158,7 +159,8 @@ CovarianceModel::CovarianceModel(const Model<double>& model, const UncertaintyCo
   for (std::size_t k = 0; k < wrenches.size(); ++k) {
     const WrenchInputConfig& c = wrenches[k];
     if (input_frames[k] < 0 || (c.force_noise == 0.0 && c.moment_noise == 0.0)) continue;
-    inputs.push_back({input_frames[k], c.force_noise * c.force_noise, c.moment_noise * c.moment_noise});
+    inputs.push_back(
+        {input_frames[k], c.force_noise * c.force_noise, c.moment_noise * c.moment_noise});
   }
   const int n = model.nsegments();
   subtree_end = subtreeEnds(model);
@@ -425,7 +427,8 @@ bool addInputTerms(const CovarianceModel& cm, CovarianceWorkspace& ws, const Mod
   for (const CovarianceModel::InputNoise& in : cm.inputs) {
     const Frame<double>& fr = model.frames[in.frame];
     Matrix6 D = Matrix6::Zero();
-    D.diagonal() << Eigen::Vector3d::Constant(in.var_force * g00), Eigen::Vector3d::Constant(in.var_moment * g00);
+    D.diagonal() << Eigen::Vector3d::Constant(in.var_force * g00),
+        Eigen::Vector3d::Constant(in.var_moment * g00);
     addForceCongruence(fr.R_segment_frame, fr.p_segment_frame, D, ws.local[fr.segment]);
   }
   return !cm.inputs.empty();
@@ -434,8 +437,8 @@ bool addInputTerms(const CovarianceModel& cm, CovarianceWorkspace& ws, const Mod
 // Segment i's inertial parameters: mass (exact: the loads are linear in m), centre of
 // mass (linearised: the moment is quadratic in c) and inertia (exact: linear in the
 // tensor's scale).
-void addInertialTerms(const CovarianceModel& cm, const Model<double>& model, const Data<double>& nom,
-                      int i, Matrix6& local) {
+void addInertialTerms(const CovarianceModel& cm, const Model<double>& model,
+                      const Data<double>& nom, int i, Matrix6& local) {
   const double m = model.mass[i];
   const Eigen::Vector3d& c = model.com[i];
   const Eigen::Vector3d& w = nom.omega[i];
@@ -522,7 +525,8 @@ void quadraticThroughLastThree(const CovarianceModel& cm, CovarianceWorkspace& w
   for (int i : cm.dynamics_segments) {
     Matrix6& out = ws.covariance[i];
     if (cm.diagonal_only)
-      out.diagonal() = w0 * ws.last[i].diagonal() + w1 * ws.prev[i].diagonal() + w2 * ws.prev2[i].diagonal();
+      out.diagonal() =
+          w0 * ws.last[i].diagonal() + w1 * ws.prev[i].diagonal() + w2 * ws.prev2[i].diagonal();
     else
       out = w0 * ws.last[i] + w1 * ws.prev[i] + w2 * ws.prev2[i];
     for (int r = 0; r < 6; ++r) {
@@ -549,8 +553,9 @@ bool extrapolateCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws,
   return true;
 }
 
-void computeCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws, const Model<double>& model,
-                       const Data<double>& nominal, const Eigen::Matrix3d& gain, double t) {
+void computeCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws,
+                       const Model<double>& model, const Data<double>& nominal,
+                       const Eigen::Matrix3d& gain, double t) {
   for (int i : cm.dynamics_segments) {
     ws.covariance[i].setZero();
     ws.local[i].setZero();
@@ -566,7 +571,8 @@ void computeCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws, const
   keepForExtrapolation(cm, ws, gain, t);
 }
 
-double effortVariance(const Model<double>& model, const Eigen::Matrix<double, 6, 6>& C, int segment) {
+double effortVariance(const Model<double>& model, const Eigen::Matrix<double, 6, 6>& C,
+                      int segment) {
   const Eigen::Vector3d& u = model.axis[static_cast<std::size_t>(segment)];
   switch (model.joint_type[static_cast<std::size_t>(segment)]) {
     case JointType::kRevolute: return std::max(0.0, u.dot(C.bottomRightCorner<3, 3>() * u));

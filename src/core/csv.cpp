@@ -486,8 +486,9 @@ class StateHeader {
   // JOINT.q, JOINT.qd, JOINT.qdd.
   void bindJoint(int c, const std::string& name) {
     const std::size_t dot = name.rfind('.');
-    const int kind =
-        dot == std::string::npos ? -1 : indexOf(kStateSuffixes, std::string_view(name).substr(dot + 1));
+    const int kind = dot == std::string::npos
+                         ? -1
+                         : indexOf(kStateSuffixes, std::string_view(name).substr(dot + 1));
     if (kind < 0) {
       problems_.add(name,
                     "unknown column (expected t, JOINT.q, JOINT.qd, JOINT.qdd or "

@@ -63,7 +63,8 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   base_channel_ = model_.nq;
   wrench_channel_ = base_channel_ + (model_.floating_base ? 7 : 0);
   setUpWrenchInputs();
-  plates_ = PlateInputs(model_, config_.plates, wrench_channel_ + 6 * static_cast<int>(inputs_.size()));
+  plates_ =
+      PlateInputs(model_, config_.plates, wrench_channel_ + 6 * static_cast<int>(inputs_.size()));
   channels_.assign(static_cast<std::size_t>(bank_.channels()), 0.0);
   last_inputs_.assign(channels_.size() * 3, 0.0);
   const std::vector<char> dynamics = selectSegments();
@@ -78,7 +79,8 @@ void Estimator::setUpWrenchInputs() {
     input.channel = wrench_channel_ + 6 * static_cast<int>(inputs_.size());
     const int sensor_segment = sensors_.add(model_, c, input.channel);  // throws naming the input
     // A sensor's link is its joint's child link (sensors_ checked a non-empty one).
-    input.frame = model_.frameIndex(sensor_segment >= 0 ? model_.link_name[sensor_segment] : c.link);
+    input.frame =
+        model_.frameIndex(sensor_segment >= 0 ? model_.link_name[sensor_segment] : c.link);
     input.sign = c.sign;
     input.samples = InputBuffer(c.timeout, c.stale_policy);
     inputs_.push_back(input);
@@ -96,7 +98,8 @@ std::vector<char> Estimator::selectSegments() {
     for (const std::string& j : config_.joints) dyn[model_.segmentOfJoint(j)] = 1;
     // A sensor's prediction needs its distal subtree, whatever is published.
     for (std::size_t k = 0; k < inputs_.size(); ++k)
-      if (sensors_.segment(static_cast<int>(k)) >= 0) dyn[sensors_.segment(static_cast<int>(k))] = 1;
+      if (sensors_.segment(static_cast<int>(k)) >= 0)
+        dyn[sensors_.segment(static_cast<int>(k))] = 1;
     for (int i = 1; i < n; ++i)
       if (dyn[model_.parent[i]]) dyn[i] = 1;
   }
@@ -141,7 +144,8 @@ void Estimator::setUpPlanar() {
   } else if (plates_.size() > 0) {
     planar_reason_ = "force plates need the 6x6 path (the feet's 3-D positions)";
   } else {
-    const PlanarCheck<double> check = detectPlanar(model_, config_.gravity_world, kinematics_segments_);
+    const PlanarCheck<double> check =
+        detectPlanar(model_, config_.gravity_world, kinematics_segments_);
     planar_ = check.planar;
     planar_reason_ = check.reason;
     if (!planar_ && config_.savings.planar == PlanarMode::kOn) {
@@ -215,7 +219,8 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
 }
 
 // The steps of addJointSample, inline in it (out of line they cost 2% of a still sample).
-inline bool Estimator::accept(double t, const double* q, const BasePose* base, SampleStatus& refused) {
+inline bool Estimator::accept(double t, const double* q, const BasePose* base,
+                              SampleStatus& refused) {
   if (model_.floating_base && base == nullptr)
     throw std::invalid_argument("a floating-base model needs the base pose with each sample");
   refused = SampleStatus::kNonFinite;
@@ -292,12 +297,12 @@ void Estimator::compute(const BaseState<double>& base_state) {
 }
 
 template <typename Scalar>
-void Estimator::computeLoads(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
-                             const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
-                             const BaseState<Scalar>& base) {
+void Estimator::computeLoads(const Model<Scalar>& model, Data<Scalar>& data,
+                             const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                             const VectorX<Scalar>& qdd, const BaseState<Scalar>& base) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  forwardKinematics(model, data, q, qd, qdd, Vector3(config_.gravity_world.template cast<Scalar>()), base,
-                    kinematics_segments_, static_);
+  forwardKinematics(model, data, q, qd, qdd, Vector3(config_.gravity_world.template cast<Scalar>()),
+                    base, kinematics_segments_, static_);
   for (std::size_t k = 0; k < inputs_.size(); ++k) {
     const WrenchInput& input = inputs_[k];
     if (!input.needed || sensors_.segment(static_cast<int>(k)) >= 0) continue;  // sensors: below
@@ -311,8 +316,10 @@ void Estimator::computeLoads(const Model<Scalar>& model, Data<Scalar>& data, con
     return;
   }
   for (std::size_t k = 0; k < inputs_.size(); ++k)
-    if (sensors_.segment(static_cast<int>(k)) >= 0) sensors_.setUsed(static_cast<int>(k), !inputs_[k].samples.zeroed());
-  inverseDynamics(model, data, dynamics_segments_, [&](int i) { sensors_.atSegment(data, model, i, bank_); });
+    if (sensors_.segment(static_cast<int>(k)) >= 0)
+      sensors_.setUsed(static_cast<int>(k), !inputs_[k].samples.zeroed());
+  inverseDynamics(model, data, dynamics_segments_,
+                  [&](int i) { sensors_.atSegment(data, model, i, bank_); });
 }
 
 void Estimator::computeInFloat(const BaseState<double>& base_state) {
@@ -360,12 +367,13 @@ void Estimator::updateCovariance(const BaseState<double>& base_state) {
   // The kinematics in double: data_ itself, or a double pass beside the float one.
   const bool single = config_.precision == Precision::kFloat;
   if (single) loadsPass(cov_nominal_, base_state);
-  computeCovariance(covariance_model_, covariance_, model_, single ? cov_nominal_ : data_, gain, stamp_);
+  computeCovariance(covariance_model_, covariance_, model_, single ? cov_nominal_ : data_, gain,
+                    stamp_);
 }
 
 void Estimator::loadsPass(Data<double>& data, const BaseState<double>& base_state) {
-  forwardKinematics(model_, data, q_, qd_, qdd_, config_.gravity_world, base_state, kinematics_segments_,
-                    false);
+  forwardKinematics(model_, data, q_, qd_, qdd_, config_.gravity_world, base_state,
+                    kinematics_segments_, false);
   for (const WrenchInput& input : inputs_) {
     if (!input.needed) continue;
     const Wrench<double> w = filteredWrench(bank_, input.channel);
@@ -381,7 +389,8 @@ Wrench<double> Estimator::appliedWrench(int k) const {
 Wrench<double> Estimator::sensorResidual(int k) const { return sensors_.residual(k, data_); }
 
 double Estimator::effortVariance(int segment) const {
-  return jle::effortVariance(model_, covariance_.covariance[static_cast<std::size_t>(segment)], segment);
+  return jle::effortVariance(model_, covariance_.covariance[static_cast<std::size_t>(segment)],
+                             segment);
 }
 
 }  // namespace jle

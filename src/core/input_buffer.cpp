@@ -37,9 +37,7 @@ InputBuffer::Vector6 InputBuffer::interpolate(double t) const {
   return values_[ring(count_ - 1)];  // older than all we hold
 }
 
-bool InputBuffer::staleAt(double t) const {
-  return count_ == 0 || t - times_[ring(0)] > timeout_;
-}
+bool InputBuffer::staleAt(double t) const { return count_ == 0 || t - times_[ring(0)] > timeout_; }
 
 InputBuffer::Vector6 InputBuffer::valueAt(double t) const {
   if (zero_when_stale_ && staleAt(t)) return Vector6::Zero();

@@ -122,7 +122,8 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     : settings_(checkedSettings(model, settings)),
       frames_(frames),
       estimator_(model, settings_.estimator),
-      joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints)),
+      joints_(estimator_.model(),
+              publishedSegments(estimator_.model(), settings_.estimator.joints)),
       wrenches_(settings_.estimator.wrenches.size()),
       plates_(settings_.estimator.plates.size()),
       ring_(kRing) {
@@ -210,9 +211,9 @@ bool Pipeline::checkJointState(const std::vector<std::string>& names,
     const char *name, *plural;
     const std::vector<double>& values;
   };
-  const Field fields[] = {
-      {"position", "positions", position}, {"velocity", "velocities", velocity},
-      {"effort", "efforts", effort}};
+  const Field fields[] = {{"position", "positions", position},
+                          {"velocity", "velocities", velocity},
+                          {"effort", "efforts", effort}};
   for (const Field& field : fields) {
     const std::size_t size = field.values.size();
     if (size != n && (size != 0 || &field.values == &position)) {
@@ -394,7 +395,8 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   problem_.clear();
   const std::string& topic = settings_.wrenches.at(ix(k)).topic;
   if (!force.allFinite() || !torque.allFinite())
-    return fail(kind, Outcome::kInvalid, "wrench '" + topic + "': non-finite force or torque: dropped");
+    return fail(kind, Outcome::kInvalid,
+                "wrench '" + topic + "': non-finite force or torque: dropped");
   const std::string& configured = settings_.wrenches[ix(k)].frame;
   const std::string& frame = configured.empty() ? frame_id : configured;
   if (frame.empty())
@@ -409,11 +411,11 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   // The sensor's offset is in its own frame and sign: removed before anything else.
   const Eigen::Vector3d f = force - input.bias_force, m = torque - input.bias_torque;
   Eigen::Vector3d f_link, m_link;
-  wrenchInLink(input.X_link_frame.linear(), input.X_link_frame.translation(), f, m, f_link,
-               m_link);
+  wrenchInLink(input.X_link_frame.linear(), input.X_link_frame.translation(), f, m, f_link, m_link);
   if (!estimator_.addWrench(k, relative(stamp), f_link, m_link))
-    return fail(kind, Outcome::kOrder,
-                "wrench '" + topic + "': stamp " + seconds(stamp) + " not newer than the last: dropped");
+    return fail(
+        kind, Outcome::kOrder,
+        "wrench '" + topic + "': stamp " + seconds(stamp) + " not newer than the last: dropped");
   return count(kind, Outcome::kUsed);
 }
 
@@ -453,8 +455,9 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
   const PlateTopicSettings& configured = settings_.force_plates[ix(k)];
   const std::string& frame = configured.frame.empty() ? frame_id : configured.frame;
   if (frame.empty() && !configured.pose_configured)
-    return fail(kind, Outcome::kFrame,
-                "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
+    return fail(
+        kind, Outcome::kFrame,
+        "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
   if (stamp == 0) stamp = clock;
   checkTimeJump(stamp, clock);  // as for wrenches: a looping bag
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);

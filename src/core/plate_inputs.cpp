@@ -56,7 +56,8 @@ void PlateInputs::setPose(int k, const Eigen::Matrix3d& R_world_plate,
 
 void PlateInputs::setNeeded(const Model<double>& model, const std::vector<char>& dynamics) {
   for (Plate& p : plates_)
-    p.needed = dynamics[static_cast<std::size_t>(model.frames[static_cast<std::size_t>(p.frame)].segment)] != 0;
+    p.needed = dynamics[static_cast<std::size_t>(
+                   model.frames[static_cast<std::size_t>(p.frame)].segment)] != 0;
 }
 
 bool PlateInputs::updateContacts(double stamp) {

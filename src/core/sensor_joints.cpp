@@ -7,20 +7,23 @@
 
 namespace jle {
 
-SensorJoints::SensorJoints(int segments) : sensor_of_segment_(static_cast<std::size_t>(segments), -1) {}
+SensorJoints::SensorJoints(int segments)
+    : sensor_of_segment_(static_cast<std::size_t>(segments), -1) {}
 
 int SensorJoints::add(const Model<double>& model, const WrenchInputConfig& config, int channel) {
   Input input;
   input.channel = channel;
   if (!config.sensor_joint.empty()) {
-    const std::string what = "wrench input '" + config.name + "': sensor_joint '" + config.sensor_joint + "'";
+    const std::string what =
+        "wrench input '" + config.name + "': sensor_joint '" + config.sensor_joint + "'";
     int s = -1;
     try {
       s = model.segmentOfJoint(config.sensor_joint);
     } catch (const std::invalid_argument&) {
       throw std::invalid_argument(what + " is not a joint kept as a segment (keep_fixed_joints)");
     }
-    if (model.joint_type[s] != JointType::kFixed) throw std::invalid_argument(what + " is not a fixed joint");
+    if (model.joint_type[s] != JointType::kFixed)
+      throw std::invalid_argument(what + " is not a fixed joint");
     if (!config.link.empty() && config.link != model.link_name[s])
       throw std::invalid_argument(what + ": link must be its child link '" + model.link_name[s] +
                                   "', not '" + config.link + "'");

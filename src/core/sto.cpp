@@ -43,8 +43,8 @@ std::string plateName(const std::string& name, const std::string& plate,
 
 // J.effort, J.effort_per_kg, J.fx ... J.mz of a moving joint, or of a fixed one kept as a
 // segment (process_bag).
-std::string jointName(const Model<double>& model, const std::string& name,
-                      const std::string& joint, const std::string& suffix, WrenchFrame frame) {
+std::string jointName(const Model<double>& model, const std::string& name, const std::string& joint,
+                      const std::string& suffix, WrenchFrame frame) {
   int segment = -1;
   for (int s = 1; s < model.nsegments(); ++s)
     if (model.joint_name[s] == joint) segment = s;

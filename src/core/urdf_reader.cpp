@@ -31,9 +31,9 @@ struct LinkDesc {
   int line = 0;
   bool has_inertial = false;
   double mass = 0.0;
-  Pose inertial_origin;  // com frame in the link frame
+  Pose inertial_origin;               // com frame in the link frame
   Matrix3 inertia = Matrix3::Zero();  // about the com, in the inertial frame
-  std::vector<int> child_joints;  // document order
+  std::vector<int> child_joints;      // document order
   int parent_joint = -1;
 };
 
@@ -90,7 +90,8 @@ Vector3 vector3(const tinyxml2::XMLElement* e, const char* attribute, const std:
                 const Vector3& fallback) {
   const char* text = e->Attribute(attribute);
   if (!text) return fallback;
-  const std::vector<double> v = numbers(text, 3, what + " attribute '" + attribute + "'" + where(e));
+  const std::vector<double> v =
+      numbers(text, 3, what + " attribute '" + attribute + "'" + where(e));
   return Vector3(v[0], v[1], v[2]);
 }
 
@@ -101,10 +102,10 @@ Pose origin(const tinyxml2::XMLElement* parent, const std::string& what) {
   pose.p = vector3(e, "xyz", what + " origin", Vector3::Zero());
   const Vector3 rpy = vector3(e, "rpy", what + " origin", Vector3::Zero());
   // URDF: fixed-axis roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll).
-  pose.R = (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) *
-            Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
-            Eigen::AngleAxisd(rpy.x(), Vector3::UnitX()))
-               .toRotationMatrix();
+  pose.R =
+      (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
+       Eigen::AngleAxisd(rpy.x(), Vector3::UnitX()))
+          .toRotationMatrix();
   return pose;
 }
 
@@ -191,9 +192,8 @@ void checkInertia(const LinkDesc& link, double triangle_tolerance,
   }
   if (l[0] + l[1] < l[2] - tol) {
     std::ostringstream os;
-    os << what << ": inertia violates the triangle inequality (principal moments " << l[0]
-       << " + " << l[1] << " < " << l[2] << ", by " << 100.0 * (l[2] - l[0] - l[1]) / l[2]
-       << "%)";
+    os << what << ": inertia violates the triangle inequality (principal moments " << l[0] << " + "
+       << l[1] << " < " << l[2] << ", by " << 100.0 * (l[2] - l[0] - l[1]) / l[2] << "%)";
     if (l[0] + l[1] < l[2] * (1.0 - triangle_tolerance)) fail(os.str());
     warnings.push_back(os.str());
   }
@@ -270,9 +270,9 @@ struct Builder {
       const JointDesc& joint = joints[pending.joint];
       const int child = link_index.at(joint.child);
       const std::string what = "joint '" + joint.name + "'";
-      const bool keep = std::find(options.keep_fixed_joints.begin(),
-                                  options.keep_fixed_joints.end(),
-                                  joint.name) != options.keep_fixed_joints.end();
+      const bool keep =
+          std::find(options.keep_fixed_joints.begin(), options.keep_fixed_joints.end(),
+                    joint.name) != options.keep_fixed_joints.end();
       const Pose X = pending.X_segment_parent * joint.origin;
       if (joint.type == "fixed" && !keep) {
         place(child, pending.segment, X);
@@ -430,8 +430,8 @@ int rootLink(const Description& d) {
 // whether the root was left out so.
 bool buildTree(Builder& b, const Description& d, int root) {
   const LinkDesc& root_link = d.links[root];
-  const bool root_floats = root_link.child_joints.size() == 1 &&
-                           d.joints[root_link.child_joints[0]].type == "floating";
+  const bool root_floats =
+      root_link.child_joints.size() == 1 && d.joints[root_link.child_joints[0]].type == "floating";
   if (root_floats) {
     const JointDesc& j = d.joints[root_link.child_joints[0]];
     if (root_link.has_inertial && root_link.mass != 0.0)
@@ -460,8 +460,7 @@ void checkReached(const Builder& b, const Description& d, int root, bool root_le
     for (const Frame<double>& f : b.model.frames) seen = seen || f.name == l.name;
     if (!seen) names += (names.empty() ? "'" : ", '") + l.name + "'";
   }
-  fail("links " + names + " are not reachable from the root '" + root_link.name +
-       "' (a loop)");
+  fail("links " + names + " are not reachable from the root '" + root_link.name + "' (a loop)");
 }
 
 }  // namespace

@@ -103,10 +103,9 @@ void EstimatorNode::collectBiasSample() {
       BiasSample& sample = c.sample[i];
       sample.used = estimator.sensorUsed(input);
       if (sample.used)
-        sample.offset = readingOffset(wrench_topics_[k].residual,
-                                      settings_.estimator.wrenches[k].sign,
-                                      {pipeline_->sensorBiasForce(input),
-                                       pipeline_->sensorBiasTorque(input)});
+        sample.offset =
+            readingOffset(wrench_topics_[k].residual, settings_.estimator.wrenches[k].sign,
+                          {pipeline_->sensorBiasForce(input), pipeline_->sensorBiasTorque(input)});
     }
     if (c.estimator.add(estimator.stamp(), c.sample, estimator.qd(), c.needed))
       c.last_sample = ros::WallTime::now();
@@ -206,7 +205,8 @@ bool EstimatorNode::onCalibrateBias(joint_load_estimator::CalibrateBias::Request
 void EstimatorNode::startCalibration(double duration, bool assume_still) {
   const Model<double>& model = pipeline_->model();
   std::vector<std::string> sensors;
-  for (std::size_t k : sensor_topics_) sensors.push_back(settings_.estimator.wrenches[k].sensor_joint);
+  for (std::size_t k : sensor_topics_)
+    sensors.push_back(settings_.estimator.wrenches[k].sensor_joint);
   Calibration& c = calibration_;
   c.estimator = BiasEstimator(sensors, model.coordinate_names);
   c.estimator.start(duration, assume_still, settings_.still_velocity);

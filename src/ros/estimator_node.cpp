@@ -32,10 +32,11 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   updater_.add("joint loads", this, &EstimatorNode::diagnose);
   if (!sensor_topics_.empty() || model.floating_base)
     updater_.add("consistency", this, &EstimatorNode::diagnoseConsistency);
-  ROS_INFO("joint_load_estimator: %d segments, %d coordinates, %zu joints published, %zu wrench "
-           "inputs%s",
-           model.nsegments(), model.nq, pipeline_->record().joint.size(),
-           settings_.wrenches.size(), model.floating_base ? ", floating base" : "");
+  ROS_INFO(
+      "joint_load_estimator: %d segments, %d coordinates, %zu joints published, %zu wrench "
+      "inputs%s",
+      model.nsegments(), model.nq, pipeline_->record().joint.size(), settings_.wrenches.size(),
+      model.floating_base ? ", floating base" : "");
 }
 
 EstimatorNode::~EstimatorNode() {
@@ -51,7 +52,8 @@ Model<double> EstimatorNode::loadModel() {
   std::string urdf;
   const std::string param = nh_.resolveName(settings_.robot_description);
   if (!nh_.getParam(settings_.robot_description, urdf))
-    throw SettingsError("parameter '" + param + "' (robot_description) is not set or is not a string");
+    throw SettingsError("parameter '" + param +
+                        "' (robot_description) is not set or is not a string");
   try {
     Model<double> model = modelFromUrdfString(urdf, modelOptions(settings_));
     for (const std::string& w : model.warnings) ROS_WARN("robot model: %s", w.c_str());
@@ -88,14 +90,17 @@ void EstimatorNode::subscribe() {
       continue;
     }
     wrench_topics_[k].subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
-        topic, 100, [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onWrench(k, msg); },
+        topic, 100,
+        [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onWrench(k, msg); },
         ros::VoidConstPtr(), hints);
   }
   for (std::size_t k = 0; k < plate_topics_.size(); ++k) {
     if (!estimator.plateNeeded(static_cast<int>(k))) {
-      ROS_INFO("force plate '%s' under link '%s' affects none of the published joints: not "
-               "subscribed", settings_.estimator.plates[k].plate.name.c_str(),
-               settings_.estimator.plates[k].plate.link.c_str());
+      ROS_INFO(
+          "force plate '%s' under link '%s' affects none of the published joints: not "
+          "subscribed",
+          settings_.estimator.plates[k].plate.name.c_str(),
+          settings_.estimator.plates[k].plate.link.c_str());
       continue;
     }
     plate_topics_[k].subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
@@ -103,8 +108,8 @@ void EstimatorNode::subscribe() {
         [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onPlate(k, msg); },
         ros::VoidConstPtr(), hints);
   }
-  joint_sub_ = nh_.subscribe(settings_.joint_states_topic, 100, &EstimatorNode::onJointState, this,
-                             hints);
+  joint_sub_ =
+      nh_.subscribe(settings_.joint_states_topic, 100, &EstimatorNode::onJointState, this, hints);
 }
 
 void EstimatorNode::report(Outcome outcome) {

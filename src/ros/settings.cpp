@@ -29,7 +29,8 @@ std::string typeName(const XmlRpcValue& v) {
 
 // The number `v` (an integer or a double) of parameter `key`.
 double toNumber(const XmlRpcValue& v, const std::string& key) {
-  if (v.getType() == XmlRpcValue::TypeDouble) return static_cast<double>(const_cast<XmlRpcValue&>(v));
+  if (v.getType() == XmlRpcValue::TypeDouble)
+    return static_cast<double>(const_cast<XmlRpcValue&>(v));
   if (v.getType() == XmlRpcValue::TypeInt) return static_cast<int>(const_cast<XmlRpcValue&>(v));
   wrongType(key, v, "a number");
 }
@@ -63,7 +64,9 @@ class Section {
   void read(const std::string& key, double& out) {
     if (has(key)) out = toNumber(get(key), name(key));
   }
-  void read(const std::string& key, int& out) { readScalar(key, out, XmlRpcValue::TypeInt, "an integer"); }
+  void read(const std::string& key, int& out) {
+    readScalar(key, out, XmlRpcValue::TypeInt, "an integer");
+  }
   void read(const std::string& key, bool& out) {
     readScalar(key, out, XmlRpcValue::TypeBoolean, "true or false");
   }
@@ -110,7 +113,8 @@ class Section {
       }
       names += std::string(names.empty() ? "" : ", ") + o.first;
     }
-    throw SettingsError("parameter '" + name(key) + "' is '" + text + "'; expected one of " + names);
+    throw SettingsError("parameter '" + name(key) + "' is '" + text + "'; expected one of " +
+                        names);
   }
   // The map `key` read by `each(Section&)`, then checked for unknown keys.
   template <typename Each>
@@ -187,7 +191,8 @@ void readSavings(Section& s, Savings& v) {
                 {"gyroscopic", &v.gyroscopic},
                 {"reuse_unchanged", &v.reuse_unchanged},
                 {"republish_unchanged", &v.republish_unchanged}});
-  s.read<double>({{"static_velocity", &v.static_velocity}, {"static_acceleration", &v.static_acceleration}});
+  s.read<double>(
+      {{"static_velocity", &v.static_velocity}, {"static_acceleration", &v.static_acceleration}});
   // rosparam reads YAML 1.1, where a bare on/off is a boolean: take it as meant.
   if (s.has("planar") && s.get("planar").getType() == XmlRpcValue::TypeBoolean) {
     bool planar = false;
@@ -309,7 +314,8 @@ Settings parseSettings(const XmlRpcValue& params) {
   readTopLevel(s, n);
   s.readMap("savings", [&](Section& m) { readSavings(m, n.estimator.savings); });
   s.readMap("uncertainty", [&](Section& m) { readUncertainty(m, n.estimator.uncertainty); });
-  s.readMap("differentiator", [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });
+  s.readMap("differentiator",
+            [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });
   s.readList("wrenches", [&](Section& m) {
     readWrench(m, n.wrenches.emplace_back(), n.estimator.wrenches.emplace_back());
   });

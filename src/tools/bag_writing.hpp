@@ -37,8 +37,7 @@ inline void setWrench(geometry_msgs::WrenchStamped& msg, const Eigen::Vector3d& 
 /// removed if commit() is never reached (an error, an exception).
 class PartialBag {
  public:
-  explicit PartialBag(std::string path)
-      : path_(std::move(path)), temporary_(path_ + ".partial") {
+  explicit PartialBag(std::string path) : path_(std::move(path)), temporary_(path_ + ".partial") {
     try {
       bag_.open(temporary_, rosbag::bagmode::Write);
     } catch (...) {

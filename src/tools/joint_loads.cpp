@@ -130,8 +130,9 @@ jle::WrenchFrame parseFrame(const std::string& text) {
 // NAME=LINK,x,y,z[,yaw_deg]: a plate frame (z up) at (x, y, z) in the world, turned by
 // yaw about the world z axis.
 jle::ForcePlateConfig parsePlate(const std::string& text) {
-  const std::string what =
-      "--plate: '" + text + "' is not NAME=LINK,X,Y,Z[,YAW_DEG] (NAME and LINK without '=', ',', '.' or blanks; finite numbers)";
+  const std::string what = "--plate: '" + text +
+                           "' is not NAME=LINK,X,Y,Z[,YAW_DEG] (NAME and LINK without '=', ',', "
+                           "'.' or blanks; finite numbers)";
   const std::size_t eq = text.find('=');
   if (eq == std::string::npos || eq == 0) throw UsageError(what);
   const std::size_t comma = text.find(',', eq + 1);
@@ -178,7 +179,8 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
     if (text.empty()) throw UsageError("--plate: empty value");
     jle::ForcePlateConfig plate = parsePlate(text);
     for (const jle::ForcePlateConfig& other : plates)
-      if (other.name == plate.name) throw UsageError("--plate: plate '" + plate.name + "' is given twice");
+      if (other.name == plate.name)
+        throw UsageError("--plate: plate '" + plate.name + "' is given twice");
     plate.contact_threshold = contact_threshold;
     plates.push_back(plate);
   }
@@ -189,11 +191,11 @@ Options parseOptions(int argc, char** argv) {
   std::vector<std::string> plates;
   std::vector<char*> rest;
   takePlateOptions(argc, argv, plates, rest);
-  std::map<std::string, std::string> v = optionValues(
-      static_cast<int>(rest.size()), rest.data(),
-      {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
-       "--body-mass", "--format"},
-      {"--floating-base", "--per-kg"});
+  std::map<std::string, std::string> v =
+      optionValues(static_cast<int>(rest.size()), rest.data(),
+                   {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
+                    "--body-mass", "--format"},
+                   {"--floating-base", "--per-kg"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   options.input = requiredValue(v, "--input", "STATES.csv");
@@ -236,8 +238,10 @@ class Output {
       csv_->writeRow(values.data(), values.size());
   }
   void commit() {
-    if (sto_) sto_->commit();
-    else csv_->commit();
+    if (sto_)
+      sto_->commit();
+    else
+      csv_->commit();
   }
 
  private:
@@ -272,8 +276,8 @@ void readBasePose(const jle::CsvReader& reader, const jle::StateColumns& columns
   Eigen::Quaterniond q(x[c[6]], x[c[3]], x[c[4]], x[c[5]]);
   const double norm = q.norm();
   if (!(std::abs(norm - 1.0) <= 0.01))
-    reader.failAt(c[6], "the quaternion (base.qx, .qy, .qz, .qw) has norm " +
-                            std::to_string(norm) + ", not 1 (within 1 %)");
+    reader.failAt(c[6], "the quaternion (base.qx, .qy, .qz, .qw) has norm " + std::to_string(norm) +
+                            ", not 1 (within 1 %)");
   q.coeffs() /= norm;
   row.pose.R_world_base = q.toRotationMatrix();
 }
@@ -283,8 +287,8 @@ void readBasePose(const jle::CsvReader& reader, const jle::StateColumns& columns
 // next one is read (the first two with the third, the last at the end).
 class Processor {
  public:
-  Processor(const Options& options, const jle::Model<double>& model, const jle::StateColumns& columns,
-            std::size_t cells)
+  Processor(const Options& options, const jle::Model<double>& model,
+            const jle::StateColumns& columns, std::size_t cells)
       : options_(options),
         model_(model),
         columns_(columns),

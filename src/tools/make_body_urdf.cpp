@@ -103,15 +103,15 @@ constexpr SegmentTable kHat{0.678, 0.626, 0.496, 16.9 / 32.8};
 
 // Drillis, R. & Contini, R. (1966), "Body segment parameters", Report 1166-03, New York
 // University, as drawn in Winter (2009) Fig. 4.1: lengths as fractions of height H.
-constexpr double kThighLength = 0.245;    // Fig. 4.1 thigh (hip 0.530 H - knee 0.285 H)
-constexpr double kShankLength = 0.246;    // Fig. 4.1 leg (knee 0.285 H - ankle 0.039 H)
-constexpr double kAnkleHeight = 0.039;    // Fig. 4.1 ankle height above the floor
-constexpr double kFootLength = 0.152;     // Fig. 4.1 foot length
-constexpr double kFootWidth = 0.055;      // Fig. 4.1 foot width (drawing only)
-constexpr double kHipWidth = 0.191;       // Fig. 4.1 hip width (see A4)
-constexpr double kHatLength = 0.288;      // Fig. 4.1 shoulder 0.818 H - hip 0.530 H
-constexpr double kShoulderWidth = 0.259;  // Fig. 4.1 shoulder width (drawing only)
-constexpr double kChinHeight = 0.870;     // Fig. 4.1 chin height (drawing only)
+constexpr double kThighLength = 0.245;     // Fig. 4.1 thigh (hip 0.530 H - knee 0.285 H)
+constexpr double kShankLength = 0.246;     // Fig. 4.1 leg (knee 0.285 H - ankle 0.039 H)
+constexpr double kAnkleHeight = 0.039;     // Fig. 4.1 ankle height above the floor
+constexpr double kFootLength = 0.152;      // Fig. 4.1 foot length
+constexpr double kFootWidth = 0.055;       // Fig. 4.1 foot width (drawing only)
+constexpr double kHipWidth = 0.191;        // Fig. 4.1 hip width (see A4)
+constexpr double kHatLength = 0.288;       // Fig. 4.1 shoulder 0.818 H - hip 0.530 H
+constexpr double kShoulderWidth = 0.259;   // Fig. 4.1 shoulder width (drawing only)
+constexpr double kChinHeight = 0.870;      // Fig. 4.1 chin height (drawing only)
 constexpr double kShoulderHeight = 0.818;  // Fig. 4.1 shoulder height (drawing only)
 
 // A3. Winter places the ankle only by its height; the foot's plan is ours: the heel
@@ -145,8 +145,8 @@ constexpr Range kAnkleFlexion{-50.0, 20.0};
 constexpr Range kSubtalarInversion{-15.0, 35.0};
 // URDF requires effort and velocity limits; these bound nothing a human does (they are
 // not a strength model) so that no tool clips a computed load.
-constexpr double kEffortLimit = 2000.0;   // N m
-constexpr double kVelocityLimit = 30.0;   // rad/s
+constexpr double kEffortLimit = 2000.0;  // N m
+constexpr double kVelocityLimit = 30.0;  // rad/s
 
 // ----------------------------------------------------------------------- the options
 
@@ -160,11 +160,11 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v = optionValues(
-      argc, argv,
-      {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
-       "--foot-height", "--pelvis-width", "--hat-length", "--name", "--output"},
-      {"--subtalar"});
+  std::map<std::string, std::string> v =
+      optionValues(argc, argv,
+                   {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
+                    "--foot-height", "--pelvis-width", "--hat-length", "--name", "--output"},
+                   {"--subtalar"});
   const std::string mass = requiredValue(v, "--mass", "KG");
   const std::string height = requiredValue(v, "--height", "M");
   Options o;
@@ -192,9 +192,8 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--output")) o.output = v["--output"];
   // The header comment repeats the options (not the output path), in a fixed order.
   o.command = "make_body_urdf";
-  for (const char* key : {"--mass", "--height", "--thigh-length", "--shank-length",
-                          "--foot-length", "--foot-height", "--pelvis-width", "--hat-length",
-                          "--name"})
+  for (const char* key : {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
+                          "--foot-height", "--pelvis-width", "--hat-length", "--name"})
     if (v.count(key)) o.command += std::string(" ") + key + " " + v[key];
   if (o.subtalar) o.command += " --subtalar";
   return o;
@@ -336,8 +335,8 @@ void writeLeg(UrdfText& u, const Options& o, const Body& b, const std::string& s
   u.visual(Vector3d(0.0, 0.0, -0.5 * o.thigh_length),
            cylinder(drawingRadius(b.m_thigh, o.thigh_length), o.thigh_length), "skin");
   u.line("  </link>");
-  u.revolute("knee_flexion_" + s, "femur_" + s, "tibia_" + s,
-             Vector3d(0.0, 0.0, -o.thigh_length), plus_y, kKneeFlexion);
+  u.revolute("knee_flexion_" + s, "femur_" + s, "tibia_" + s, Vector3d(0.0, 0.0, -o.thigh_length),
+             plus_y, kKneeFlexion);
 
   u.line("  <link name=\"tibia_" + s + "\">");
   u.inertial(b.m_shank, b.com_shank, b.i_shank);
@@ -351,8 +350,8 @@ void writeLeg(UrdfText& u, const Options& o, const Body& b, const std::string& s
     // inversion moment in the anatomical sense.
     u.revolute("ankle_flexion_" + s, "tibia_" + s, "talus_" + s, ankle, minus_y, kAnkleFlexion);
     u.emptyLink("talus_" + s);
-    u.revolute("subtalar_inversion_" + s, "talus_" + s, "foot_" + s, Vector3d::Zero(),
-               mirrored_x, kSubtalarInversion);
+    u.revolute("subtalar_inversion_" + s, "talus_" + s, "foot_" + s, Vector3d::Zero(), mirrored_x,
+               kSubtalarInversion);
   } else {
     u.revolute("ankle_flexion_" + s, "tibia_" + s, "foot_" + s, ankle, minus_y, kAnkleFlexion);
   }
@@ -392,8 +391,8 @@ std::string makeUrdf(const Options& o) {
   u.inertial(b.m_hat, b.com_hat, b.i_hat);
   const double h = o.height;
   // Drawing only: a pelvis block across the hips, the trunk up to the shoulders, a head.
-  u.visual(Vector3d(0.0, 0.0, 0.05 * h),
-           box(Vector3d(0.1 * h, o.pelvis_width + 0.05 * h, 0.1 * h)), "cloth");
+  u.visual(Vector3d(0.0, 0.0, 0.05 * h), box(Vector3d(0.1 * h, o.pelvis_width + 0.05 * h, 0.1 * h)),
+           "cloth");
   u.visual(Vector3d(0.0, 0.0, 0.5 * (0.1 * h + o.hat_length)),
            box(Vector3d(0.11 * h, 0.8 * kShoulderWidth * h, o.hat_length - 0.1 * h)), "cloth");
   const double head_radius = 0.5 * (1.0 - kChinHeight) * h;
@@ -414,8 +413,7 @@ std::string errnoText() { return std::strerror(errno); }
 // Standard output, or a temporary file beside `path` renamed onto it once complete.
 void writeOutput(const std::string& path, const std::string& text) {
   if (path.empty()) {
-    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() ||
-        std::fflush(stdout) != 0)
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
       throw std::runtime_error("standard output: cannot write: " + errnoText());
     return;
   }

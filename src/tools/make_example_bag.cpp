@@ -122,7 +122,8 @@ Options parseOptions(int argc, char** argv) {
     options.samples = std::max(1LL, std::llround(options.duration * options.rate));
   }
   if (v.count("--seed"))
-    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
+    options.seed =
+        static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;
 }
 
@@ -241,8 +242,8 @@ sensor_msgs::JointState jointStateMessage(const jle::Model<double>& model, bool 
   return joints;
 }
 
-void fillJointState(const jle::Model<double>& model, const jle::Data<double>& data,
-                    long long i, const ros::Time& stamp, sensor_msgs::JointState& joints) {
+void fillJointState(const jle::Model<double>& model, const jle::Data<double>& data, long long i,
+                    const ros::Time& stamp, sensor_msgs::JointState& joints) {
   joints.header.stamp = stamp;
   joints.header.seq = static_cast<std::uint32_t>(i);
   for (std::size_t j = 0; j < model.moving_segments.size(); ++j) {

@@ -120,29 +120,30 @@ constexpr std::int64_t kEpochNs = 1000000000000LL;  // t0 = 1000 s
 constexpr double kGravity = 9.80665;
 
 // The trial's parameters (kUsage).
-constexpr double kSpeed = 1.2;           // [m/s]
-constexpr double kStride = 1.1;          // [s]
-constexpr double kStartPhase = 0.3;      // the trial starts at 30 % of the right cycle
-constexpr double kHeelRocker = 0.10;     // end of the heel rocker, fraction of T
-constexpr double kHeelOff = 0.35;        // start of the toe rocker
-constexpr double kToeOff = 0.60;         // end of stance
+constexpr double kSpeed = 1.2;        // [m/s]
+constexpr double kStride = 1.1;       // [s]
+constexpr double kStartPhase = 0.3;   // the trial starts at 30 % of the right cycle
+constexpr double kHeelRocker = 0.10;  // end of the heel rocker, fraction of T
+constexpr double kHeelOff = 0.35;     // start of the toe rocker
+constexpr double kToeOff = 0.60;      // end of stance
 constexpr double kHeelStrikePitch = 15.0 * kPi / 180.0;  // toe up at heel strike
 constexpr double kToeOffPitch = -50.0 * kPi / 180.0;     // heel up at toe off
 constexpr double kToeOut = 5.0 * kPi / 180.0;
-constexpr double kClearance = 0.05;      // [m] heel lift in mid-swing
-constexpr double kPelvisDrop = 0.06;     // [m] mean pelvis height below standing
-constexpr double kHeelAhead = 0.20;      // [m] heel ahead of the hip at heel strike
+constexpr double kClearance = 0.05;   // [m] heel lift in mid-swing
+constexpr double kPelvisDrop = 0.06;  // [m] mean pelvis height below standing
+constexpr double kHeelAhead = 0.20;   // [m] heel ahead of the hip at heel strike
 constexpr double kSwayX = 0.016;
-constexpr double kSwayY = 0.03;          // [m] lateral sway (amplitude of y)
-constexpr double kStepWidthRatio = 0.6;  // footprint y / standing heel y         // [m] forward speed modulation (amplitude of x)
-constexpr double kJointRate = 200.0;     // [Hz]
-constexpr int kPlateDivisor = 5;         // plate samples per joint sample (1 kHz)
-constexpr int kDisplayDivisor = 10;      // plate samples per display sample (100 Hz)
-constexpr double kLaneWidth = 0.4;       // [m] each plate's width (y)
-constexpr int kHarmonics = 20;           // of the pelvis path's correction (18 Hz)
-constexpr double kCopArrival = 0.45;     // the centre of pressure reaches the toe (of T)
-constexpr int kPelvisIterations = 12;    // of solvePelvis
-constexpr double kRelaxation = 0.7;      // of its steps
+constexpr double kSwayY = 0.03;  // [m] lateral sway (amplitude of y)
+constexpr double kStepWidthRatio =
+    0.6;  // footprint y / standing heel y         // [m] forward speed modulation (amplitude of x)
+constexpr double kJointRate = 200.0;   // [Hz]
+constexpr int kPlateDivisor = 5;       // plate samples per joint sample (1 kHz)
+constexpr int kDisplayDivisor = 10;    // plate samples per display sample (100 Hz)
+constexpr double kLaneWidth = 0.4;     // [m] each plate's width (y)
+constexpr int kHarmonics = 20;         // of the pelvis path's correction (18 Hz)
+constexpr double kCopArrival = 0.45;   // the centre of pressure reaches the toe (of T)
+constexpr int kPelvisIterations = 12;  // of solvePelvis
+constexpr double kRelaxation = 0.7;    // of its steps
 
 struct Options {
   std::string urdf, output;
@@ -153,8 +154,8 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v = optionValues(
-      argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
+  std::map<std::string, std::string> v =
+      optionValues(argc, argv, {"--urdf", "--output", "--csv", "--strides", "--noise", "--seed"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "BODY.urdf");
   options.output = requiredValue(v, "--output", "OUT.bag");
@@ -163,7 +164,8 @@ Options parseOptions(int argc, char** argv) {
     options.strides = static_cast<int>(parseInteger("--strides", v["--strides"], 1, 100));
   if (v.count("--noise")) options.noise = parseNumber("--noise", v["--noise"], Sign::kNonNegative);
   if (v.count("--seed"))
-    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
+    options.seed =
+        static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;
 }
 
@@ -211,9 +213,9 @@ struct Pelvis {
                               -kSwayY * std::cos(w * c) + d.y(), z0 + 0.02 * std::cos(w2 * c));
     b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c) + d1.x(),
                          kSwayY * w * std::sin(w * c) + d1.y(), -0.02 * w2 * std::sin(w2 * c));
-    b.a_world = Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c) + d2.x(),
-                         kSwayY * w * w * std::cos(w * c) + d2.y(),
-                         -0.02 * w2 * w2 * std::cos(w2 * c));
+    b.a_world =
+        Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c) + d2.x(),
+                 kSwayY * w * w * std::cos(w * c) + d2.y(), -0.02 * w2 * w2 * std::cos(w2 * c));
     const double yaw = 0.07 * std::cos(w * g), yaw_d = -0.07 * w * std::sin(w * g),
                  yaw_dd = -0.07 * w * w * std::cos(w * g);
     const double roll = -0.05 * std::sin(w * g), roll_d = -0.05 * w * std::cos(w * g),
@@ -232,12 +234,12 @@ struct Pelvis {
 // A leg's coordinates and sole frames.
 struct Leg {
   char side = 'r';
-  double y_sign = -1.0;            // -1 right, +1 left
-  double strike_offset = 0.0;      // gait time of its first heel strike in the cycle [s]
+  double y_sign = -1.0;        // -1 right, +1 left
+  double strike_offset = 0.0;  // gait time of its first heel strike in the cycle [s]
   std::array<int, 5> coordinate{};
-  int heel = 0, toe = 0;           // frame indices
-  double y_footprint = 0.0;        // [m] heel's y at standing (footprints' lateral place)
-  double foot_length = 0.0;        // [m] heel to toe
+  int heel = 0, toe = 0;     // frame indices
+  double y_footprint = 0.0;  // [m] heel's y at standing (footprints' lateral place)
+  double foot_length = 0.0;  // [m] heel to toe
 };
 
 // Heel and toe points of a leg at gait time g, and whether it is in stance; also the
@@ -422,8 +424,8 @@ Eigen::Vector2d plannedCop(const std::array<FootState, 2>& feet) {
 void fivePoint(const std::vector<jle::VectorX<double>>& grid, std::size_t c, double h,
                jle::VectorX<double>& qd, jle::VectorX<double>& qdd) {
   for (int j = 0; j < qd.size(); ++j) {
-    const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j],
-                 p2 = grid[c + 2][j], z = grid[c][j];
+    const double m2 = grid[c - 2][j], m1 = grid[c - 1][j], p1 = grid[c + 1][j], p2 = grid[c + 2][j],
+                 z = grid[c][j];
     qd[j] = (m2 - 8.0 * m1 + 8.0 * p1 - p2) / (12.0 * h);
     qdd[j] = (-m2 + 16.0 * m1 - 30.0 * z + 16.0 * p1 - p2) / (12.0 * h * h);
   }
@@ -433,8 +435,8 @@ void fivePoint(const std::vector<jle::VectorX<double>>& grid, std::size_t c, dou
 // inverse dynamics): force F [N] and moment M [N m] in world axes, about the world origin.
 void pelvisWrench(const jle::Model<double>& model, jle::Data<double>& data,
                   const jle::VectorX<double>& q, const jle::VectorX<double>& qd,
-                  const jle::VectorX<double>& qdd, const jle::BaseState<double>& base,
-                  Vector3d& F, Vector3d& M) {
+                  const jle::VectorX<double>& qdd, const jle::BaseState<double>& base, Vector3d& F,
+                  Vector3d& M) {
   jle::forwardKinematics(model, data, q, qd, qdd, Vector3d(0.0, 0.0, -kGravity), base);
   jle::inverseDynamics(model, data);
   F = base.R_world_base * data.force[0];
@@ -567,8 +569,8 @@ struct Trial {
   double cop_error = 0.0;  // [m] solvePelvis's
 };
 
-Trial planTrial(const jle::Model<double>& model, jle::Data<double>& data,
-                const std::string& urdf, jle::VectorX<double>& q) {
+Trial planTrial(const jle::Model<double>& model, jle::Data<double>& data, const std::string& urdf,
+                jle::VectorX<double>& q) {
   Trial trial;
   trial.legs = findLegs(model, urdf);
   const double sole = measureFeet(model, data, trial.legs, urdf);
@@ -613,7 +615,8 @@ Grid solveGrid(const jle::Model<double>& model, jle::Data<double>& data, const T
     grid.q.push_back(q);
   }
   if (grid.ik_error > 1e-6)
-    throw std::runtime_error(urdf + ": the legs cannot follow the trial (the inverse "
+    throw std::runtime_error(urdf +
+                             ": the legs cannot follow the trial (the inverse "
                              "kinematics misses the feet by " +
                              std::to_string(grid.ik_error) + " m)");
   return grid;
@@ -692,13 +695,15 @@ void placeSingleSupport(const std::array<FootState, 2>& feet, Reaction& r, Figur
 // between the feet, checked: the two shares make the whole wrench.
 Reaction groundReaction(const jle::Model<double>& model, jle::Data<double>& data,
                         const Trial& trial, const jle::VectorX<double>& q,
-                        const jle::VectorX<double>& qd, const jle::VectorX<double>& qdd,
-                        double g, Figures& figures) {
+                        const jle::VectorX<double>& qd, const jle::VectorX<double>& qdd, double g,
+                        Figures& figures) {
   Reaction r;
   pelvisWrench(model, data, q, qd, qdd, trial.pelvis.at(g), r.F, r.M);
   if (!(r.F.z() > 0.0))
-    throw std::runtime_error("the trial needs the body pulled down (vertical ground "
-                             "reaction " + std::to_string(r.F.z()) + " N)");
+    throw std::runtime_error(
+        "the trial needs the body pulled down (vertical ground "
+        "reaction " +
+        std::to_string(r.F.z()) + " N)");
   r.cop = Vector3d(-r.M.y() / r.F.z(), r.M.x() / r.F.z(), 0.0);
   r.free_moment = r.M.z() - (r.cop.x() * r.F.y() - r.cop.y() * r.F.x());
   const std::array<FootState, 2> feet = {trial.gait.at(trial.legs[0], g),
@@ -722,7 +727,10 @@ Reaction groundReaction(const jle::Model<double>& model, jle::Data<double>& data
 class TrialWriter {
  public:
   TrialWriter(const jle::Model<double>& model, const Options& options, const Plates& plates)
-      : model_(model), options_(options), plates_(plates), random_(options.seed),
+      : model_(model),
+        options_(options),
+        plates_(plates),
+        random_(options.seed),
         bag_(options.output) {
     joints_.name = model.coordinate_names;
     joints_.position.resize(joints_.name.size());
@@ -829,7 +837,8 @@ class TrialWriter {
                            Vector3d(0, 0, r.share[i].free_moment));
     }
     bag_.bag().write("/tf", early, cop_msg_);
-    for (std::size_t i = 0; i < 2; ++i) bag_.bag().write(reaction_topic_[i], stamp, reaction_msg_[i]);
+    for (std::size_t i = 0; i < 2; ++i)
+      bag_.bag().write(reaction_topic_[i], stamp, reaction_msg_[i]);
   }
 
   // t, J.q, J.qd, J.qdd, base.x .. base.alz, plate@plate1.fx .. plate@plate2.mz.
@@ -871,28 +880,33 @@ class TrialWriter {
 void printReport(const jle::Model<double>& model, const Options& options, const Trial& trial,
                  const Grid& grid, const Plates& plates, const Figures& figures) {
   const double weight = model.totalMass() * kGravity;
-  std::printf("make_gait_bag: %d strides, %.3f s, %lld joint states (200 Hz), %lld plate "
-              "samples per plate (1 kHz) -> %s\n",
-              options.strides, static_cast<double>(grid.samples) * grid.h,
-              (grid.samples + 4) / 5, grid.samples, options.output.c_str());
-  std::printf("  body %.2f kg (weight %.1f N); plates %.1f m x %.1f m, centres x %.3f m, "
-              "y -/+%.2f m\n",
-              model.totalMass(), weight, plates.length, kLaneWidth, plates.x_centre,
-              0.5 * kLaneWidth);
-  std::printf("  joint_loads: --plate plate1=foot_r,%.3f,%.3f,0 --plate plate2=foot_l,%.3f,%.3f,0\n",
-              plates.x_centre, -0.5 * kLaneWidth, plates.x_centre, 0.5 * kLaneWidth);
+  std::printf(
+      "make_gait_bag: %d strides, %.3f s, %lld joint states (200 Hz), %lld plate "
+      "samples per plate (1 kHz) -> %s\n",
+      options.strides, static_cast<double>(grid.samples) * grid.h, (grid.samples + 4) / 5,
+      grid.samples, options.output.c_str());
+  std::printf(
+      "  body %.2f kg (weight %.1f N); plates %.1f m x %.1f m, centres x %.3f m, "
+      "y -/+%.2f m\n",
+      model.totalMass(), weight, plates.length, kLaneWidth, plates.x_centre, 0.5 * kLaneWidth);
+  std::printf(
+      "  joint_loads: --plate plate1=foot_r,%.3f,%.3f,0 --plate plate2=foot_l,%.3f,%.3f,0\n",
+      plates.x_centre, -0.5 * kLaneWidth, plates.x_centre, 0.5 * kLaneWidth);
   std::printf("  vertical ground reaction: peak %.2f BW (both feet), %.2f BW (one foot)\n",
               figures.peak_fz / weight, figures.peak_fz_foot / weight);
-  std::printf("  single support: centre of pressure from %.2f to %.2f of heel->toe, up to "
-              "%.3f m beside that line\n",
-              figures.cop_min, figures.cop_max, figures.cop_side);
-  std::printf("  double support: each foot's centre of pressure within %.3f m of its heel "
-              "(leading) or toe (trailing)\n",
-              figures.cop_shift);
+  std::printf(
+      "  single support: centre of pressure from %.2f to %.2f of heel->toe, up to "
+      "%.3f m beside that line\n",
+      figures.cop_min, figures.cop_max, figures.cop_side);
+  std::printf(
+      "  double support: each foot's centre of pressure within %.3f m of its heel "
+      "(leading) or toe (trailing)\n",
+      figures.cop_shift);
   std::printf("  centre of pressure: planned path missed by %.3f m at most\n", trial.cop_error);
-  std::printf("  inverse kinematics error %.1e m, split error %.1e, lowest toe in mid-swing "
-              "%.3f m\n",
-              grid.ik_error, figures.max_residual_split, grid.min_toe);
+  std::printf(
+      "  inverse kinematics error %.1e m, split error %.1e, lowest toe in mid-swing "
+      "%.3f m\n",
+      grid.ik_error, figures.max_residual_split, grid.min_toe);
   for (const Leg& leg : trial.legs)
     for (int j : leg.coordinate)
       std::printf("  %-18s %7.1f .. %6.1f deg\n",

@@ -1,8 +1,8 @@
 // make_trajectory: a deterministic analytic joint-state CSV (and optionally an applied
 // wrench) for joint_loads. The formula is in kUsage and docs/joint_loads.md.
-#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/csv.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <cmath>
@@ -79,7 +79,8 @@ Options parseOptions(int argc, char** argv) {
   if (!(options.rate > 0.0)) throw UsageError("--rate: must be > 0");
   if (options.duration * options.rate > 1e9) throw UsageError("--duration * --rate: over 1e9 rows");
   if (v.count("--seed"))
-    options.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
+    options.seed =
+        static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
   return options;
 }
 

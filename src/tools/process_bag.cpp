@@ -2,8 +2,8 @@
 // settings file and the same message path (jle::Pipeline, through the node's own message
 // conversions), in the bag's time order, with the bag's /tf and /tf_static in a tf2
 // buffer for the frames the URDF does not hold. docs/demo.md.
-#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/JointLoads.h>
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
@@ -270,7 +270,7 @@ class BagProcessor {
   std::unique_ptr<Outputs> outputs_;
   std::string joint_topic_;
   std::vector<std::string> wrench_topics_, plate_topics_;  // settings order
-  bool have_tf_ = false;  // the bag has /tf or /tf_static
+  bool have_tf_ = false;                                   // the bag has /tf or /tf_static
   ReuseBuffer buffer_;
   sensor_msgs::JointState joint_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
@@ -312,7 +312,8 @@ void BagProcessor::run() {
     }
   }
   if (progress_shown) std::fputc('\n', stderr);
-  if (pipeline_.counters().count(jle::Outcome::kPublished) == 0) throw std::runtime_error(noLoads());
+  if (pipeline_.counters().count(jle::Outcome::kPublished) == 0)
+    throw std::runtime_error(noLoads());
   outputs_->commit();
   summarize(std::chrono::duration<double>(Clock::now() - start).count());
 }
@@ -403,18 +404,22 @@ void BagProcessor::checkTopics(const rosbag::Bag& in, rosbag::View& view) {
       seen[c->topic] = c->datatype;
     std::string all;
     for (const auto& t : seen) all += (all.empty() ? "" : ", ") + t.first + " (" + t.second + ")";
-    throw std::runtime_error(options_.bag + ": no messages on the joint states topic '" +
-                             joint_topic_ + "' (parameter joint_states_topic); the bag has: " +
-                             (all.empty() ? "nothing" : all));
+    throw std::runtime_error(
+        options_.bag + ": no messages on the joint states topic '" + joint_topic_ +
+        "' (parameter joint_states_topic); the bag has: " + (all.empty() ? "nothing" : all));
   }
   for (const std::string& w : wrench_topics_)
     if (!present.count(w))
-      std::fprintf(stderr, "process_bag: warning: no messages on wrench topic '%s' in %s: the loads "
-                   "are computed without it\n", w.c_str(), options_.bag.c_str());
+      std::fprintf(stderr,
+                   "process_bag: warning: no messages on wrench topic '%s' in %s: the loads "
+                   "are computed without it\n",
+                   w.c_str(), options_.bag.c_str());
   for (const std::string& p : plate_topics_)
     if (!present.count(p))
-      std::fprintf(stderr, "process_bag: warning: no messages on force plate topic '%s' in %s: the "
-                   "loads are computed without it\n", p.c_str(), options_.bag.c_str());
+      std::fprintf(stderr,
+                   "process_bag: warning: no messages on force plate topic '%s' in %s: the "
+                   "loads are computed without it\n",
+                   p.c_str(), options_.bag.c_str());
 }
 
 void BagProcessor::summarize(double total_s) const {
@@ -422,15 +427,14 @@ void BagProcessor::summarize(double total_s) const {
   const double compute_s = std::chrono::duration<double>(compute_).count();
   const long joint_states = c.received(jle::InputKind::kJointState);
   const double samples = static_cast<double>(joint_states);
-  std::fprintf(stderr,
-               "process_bag: %ld joint states, %ld wrenches, %ld plate samples -> %ld loads%s\n"
-               "process_bag: compute %.3f s (%.0f samples/s), total with I/O %.3f s "
-               "(%.0f samples/s)\n",
-               joint_states, c.received(jle::InputKind::kWrench),
-               c.received(jle::InputKind::kPlate), c.count(jle::Outcome::kPublished),
-               outputs_->destination().c_str(), compute_s,
-               compute_s > 0 ? samples / compute_s : 0.0, total_s,
-               total_s > 0 ? samples / total_s : 0.0);
+  std::fprintf(
+      stderr,
+      "process_bag: %ld joint states, %ld wrenches, %ld plate samples -> %ld loads%s\n"
+      "process_bag: compute %.3f s (%.0f samples/s), total with I/O %.3f s "
+      "(%.0f samples/s)\n",
+      joint_states, c.received(jle::InputKind::kWrench), c.received(jle::InputKind::kPlate),
+      c.count(jle::Outcome::kPublished), outputs_->destination().c_str(), compute_s,
+      compute_s > 0 ? samples / compute_s : 0.0, total_s, total_s > 0 ? samples / total_s : 0.0);
   printDrops();
 }
 
@@ -443,8 +447,10 @@ void BagProcessor::printDrops() const {
       drops += (drops.empty() ? "" : ", ") + std::to_string(n) + " " +
                jle::toString(static_cast<jle::Outcome>(o));
   if (c.unknown_joints)
-    drops += (drops.empty() ? "" : ", ") + std::to_string(c.unknown_joints) + " with unknown joints";
-  if (c.resets) drops += (drops.empty() ? "" : ", ") + std::to_string(c.resets) + " time jumps back";
+    drops +=
+        (drops.empty() ? "" : ", ") + std::to_string(c.unknown_joints) + " with unknown joints";
+  if (c.resets)
+    drops += (drops.empty() ? "" : ", ") + std::to_string(c.resets) + " time jumps back";
   if (!drops.empty()) std::fprintf(stderr, "process_bag: not used: %s\n", drops.c_str());
 }
 
@@ -456,7 +462,8 @@ void run(const Options& options) {
   } catch (const jle::SettingsError& e) {
     throw std::runtime_error(options.config + ": " + e.what());
   }
-  const jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));
+  const jle::Model<double> model =
+      jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));
   for (const std::string& w : model.warnings)
     std::fprintf(stderr, "process_bag: warning: robot model: %s\n", w.c_str());
   std::unique_ptr<BagProcessor> processor;

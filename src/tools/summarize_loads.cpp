@@ -150,8 +150,8 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--topic")) o.topic = v["--topic"];
   if (v.count("--output")) o.output = v["--output"];
   if (v.count("--count"))
-    o.count = static_cast<long>(jle::cli::parseInteger("--count", v["--count"], 1,
-                                                       std::numeric_limits<long>::max()));
+    o.count = static_cast<long>(
+        jle::cli::parseInteger("--count", v["--count"], 1, std::numeric_limits<long>::max()));
   if (v.count("--idle"))
     o.idle = jle::cli::parseNumber("--idle", v["--idle"], jle::cli::Sign::kPositive);
   return o;

@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define JLE_FUZZ_CHECK(ok) \
-  do { \
-    if (!(ok)) { \
+#define JLE_FUZZ_CHECK(ok)                                                        \
+  do {                                                                            \
+    if (!(ok)) {                                                                  \
       std::fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #ok); \
-      std::abort(); \
-    } \
+      std::abort();                                                               \
+    }                                                                             \
   } while (false)

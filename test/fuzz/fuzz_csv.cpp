@@ -78,7 +78,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
       jle::forwardKinematics(model, f.data, q, qd, qdd, Eigen::Vector3d(0.0, 0.0, -9.80665));
       for (const jle::StateColumns::WrenchColumns& w : columns.wrenches) {
         const auto& c = w.column;
-        auto at = [&](int i) { return cells.at(static_cast<std::size_t>(c[static_cast<std::size_t>(i)])); };
+        auto at = [&](int i) {
+          return cells.at(static_cast<std::size_t>(c[static_cast<std::size_t>(i)]));
+        };
         jle::addExternalWrench(model, f.data, w.frame, Eigen::Vector3d(at(0), at(1), at(2)),
                                Eigen::Vector3d(at(3), at(4), at(5)), jle::WrenchFrame::kLocal);
       }

@@ -49,8 +49,19 @@ class Bytes {
   // A value from a table of the interesting ones, or the next 8 bytes as a double.
   double value() {
     constexpr double kInf = std::numeric_limits<double>::infinity();
-    static const double kTable[] = {0.0,   0.1,  -0.5,  1.0,    3.14159, -2.0,   1e-300,
-                                    1e300, -1e300, 1e6, -0.0,  kInf,    -kInf,
+    static const double kTable[] = {0.0,
+                                    0.1,
+                                    -0.5,
+                                    1.0,
+                                    3.14159,
+                                    -2.0,
+                                    1e-300,
+                                    1e300,
+                                    -1e300,
+                                    1e6,
+                                    -0.0,
+                                    kInf,
+                                    -kInf,
                                     std::numeric_limits<double>::quiet_NaN(),
                                     std::numeric_limits<double>::denorm_min()};
     const std::uint8_t b = byte();
@@ -64,10 +75,16 @@ class Bytes {
   std::size_t pos_ = 0;
 };
 
-const char* const kNames[] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
-                              "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint",
+const char* const kNames[] = {"shoulder_pan_joint",
+                              "shoulder_lift_joint",
+                              "elbow_joint",
+                              "wrist_1_joint",
+                              "wrist_2_joint",
+                              "wrist_3_joint",
                               "wrist_3_link-tool0_fixed_joint",  // fixed: not a coordinate
-                              "unknown_joint",      "",            "elbow_joint "};
+                              "unknown_joint",
+                              "",
+                              "elbow_joint "};
 constexpr std::size_t kNameCount = sizeof kNames / sizeof kNames[0];
 
 const jle::Model<double>& model() {
@@ -130,13 +147,14 @@ jle::Settings settingsFrom(Bytes& in) {
 // The next stamp [ns] and clock from the fuzz bytes, within what a ROS time holds.
 void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
   switch (in.byte() % 9) {
-    case 0: break;                                               // duplicate
+    case 0: break;                                                     // duplicate
     case 1: stamp = std::max<jle::Stamp>(0, stamp - 10000000); break;  // backward 10 ms
     case 2: stamp = std::min(kMaxStamp, stamp + 1000000000); break;    // a gap of 1 s
     case 3:
-      stamp = kStart - kReach + static_cast<jle::Stamp>(in.raw64() % static_cast<std::uint64_t>(2 * kReach));
+      stamp = kStart - kReach +
+              static_cast<jle::Stamp>(in.raw64() % static_cast<std::uint64_t>(2 * kReach));
       break;
-    case 4: stamp = 0; break;                                    // "no stamp": the clock
+    case 4: stamp = 0; break;                                            // "no stamp": the clock
     case 5: clock = std::max<jle::Stamp>(1, clock - 5000000000); break;  // clock jumps back
     default: stamp = std::min(kMaxStamp, stamp + 2000000 * (1 + in.byte() % 8)); break;
   }

@@ -13,9 +13,7 @@
 #include <cstdlib>
 #include <string>
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t size) {
   // The whole input is the XML; its last byte also picks the options (a plain URDF
@@ -37,8 +35,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
   JLE_FUZZ_CHECK(n >= 1);
   JLE_FUZZ_CHECK(model.parent.size() == static_cast<std::size_t>(n));
   JLE_FUZZ_CHECK(model.parent[0] < 0);
-  for (int i = 1; i < n; ++i) JLE_FUZZ_CHECK(model.parent[static_cast<std::size_t>(i)] >= 0 &&
-                                    model.parent[static_cast<std::size_t>(i)] < i);
+  for (int i = 1; i < n; ++i)
+    JLE_FUZZ_CHECK(model.parent[static_cast<std::size_t>(i)] >= 0 &&
+                   model.parent[static_cast<std::size_t>(i)] < i);
   JLE_FUZZ_CHECK(model.coordinate_names.size() == static_cast<std::size_t>(model.nq));
   for (int s : model.moving_segments) JLE_FUZZ_CHECK(s > 0 && s < n);
   for (const auto& f : model.frames) {

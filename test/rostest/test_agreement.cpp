@@ -27,7 +27,7 @@ using jle_test::JointLoads;
 using jle_test::runSpinning;
 
 constexpr int kSamples = 150;
-constexpr double kPeriod = 0.01;          // [s]
+constexpr double kPeriod = 0.01;         // [s]
 constexpr double kLead = 0.5 * kPeriod;  // [s] wrenches and /tf ahead of their joint state
 constexpr double kPi = 3.14159265358979323846;
 const ros::Time kStart(1700000000, 123456789);
@@ -58,9 +58,9 @@ geometry_msgs::TransformStamped basePose(const ros::Time& stamp, double t) {
   tf.transform.translation.x = 0.05 * std::sin(2 * kPi * 0.5 * t);
   tf.transform.translation.y = 0.2 * t;
   tf.transform.translation.z = 1.0 + 0.03 * std::sin(2 * kPi * 0.9 * t);
-  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.05 * t, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(0.1 * std::sin(2 * kPi * 0.6 * t),
-                                               Eigen::Vector3d::UnitY()));
+  const Eigen::Quaterniond q(
+      Eigen::AngleAxisd(0.05 * t, Eigen::Vector3d::UnitZ()) *
+      Eigen::AngleAxisd(0.1 * std::sin(2 * kPi * 0.6 * t), Eigen::Vector3d::UnitY()));
   tf.transform.rotation.w = q.w();
   tf.transform.rotation.x = q.x();
   tf.transform.rotation.y = q.y();
@@ -161,8 +161,7 @@ std::map<std::uint64_t, JointLoads> offline(const std::string& dir, const Scenar
   std::ifstream in(std::string(JLE_ROSTEST_DIR) + "/" + s.config);
   std::stringstream yaml;
   yaml << in.rdbuf();
-  if (s.ns == "bias")
-    yaml << "bias_file: " << JLE_ROSTEST_DIR << "/agreement_bias_file.yaml\n";
+  if (s.ns == "bias") yaml << "bias_file: " << JLE_ROSTEST_DIR << "/agreement_bias_file.yaml\n";
   const std::string config = dir + "/" + s.ns + ".yaml", out = dir + "/" + s.ns + "_loads.bag";
   std::ofstream(config) << yaml.str();
   EXPECT_EQ(runSpinning({JLE_PROCESS_BAG, "--bag", dir + "/in.bag", "--urdf", s.urdf, "--config",
@@ -173,13 +172,19 @@ std::map<std::uint64_t, JointLoads> offline(const std::string& dir, const Scenar
 }
 
 TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
-  const std::vector<Scenario> scenarios = {
-      {"floating", JLE_ROSTEST_DIR "/two_link_floating.urdf", "agreement_floating.yaml",
-       {"hip", "knee"}},
-      {"partial", JLE_TEST_DATA "/urdf/talos_reduced.urdf", "agreement_partial.yaml",
-       {"leg_left_4_joint"}},
-      {"bias", JLE_TEST_DATA "/urdf/wrist_sensor_arm.urdf", "agreement_bias.yaml", {"j1", "j2"},
-       true}};
+  const std::vector<Scenario> scenarios = {{"floating",
+                                            JLE_ROSTEST_DIR "/two_link_floating.urdf",
+                                            "agreement_floating.yaml",
+                                            {"hip", "knee"}},
+                                           {"partial",
+                                            JLE_TEST_DATA "/urdf/talos_reduced.urdf",
+                                            "agreement_partial.yaml",
+                                            {"leg_left_4_joint"}},
+                                           {"bias",
+                                            JLE_TEST_DATA "/urdf/wrist_sensor_arm.urdf",
+                                            "agreement_bias.yaml",
+                                            {"j1", "j2"},
+                                            true}};
   ros::NodeHandle nh;
   std::map<std::string, std::vector<JointLoads>> online;
   std::vector<ros::Subscriber> subs;
@@ -195,8 +200,8 @@ TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
       },
       60.0));
   // rosbag play waits until the nodes listen to every input topic, then drives /clock.
-  ASSERT_EQ(runSpinning({"rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers",
-                         "--rate", "0.25", dir_ + "/in.bag"},
+  ASSERT_EQ(runSpinning({"rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", "--rate",
+                         "0.25", dir_ + "/in.bag"},
                         120.0),
             0);
   jle_test::spinUntilQuiet([&] {

@@ -40,15 +40,16 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   const jle::Model<double> model = jle::modelFromUrdfFile(urdf, options);
   const double weight = model.totalMass() * kGravity;
   std::vector<std::string> joints;
-  for (int s : model.moving_segments) joints.push_back(model.joint_name[static_cast<std::size_t>(s)]);
+  for (int s : model.moving_segments)
+    joints.push_back(model.joint_name[static_cast<std::size_t>(s)]);
   ASSERT_EQ(joints.size(), 10u);  // hip x3, knee, ankle per side
 
   ros::NodeHandle nh;
   std::vector<JointLoads> loads;
   std::vector<geometry_msgs::WrenchStamped> residuals;
-  ros::Subscriber loads_sub = nh.subscribe<JointLoads>(
-      "/joint_load_estimator/joint_loads", 10000,
-      [&loads](const JointLoads::ConstPtr& m) { loads.push_back(*m); });
+  ros::Subscriber loads_sub =
+      nh.subscribe<JointLoads>("/joint_load_estimator/joint_loads", 10000,
+                               [&loads](const JointLoads::ConstPtr& m) { loads.push_back(*m); });
   ros::Subscriber residual_sub = nh.subscribe<geometry_msgs::WrenchStamped>(
       "/joint_load_estimator/base_residual", 10000,
       [&residuals](const geometry_msgs::WrenchStamped::ConstPtr& m) { residuals.push_back(*m); });
@@ -63,10 +64,10 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
 
   // rosbag play waits until the node listens to every input topic, then plays at the
   // bag's pace, driving /clock.
-  ASSERT_EQ(jle_test::runSpinning({"rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", bag,
-                         "--topics", "/joint_states", "/tf", "/tf_static",
-                         "/force_plate_1/wrench", "/force_plate_2/wrench"},
-                        60.0),
+  ASSERT_EQ(jle_test::runSpinning({"rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers",
+                                   bag, "--topics", "/joint_states", "/tf", "/tf_static",
+                                   "/force_plate_1/wrench", "/force_plate_2/wrench"},
+                                  60.0),
             0);
   // The last messages in flight: until nothing new arrives for 1 s.
   jle_test::spinUntilQuiet([&] { return loads.size() + residuals.size(); });
@@ -78,14 +79,16 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   for (const JointLoads& m : loads) {
     ASSERT_EQ(m.name, joints);
     ASSERT_EQ(m.effort.size(), joints.size());
-    for (std::size_t j = 0; j < joints.size(); ++j) ASSERT_TRUE(std::isfinite(m.effort[j])) << m.name[j];
+    for (std::size_t j = 0; j < joints.size(); ++j)
+      ASSERT_TRUE(std::isfinite(m.effort[j])) << m.name[j];
   }
   // The loads are the walking body's: the stance hip carries a peak moment of the order
   // of 1 N m/kg, far from 0 (no plate) and from what a missing plate would leave.
   double peak_hip = 0.0;
   for (const JointLoads& m : loads)
     for (std::size_t j = 0; j < joints.size(); ++j)
-      if (joints[j].rfind("hip_flexion", 0) == 0) peak_hip = std::max(peak_hip, std::abs(m.effort[j]));
+      if (joints[j].rfind("hip_flexion", 0) == 0)
+        peak_hip = std::max(peak_hip, std::abs(m.effort[j]));
   EXPECT_GT(peak_hip / model.totalMass(), 0.3);
 
   // The residual. Without the plates it would be the body weight (735 N) and more; with

@@ -201,16 +201,19 @@ TEST(Plates, PapersPlanarFootThroughTheNode) {
       for (const auto& p : cop.msgs())
         if (p->header.stamp == t) c = p;
       return c != nullptr;
-    })) << "no COP stamped " << t;
+    })) << "no COP stamped "
+        << t;
     EXPECT_EQ(c->header.frame_id, "force_plate_1");
     const Vector3d expected = foot.cop(t, O, foot.surface_y_shank);
     // The COP: rounding of one division (|M| / |F| ~ 0.3 m): 1e-12 m.
-    worst_cop = std::max(worst_cop, (Vector3d(c->point.x, c->point.y, c->point.z) - expected)
-                                        .cwiseAbs().maxCoeff());
+    worst_cop = std::max(
+        worst_cop, (Vector3d(c->point.x, c->point.y, c->point.z) - expected).cwiseAbs().maxCoeff());
     EXPECT_NEAR(c->point.z, 0.04, 1e-15) << "the COP lies on the surface";
   }
-  std::printf("paper's foot, fixed ankle: exact from sample %d, largest relative error %.3g, "
-              "COP error %.3g m\n", first, worst, worst_cop);
+  std::printf(
+      "paper's foot, fixed ankle: exact from sample %d, largest relative error %.3g, "
+      "COP error %.3g m\n",
+      first, worst, worst_cop);
   EXPECT_LT(worst, kExactRel);
   EXPECT_LT(worst_cop, 1e-12);
 }
@@ -287,8 +290,10 @@ TEST(Plates, PapersPlanarFootOnAFloatingShankWithTheLabPlateFromTf) {
     EXPECT_TRUE(msg->effort_per_kg.empty()) << "body_mass 0: no effort_per_kg";
   }
   ASSERT_GE(first, 0) << "the loads never carried the plate";
-  std::printf("paper's foot, floating shank, plate from tf2: exact from sample %d, %d samples, "
-              "largest relative error %.3g\n", first, published, worst);
+  std::printf(
+      "paper's foot, floating shank, plate from tf2: exact from sample %d, %d samples, "
+      "largest relative error %.3g\n",
+      first, published, worst);
   EXPECT_GE(published, 30);
   EXPECT_LT(worst, kExactRel);
 }

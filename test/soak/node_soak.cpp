@@ -47,19 +47,20 @@
 
 namespace {
 
-const char kUsage[] = "usage: node_soak --pid PID --config YAML [--samples N] "
-                      "[--window N] [--jumps N]\n"
-                      "                 [--rss-limit KB]\n"
-                      "Drives a running joint_load_estimator node (process "
-                      "PID, parameters from YAML, the\n"
-                      "same file the node was given; its wrenches[0] is fed) "
-                      "with N joint states (default\n"
-                      "1000000) and bad messages; checks its loads, "
-                      "diagnostics and memory. --window: joint\n"
-                      "states in flight (default 64, below the node's queue of "
-                      "100); --jumps: backward time\n"
-                      "jumps (default 3); --rss-limit: allowed VmRSS growth "
-                      "from 10% to 100% (default 256).\n";
+const char kUsage[] =
+    "usage: node_soak --pid PID --config YAML [--samples N] "
+    "[--window N] [--jumps N]\n"
+    "                 [--rss-limit KB]\n"
+    "Drives a running joint_load_estimator node (process "
+    "PID, parameters from YAML, the\n"
+    "same file the node was given; its wrenches[0] is fed) "
+    "with N joint states (default\n"
+    "1000000) and bad messages; checks its loads, "
+    "diagnostics and memory. --window: joint\n"
+    "states in flight (default 64, below the node's queue of "
+    "100); --jumps: backward time\n"
+    "jumps (default 3); --rss-limit: allowed VmRSS growth "
+    "from 10% to 100% (default 256).\n";
 
 struct Options {
   long samples = 1000000;
@@ -70,30 +71,26 @@ struct Options {
   std::string config;
 };
 
-long toLong(const std::map<std::string, std::string> &v, const std::string &key,
-            long fallback, long min) {
+long toLong(const std::map<std::string, std::string>& v, const std::string& key, long fallback,
+            long min) {
   auto it = v.find(key);
-  if (it == v.end())
-    return fallback;
-  return static_cast<long>(jle::cli::parseInteger(
-      key, it->second, static_cast<unsigned long long>(min),
-      static_cast<unsigned long long>(std::numeric_limits<long>::max())));
+  if (it == v.end()) return fallback;
+  return static_cast<long>(
+      jle::cli::parseInteger(key, it->second, static_cast<unsigned long long>(min),
+                             static_cast<unsigned long long>(std::numeric_limits<long>::max())));
 }
 
-Options parseOptions(int argc, char **argv) {
+Options parseOptions(int argc, char** argv) {
   const auto v = jle::cli::optionValues(
-      argc, argv,
-      {"--samples", "--window", "--jumps", "--rss-limit", "--pid", "--config"});
+      argc, argv, {"--samples", "--window", "--jumps", "--rss-limit", "--pid", "--config"});
   Options o;
   o.samples = toLong(v, "--samples", o.samples, 1000);
   o.window = toLong(v, "--window", o.window, 1);
   o.jumps = toLong(v, "--jumps", o.jumps, 1);
   o.rss_limit_kb = toLong(v, "--rss-limit", o.rss_limit_kb, 0);
   o.pid = toLong(v, "--pid", 0, 1);
-  if (!o.pid)
-    throw jle::cli::UsageError("--pid is required");
-  if (!v.count("--config"))
-    throw jle::cli::UsageError("--config is required");
+  if (!o.pid) throw jle::cli::UsageError("--pid is required");
+  if (!v.count("--config")) throw jle::cli::UsageError("--config is required");
   o.config = v.at("--config");
   return o;
 }
@@ -102,8 +99,7 @@ long vmRssKb(long pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
   std::string line;
   while (std::getline(status, line))
-    if (line.rfind("VmRSS:", 0) == 0)
-      return std::strtol(line.c_str() + 6, nullptr, 10);
+    if (line.rfind("VmRSS:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
   return -1;
 }
 
@@ -119,14 +115,14 @@ enum Bad {
   kNanWrench,
   kBackwardWrench,
   kUnresolvedFrame,
-  kTimeJump, // not in the periodic cycle: --jumps times
+  kTimeJump,  // not in the periodic cycle: --jumps times
   kKinds
 };
-const char *const kBadName[kKinds] = {
-    "nan_position",    "inf_position",     "position_length", "velocity_length",
-    "unknown_joint",   "duplicate_stamp",  "backward_stamp",  "nan_wrench",
-    "backward_wrench", "unresolved_frame", "time_jump_back"};
-const char *const kBadKey[kKinds] = {"dropped: invalid",
+const char* const kBadName[kKinds] = {"nan_position",     "inf_position",  "position_length",
+                                      "velocity_length",  "unknown_joint", "duplicate_stamp",
+                                      "backward_stamp",   "nan_wrench",    "backward_wrench",
+                                      "unresolved_frame", "time_jump_back"};
+const char* const kBadKey[kKinds] = {"dropped: invalid",
                                      "dropped: invalid",
                                      "dropped: invalid",
                                      "dropped: invalid",
@@ -137,9 +133,9 @@ const char *const kBadKey[kKinds] = {"dropped: invalid",
                                      "dropped: stamp order",
                                      "dropped: unresolved frame",
                                      "time jumps back"};
-constexpr long kBadPeriod = 50;    // one bad message per 50 good samples
-constexpr long kWrenchPeriod = 10; // one wrench per 10 joint samples (100 Hz)
-constexpr std::int64_t kDtNs = 1000000; // 1 kHz
+constexpr long kBadPeriod = 50;          // one bad message per 50 good samples
+constexpr long kWrenchPeriod = 10;       // one wrench per 10 joint samples (100 Hz)
+constexpr std::int64_t kDtNs = 1000000;  // 1 kHz
 constexpr std::int64_t kEpochNs = 1700000000LL * 1000000000LL;
 
 ros::Time fromNs(std::int64_t ns) {
@@ -149,102 +145,86 @@ ros::Time fromNs(std::int64_t ns) {
 }
 
 class Driver {
-public:
-  Driver(const Options &o) : o_(o) {
-    const jle::Settings settings =
-        jle::parseSettings(jle::loadYaml(o.config));
+ public:
+  Driver(const Options& o) : o_(o) {
+    const jle::Settings settings = jle::parseSettings(jle::loadYaml(o.config));
     if (settings.wrenches.empty())
-      throw std::runtime_error(
-          o.config + ": the soak needs at least one entry in 'wrenches'");
+      throw std::runtime_error(o.config + ": the soak needs at least one entry in 'wrenches'");
     if (settings.estimator.decimation != 1)
       throw std::runtime_error(o.config + ": the soak expects decimation 1");
     const jle::DifferentiatorBank bank(settings.estimator.differentiator, 1);
     warmup_ = bank.warmup();
     delay_ = bank.config().delay;
-    jump_back_ns_ =
-        static_cast<std::int64_t>(2e9 * settings.time_jump_threshold);
+    jump_back_ns_ = static_cast<std::int64_t>(2e9 * settings.time_jump_threshold);
     wrench_link_ = settings.estimator.wrenches[0].link;
 
     std::string urdf;
     if (!nh_.getParam(settings.robot_description, urdf))
-      throw std::runtime_error("parameter '" + settings.robot_description +
-                               "' is not set");
+      throw std::runtime_error("parameter '" + settings.robot_description + "' is not set");
     jle::ModelOptions options;
     options.floating_base = settings.floating_base;
-    if (options.floating_base)
-      throw std::runtime_error("the soak drives fixed-base models");
+    if (options.floating_base) throw std::runtime_error("the soak drives fixed-base models");
     names_ = jle::modelFromUrdfString(urdf, options).coordinate_names;
 
     const std::string node = "/joint_load_estimator";
-    joint_pub_ = nh_.advertise<sensor_msgs::JointState>(
-        settings.joint_states_topic, 1000);
-    wrench_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>(
-        settings.wrenches[0].topic, 1000);
-    loads_sub_ = nh_.subscribe(node + "/joint_loads", 1000, &Driver::onLoads,
-                               this, ros::TransportHints().tcpNoDelay());
-    diag_sub_ =
-        nh_.subscribe("/diagnostics", 100, &Driver::onDiagnostics, this);
+    joint_pub_ = nh_.advertise<sensor_msgs::JointState>(settings.joint_states_topic, 1000);
+    wrench_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>(settings.wrenches[0].topic, 1000);
+    loads_sub_ = nh_.subscribe(node + "/joint_loads", 1000, &Driver::onLoads, this,
+                               ros::TransportHints().tcpNoDelay());
+    diag_sub_ = nh_.subscribe("/diagnostics", 100, &Driver::onDiagnostics, this);
   }
 
   bool run();
 
-private:
-  void onLoads(const joint_load_estimator::JointLoads::ConstPtr &msg) {
-    const std::int64_t stamp =
-        static_cast<std::int64_t>(msg->header.stamp.toNSec());
+ private:
+  void onLoads(const joint_load_estimator::JointLoads::ConstPtr& msg) {
+    const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
     const std::size_t r = received_.size();
     received_.push_back(stamp);
-    if (r < expected_.size())
-      acked_ = std::max(acked_, trigger_[r]);
-    bool finite = msg->name.size() == names_.size() &&
-                  msg->effort.size() == names_.size();
-    for (double e : msg->effort)
-      finite = finite && std::isfinite(e);
-    for (const auto &w : msg->wrench)
+    if (r < expected_.size()) acked_ = std::max(acked_, trigger_[r]);
+    bool finite = msg->name.size() == names_.size() && msg->effort.size() == names_.size();
+    for (double e : msg->effort) finite = finite && std::isfinite(e);
+    for (const auto& w : msg->wrench)
       finite = finite && std::isfinite(w.force.x) && std::isfinite(w.force.y) &&
-               std::isfinite(w.force.z) && std::isfinite(w.torque.x) &&
-               std::isfinite(w.torque.y) && std::isfinite(w.torque.z);
-    if (!finite)
-      ++bad_loads_;
+               std::isfinite(w.force.z) && std::isfinite(w.torque.x) && std::isfinite(w.torque.y) &&
+               std::isfinite(w.torque.z);
+    if (!finite) ++bad_loads_;
   }
 
-  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr &msg) {
-    for (const auto &status : msg->status) {
-      if (status.name.find("joint loads") == std::string::npos)
-        continue;
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+    for (const auto& status : msg->status) {
+      if (status.name.find("joint loads") == std::string::npos) continue;
       std::map<std::string, long> values;
-      for (const auto &kv : status.values) {
-        char *end = nullptr;
+      for (const auto& kv : status.values) {
+        char* end = nullptr;
         const long x = std::strtol(kv.value.c_str(), &end, 10);
-        if (end && *end == '\0' && !kv.value.empty())
-          values[kv.key] = x;
+        if (end && *end == '\0' && !kv.value.empty()) values[kv.key] = x;
       }
       last_diag_ = values;
       ++diag_count_;
     }
   }
 
-  long diag(const std::string &key) const {
+  long diag(const std::string& key) const {
     auto it = last_diag_.find(key);
     return it == last_diag_.end() ? -1 : it->second;
   }
 
   // Spins until pred() holds; false after 10 s without a new load or
   // diagnostics message (the node stalled or died).
-  template <typename Pred> bool spinUntil(Pred pred, const char *what) {
+  template <typename Pred>
+  bool spinUntil(Pred pred, const char* what) {
     std::size_t seen = received_.size();
     long seen_diag = diag_count_;
     auto last_progress = std::chrono::steady_clock::now();
     while (!pred()) {
-      if (!ros::ok())
-        return false;
+      if (!ros::ok()) return false;
       ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
       if (received_.size() != seen || diag_count_ != seen_diag) {
         seen = received_.size();
         seen_diag = diag_count_;
         last_progress = std::chrono::steady_clock::now();
-      } else if (std::chrono::steady_clock::now() - last_progress >
-                 std::chrono::seconds(10)) {
+      } else if (std::chrono::steady_clock::now() - last_progress > std::chrono::seconds(10)) {
         std::printf(
             "FAILED: no progress for 10 s while waiting for %s (loads expected "
             "so far "
@@ -257,9 +237,8 @@ private:
   }
 
   // Waits for room in the window, then publishes one joint-state message.
-  bool sendJoint(const sensor_msgs::JointState &msg) {
-    if (!spinUntil([&] { return sent_ - (acked_ + 1) < o_.window; },
-                   "the node's loads"))
+  bool sendJoint(const sensor_msgs::JointState& msg) {
+    if (!spinUntil([&] { return sent_ - (acked_ + 1) < o_.window; }, "the node's loads"))
       return false;
     joint_pub_.publish(msg);
     ++sent_;
@@ -267,7 +246,7 @@ private:
     return true;
   }
 
-  void sendWrench(std::int64_t stamp, double fx, const std::string &frame) {
+  void sendWrench(std::int64_t stamp, double fx, const std::string& frame) {
     wrench_msg_.header.stamp = fromNs(stamp);
     wrench_msg_.header.frame_id = frame;
     wrench_msg_.wrench.force.x = fx;
@@ -288,8 +267,7 @@ private:
     good_msg_.name = names_;
     good_msg_.position.resize(names_.size());
     for (std::size_t k = 0; k < names_.size(); ++k)
-      good_msg_.position[k] =
-          0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
+      good_msg_.position[k] = 0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
     if (ghost) {
       good_msg_.name.push_back("ghost_joint");
       good_msg_.position.push_back(1.0);
@@ -297,8 +275,7 @@ private:
     // The filter publishes from the warmup()-th sample after a (re)start on,
     // each time the estimate for the sample `delay` samples back.
     segment_.push_back(stamp);
-    if (static_cast<int>(segment_.size()) > delay_ + 1)
-      segment_.pop_front();
+    if (static_cast<int>(segment_.size()) > delay_ + 1) segment_.pop_front();
     if (segment_count_++ >= warmup_ - 1) {
       expected_.push_back(segment_.front());
       trigger_.push_back(sent_);
@@ -315,10 +292,9 @@ private:
   // different connections).
   bool barrier(long joints) {
     long guard = 0;
-    while (!(diag("wrenches received") == wrenches_sent_ &&
-             diag("joint states received") >= joints)) {
-      if (!sendGood(false))
-        return false;
+    while (
+        !(diag("wrenches received") == wrenches_sent_ && diag("joint states received") >= joints)) {
+      if (!sendGood(false)) return false;
       if (++guard > 1000000) {
         std::printf("FAILED: no diagnostics caught up with the inputs\n");
         return false;
@@ -326,8 +302,7 @@ private:
     }
     // And every joint state handled (the last one is a good sample past the
     // warm-up).
-    return spinUntil([&] { return acked_ + 1 == sent_; },
-                     "the loads of the last sample");
+    return spinUntil([&] { return acked_ + 1 == sent_; }, "the loads of the last sample");
   }
 
   bool sendBad(Bad kind) {
@@ -337,39 +312,25 @@ private:
     m.position.resize(names_.size());
     m.header.stamp = fromNs(last_good_ns_ + kDtNs / 2);
     switch (kind) {
-    case kNanPosition:
-      m.position[names_.size() / 2] = std::nan("");
-      break;
-    case kInfPosition:
-      m.position[0] = -std::numeric_limits<double>::infinity();
-      break;
-    case kPositionLength:
-      m.position.pop_back();
-      break;
-    case kVelocityLength:
-      m.velocity.assign(names_.size() - 1, 0.0);
-      break;
-    case kDuplicateStamp:
-      m.header.stamp = fromNs(last_good_ns_);
-      break;
-    case kBackwardStamp:
-      m.header.stamp = fromNs(last_good_ns_ - kDtNs / 2);
-      break;
-    case kNanWrench:
-      sendWrench(last_good_ns_ + kDtNs / 4, std::nan(""), wrench_link_);
-      return true;
-    case kBackwardWrench:
-      // Refused only if a wrench came since the last reset (an empty history
-      // takes any).
-      if (!wrench_in_segment_)
-        return false;
-      sendWrench(last_wrench_ns_ - kDtNs / 2, 1.0, wrench_link_);
-      return true;
-    case kUnresolvedFrame:
-      sendWrench(last_good_ns_ + kDtNs / 4, 1.0, "no_such_frame");
-      return true;
-    default:
-      return false;
+      case kNanPosition: m.position[names_.size() / 2] = std::nan(""); break;
+      case kInfPosition: m.position[0] = -std::numeric_limits<double>::infinity(); break;
+      case kPositionLength: m.position.pop_back(); break;
+      case kVelocityLength: m.velocity.assign(names_.size() - 1, 0.0); break;
+      case kDuplicateStamp: m.header.stamp = fromNs(last_good_ns_); break;
+      case kBackwardStamp: m.header.stamp = fromNs(last_good_ns_ - kDtNs / 2); break;
+      case kNanWrench:
+        sendWrench(last_good_ns_ + kDtNs / 4, std::nan(""), wrench_link_);
+        return true;
+      case kBackwardWrench:
+        // Refused only if a wrench came since the last reset (an empty history
+        // takes any).
+        if (!wrench_in_segment_) return false;
+        sendWrench(last_wrench_ns_ - kDtNs / 2, 1.0, wrench_link_);
+        return true;
+      case kUnresolvedFrame:
+        sendWrench(last_good_ns_ + kDtNs / 4, 1.0, "no_such_frame");
+        return true;
+      default: return false;
     }
     return sendJoint(m);
   }
@@ -386,31 +347,27 @@ private:
   sensor_msgs::JointState good_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
   std::int64_t next_ns_ = kEpochNs, last_good_ns_ = 0, last_wrench_ns_ = 0;
-  std::deque<std::int64_t>
-      segment_;            // the last delay + 1 stamps since the (re)start
-  long segment_count_ = 0; // good samples since the (re)start
+  std::deque<std::int64_t> segment_;  // the last delay + 1 stamps since the (re)start
+  long segment_count_ = 0;            // good samples since the (re)start
   bool wrench_in_segment_ = false;
   long good_ = 0, sent_ = 0, acked_ = -1, wrenches_sent_ = 0, bad_loads_ = 0;
-  std::vector<std::int64_t> expected_, received_; // loads stamps [ns]
-  std::vector<long>
-      trigger_; // index of the joint-state message that publishes expected_[r]
+  std::vector<std::int64_t> expected_, received_;  // loads stamps [ns]
+  std::vector<long> trigger_;  // index of the joint-state message that publishes expected_[r]
   std::map<std::string, long> last_diag_;
   long diag_count_ = 0;
   long injected_[kKinds] = {};
 };
 
 bool Driver::run() {
-  std::printf("node_soak: %zu joints, wrench on '%s', warm-up %d samples (%d "
-              "unpublished), "
-              "delay %d, window %ld\n",
-              names_.size(), wrench_link_.c_str(), warmup_, warmup_ - 1, delay_,
-              o_.window);
+  std::printf(
+      "node_soak: %zu joints, wrench on '%s', warm-up %d samples (%d "
+      "unpublished), "
+      "delay %d, window %ld\n",
+      names_.size(), wrench_link_.c_str(), warmup_, warmup_ - 1, delay_, o_.window);
   if (!spinUntil(
           [&] {
-            return joint_pub_.getNumSubscribers() > 0 &&
-                   wrench_pub_.getNumSubscribers() > 0 &&
-                   loads_sub_.getNumPublishers() > 0 &&
-                   diag_sub_.getNumPublishers() > 0;
+            return joint_pub_.getNumSubscribers() > 0 && wrench_pub_.getNumSubscribers() > 0 &&
+                   loads_sub_.getNumPublishers() > 0 && diag_sub_.getNumPublishers() > 0;
           },
           "the connections to the node"))
     return false;
@@ -422,15 +379,13 @@ bool Driver::run() {
   long rss_10 = -1;
   const auto start = std::chrono::steady_clock::now();
   for (long i = 0; i < o_.samples; ++i) {
-    if (i == o_.samples / 10)
-      rss_10 = vmRssKb(o_.pid);
+    if (i == o_.samples / 10) rss_10 = vmRssKb(o_.pid);
     if (next_jump <= o_.jumps && i == next_jump * o_.samples / (o_.jumps + 1)) {
       // A looping bag: back to the first stamp (or further, so that the jump is
       // at least twice the node's time_jump_threshold), once every input of the
       // old timeline has been handled.
       ++next_jump;
-      if (!barrier(0))
-        return false;
+      if (!barrier(0)) return false;
       next_ns_ = std::min(kEpochNs, last_good_ns_ - jump_back_ns_);
       segment_.clear();
       segment_count_ = 0;
@@ -440,40 +395,32 @@ bool Driver::run() {
     const Bad kind = static_cast<Bad>((i / kBadPeriod) % kTimeJump);
     const bool bad_here = i % kBadPeriod == kBadPeriod / 5;
     const bool ghost = bad_here && kind == kUnknownJoint;
-    if (ghost)
-      ++injected_[kUnknownJoint];
-    if (!sendGood(ghost))
-      return false;
+    if (ghost) ++injected_[kUnknownJoint];
+    if (!sendGood(ghost)) return false;
     if (i % kWrenchPeriod == 0) {
-      sendWrench(
-          last_good_ns_,
-          10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
-          wrench_link_);
+      sendWrench(last_good_ns_,
+                 10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
+                 wrench_link_);
       last_wrench_ns_ = last_good_ns_;
       wrench_in_segment_ = true;
     }
-    if (bad_here && !ghost && sendBad(kind))
-      ++injected_[kind];
-    if (!ros::ok())
-      return false;
+    if (bad_here && !ghost && sendBad(kind)) ++injected_[kind];
+    if (!ros::ok()) return false;
   }
   const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Every input has been sent: a diagnostics message after all of them, then
   // every load.
   const long joints_sent = sent_;
-  if (!barrier(joints_sent))
-    return false;
+  if (!barrier(joints_sent)) return false;
   const std::map<std::string, long> final_diag = last_diag_;
-  if (!spinUntil([&] { return received_.size() >= expected_.size(); },
-                 "the last loads"))
+  if (!spinUntil([&] { return received_.size() >= expected_.size(); }, "the last loads"))
     return false;
   const long rss_100 = vmRssKb(o_.pid);
   const bool alive = kill(static_cast<pid_t>(o_.pid), 0) == 0 && rss_100 > 0;
 
   bool ok = true;
-  auto expect = [&](bool c, const std::string &what) {
+  auto expect = [&](bool c, const std::string& what) {
     if (!c) {
       std::printf("FAILED: %s\n", what.c_str());
       ok = false;
@@ -486,97 +433,83 @@ bool Driver::run() {
       break;
     }
   const double total_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
-  std::printf("good samples %ld (%ld scheduled + %ld while waiting for "
-              "diagnostics at the %ld "
-              "jumps and the end), %.0f simulated s\n",
-              good_, o_.samples, good_ - o_.samples, injected_[kTimeJump],
-              1e-9 * static_cast<double>(kDtNs) * static_cast<double>(good_));
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "good samples %ld (%ld scheduled + %ld while waiting for "
+      "diagnostics at the %ld "
+      "jumps and the end), %.0f simulated s\n",
+      good_, o_.samples, good_ - o_.samples, injected_[kTimeJump],
+      1e-9 * static_cast<double>(kDtNs) * static_cast<double>(good_));
   std::printf(
       "wall time %.2f s (%.2f s to the last scheduled sample): %.0f samples/s, "
       "%.1f us/sample\n",
       total_seconds, seconds, static_cast<double>(good_) / total_seconds,
       1e6 * total_seconds / static_cast<double>(good_));
-  std::printf("node VmRSS at 10%%: %ld kB, at 100%%: %ld kB, growth %ld kB "
-              "(limit %ld)\n",
-              rss_10, rss_100, rss_100 - rss_10, o_.rss_limit_kb);
+  std::printf(
+      "node VmRSS at 10%%: %ld kB, at 100%%: %ld kB, growth %ld kB "
+      "(limit %ld)\n",
+      rss_10, rss_100, rss_100 - rss_10, o_.rss_limit_kb);
   std::printf(
       "loads: expected %zu, received %zu, in sequence %zu, non-finite %ld; "
       "unpublished warm-up %ld = %ld (re)starts x %d\n",
       expected_.size(), received_.size(), first_mismatch, bad_loads_,
-      good_ - static_cast<long>(expected_.size()), injected_[kTimeJump] + 1,
-      warmup_ - 1);
-  std::printf("%-18s %9s   %-30s %9s %9s\n", "injected", "count",
-              "diagnostics key", "expected", "diagnosed");
+      good_ - static_cast<long>(expected_.size()), injected_[kTimeJump] + 1, warmup_ - 1);
+  std::printf("%-18s %9s   %-30s %9s %9s\n", "injected", "count", "diagnostics key", "expected",
+              "diagnosed");
   std::map<std::string, long> expected_key;
-  for (int k = 0; k < kKinds; ++k)
-    expected_key[kBadKey[k]] += injected_[k];
+  for (int k = 0; k < kKinds; ++k) expected_key[kBadKey[k]] += injected_[k];
   for (int k = 0; k < kKinds; ++k) {
-    const long got =
-        final_diag.count(kBadKey[k]) ? final_diag.at(kBadKey[k]) : -1;
-    std::printf("%-18s %9ld   %-30s %9ld %9ld\n", kBadName[k], injected_[k],
-                kBadKey[k], expected_key[kBadKey[k]], got);
+    const long got = final_diag.count(kBadKey[k]) ? final_diag.at(kBadKey[k]) : -1;
+    std::printf("%-18s %9ld   %-30s %9ld %9ld\n", kBadName[k], injected_[k], kBadKey[k],
+                expected_key[kBadKey[k]], got);
     expect(injected_[k] > 0, std::string("no ") + kBadName[k] + " injected");
   }
   // The loads the node had published when it sent that diagnostics message.
-  const long at_diag = final_diag.count("joint states received")
-                           ? final_diag.at("joint states received")
-                           : -1;
+  const long at_diag =
+      final_diag.count("joint states received") ? final_diag.at("joint states received") : -1;
   long loads_at_diag = 0;
-  for (long s : trigger_)
-    loads_at_diag += s < at_diag;
-  const std::pair<const char *, long> totals[] = {
-      {"joint states received", sent_},
-      {"wrenches received", wrenches_sent_},
-      {"loads published", loads_at_diag},
-      {"not published: stale input", 0}};
-  for (const auto &[key, want] : totals) {
+  for (long s : trigger_) loads_at_diag += s < at_diag;
+  const std::pair<const char*, long> totals[] = {{"joint states received", sent_},
+                                                 {"wrenches received", wrenches_sent_},
+                                                 {"loads published", loads_at_diag},
+                                                 {"not published: stale input", 0}};
+  for (const auto& [key, want] : totals) {
     const long got = final_diag.count(key) ? final_diag.at(key) : -1;
-    const std::string range =
-        std::string(key) == "joint states received"
-            ? std::to_string(joints_sent) + ".." + std::to_string(want)
-            : std::to_string(want);
-    std::printf("%-18s %9s   %-30s %9s %9ld\n", "", "", key, range.c_str(),
-                got);
+    const std::string range = std::string(key) == "joint states received"
+                                  ? std::to_string(joints_sent) + ".." + std::to_string(want)
+                                  : std::to_string(want);
+    std::printf("%-18s %9s   %-30s %9s %9ld\n", "", "", key, range.c_str(), got);
   }
-  for (const auto &[key, want] : expected_key)
-    expect(final_diag.count(key) && final_diag.at(key) == want,
-           "diagnostics '" + key + "'");
-  expect(at_diag >= joints_sent && at_diag <= sent_,
-         "diagnostics 'joint states received'");
-  expect(final_diag.count("wrenches received") &&
-             final_diag.at("wrenches received") == wrenches_sent_,
-         "diagnostics 'wrenches received'");
-  expect(final_diag.count("loads published") &&
-             final_diag.at("loads published") == loads_at_diag,
+  for (const auto& [key, want] : expected_key)
+    expect(final_diag.count(key) && final_diag.at(key) == want, "diagnostics '" + key + "'");
+  expect(at_diag >= joints_sent && at_diag <= sent_, "diagnostics 'joint states received'");
+  expect(
+      final_diag.count("wrenches received") && final_diag.at("wrenches received") == wrenches_sent_,
+      "diagnostics 'wrenches received'");
+  expect(final_diag.count("loads published") && final_diag.at("loads published") == loads_at_diag,
          "diagnostics 'loads published'");
   expect(final_diag.count("not published: stale input") &&
              final_diag.at("not published: stale input") == 0,
          "diagnostics 'not published: stale input'");
-  expect(received_.size() == expected_.size() &&
-             first_mismatch == expected_.size(),
+  expect(received_.size() == expected_.size() && first_mismatch == expected_.size(),
          "the loads' stamps differ from the good samples' (first difference at "
          "load " +
              std::to_string(first_mismatch) + ")");
   expect(bad_loads_ == 0, "loads with the wrong size or non-finite values");
   expect(rss_10 > 0 && rss_100 > 0 && rss_100 - rss_10 <= o_.rss_limit_kb,
-         "node VmRSS grew by more than " + std::to_string(o_.rss_limit_kb) +
-             " kB");
+         "node VmRSS grew by more than " + std::to_string(o_.rss_limit_kb) + " kB");
   expect(alive, "the node is not alive at the end");
   std::printf("node soak: %s\n", ok ? "ok" : "FAILED");
   return ok;
 }
 
-} // namespace
+}  // namespace
 
-int main(int argc, char **argv) {
+int main(int argc, char** argv) {
   ros::init(argc, argv, "node_soak", ros::init_options::AnonymousName);
-  std::setvbuf(stdout, nullptr, _IOLBF, 0); // the summary before any error line
-  return jle::cli::runTool(argc, argv, "node_soak", kUsage, parseOptions,
-                           [](const Options &o) {
-                             Driver driver(o);
-                             if (!driver.run())
-                               throw std::runtime_error("failed");
-                           });
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // the summary before any error line
+  return jle::cli::runTool(argc, argv, "node_soak", kUsage, parseOptions, [](const Options& o) {
+    Driver driver(o);
+    if (!driver.run()) throw std::runtime_error("failed");
+  });
 }

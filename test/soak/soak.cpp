@@ -36,7 +36,7 @@ long vmRssKb() {
 }
 
 enum Bad { kNan, kLength, kDuplicate, kBackward, kUnknown, kWrenchNan, kWrenchBackward, kKinds };
-const char* const kBadName[kKinds] = {"nan_position",  "wrong_length",  "duplicate_stamp",
+const char* const kBadName[kKinds] = {"nan_position",   "wrong_length",  "duplicate_stamp",
                                       "backward_stamp", "unknown_joint", "nan_wrench",
                                       "backward_wrench"};
 
@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
 
   std::vector<std::string> names = model.coordinate_names, names_unknown = names;
   names_unknown.push_back("ghost_joint");
-  std::vector<double> position(static_cast<std::size_t>(nq)), position_unknown(names_unknown.size());
+  std::vector<double> position(static_cast<std::size_t>(nq)),
+      position_unknown(names_unknown.size());
   const std::vector<double> none;
   std::vector<double> short_position(static_cast<std::size_t>(nq - 1), 0.0);
 
@@ -85,8 +86,7 @@ int main(int argc, char** argv) {
     now = stamp;
     const double t = 1.0 + static_cast<double>(i) * 1e-3;
     for (int k = 0; k < nq; ++k)
-      position[static_cast<std::size_t>(k)] =
-          0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
+      position[static_cast<std::size_t>(k)] = 0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
     const Eigen::Vector3d f(10.0 * std::sin(t), 2.0, -5.0), m(0.1, 0.2 * std::cos(t), 0.0);
     if (pipeline.onWrench(0, stamp, now, frame, f, m) != Outcome::kUsed) ++other;
 
@@ -94,16 +94,20 @@ int main(int argc, char** argv) {
     Outcome s;
     if (i % 50 == 25) {
       ++injected[kUnknown];
-      for (int k = 0; k < nq; ++k) position_unknown[static_cast<std::size_t>(k)] = position[static_cast<std::size_t>(k)];
+      for (int k = 0; k < nq; ++k)
+        position_unknown[static_cast<std::size_t>(k)] = position[static_cast<std::size_t>(k)];
       position_unknown.back() = 1.0;
       s = message(stamp, names_unknown, position_unknown);
     } else {
       s = message(stamp, names, position);
     }
     ++good;
-    if (s == Outcome::kPublished) ++published;
-    else if (s == Outcome::kUsed) (published == 0 ? warming : late_warming)++;
-    else ++other;
+    if (s == Outcome::kPublished)
+      ++published;
+    else if (s == Outcome::kUsed)
+      (published == 0 ? warming : late_warming)++;
+    else
+      ++other;
 
     // The bad messages, after it.
     if (i % 50 != 10) continue;
@@ -165,8 +169,8 @@ int main(int argc, char** argv) {
               1e6 * seconds / static_cast<double>(samples), static_cast<double>(samples) * 1e-3);
   std::printf("VmRSS at 10%%: %ld kB, at 100%%: %ld kB, growth %ld kB (limit 1024)\n", rss_10,
               rss_100, rss_100 - rss_10);
-  std::printf("good %ld: published %ld, warming up %ld at the start, %ld later, other %ld\n",
-              good, published, warming, late_warming, other);
+  std::printf("good %ld: published %ld, warming up %ld at the start, %ld later, other %ld\n", good,
+              published, warming, late_warming, other);
   for (int k = 0; k < kKinds; ++k)
     std::printf("bad %-16s injected %7ld counted %7ld\n", kBadName[k], injected[k], counted[k]);
   expect(rss_10 > 0 && rss_100 - rss_10 < 1024, "VmRSS grew by 1 MB or more");
@@ -174,10 +178,11 @@ int main(int argc, char** argv) {
          "warm-up is not a few samples, once, at the start");
   expect(published == good - warming, "a good sample was not published");
   expect(other == 0, "a good sample or wrench got another outcome");
-  expect(c.received(InputKind::kJointState) == good + injected[kNan] + injected[kLength] +
-                                                    injected[kDuplicate] + injected[kBackward],
+  expect(c.received(InputKind::kJointState) ==
+             good + injected[kNan] + injected[kLength] + injected[kDuplicate] + injected[kBackward],
          "a joint state was not counted");
-  for (int k = 0; k < kKinds; ++k) expect(injected[k] > 0 && counted[k] == injected[k], kBadName[k]);
+  for (int k = 0; k < kKinds; ++k)
+    expect(injected[k] > 0 && counted[k] == injected[k], kBadName[k]);
   std::printf("soak: %s\n", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
 }

@@ -174,9 +174,9 @@ GroundTruth::GroundTruth(Model<double> model, std::vector<CoordinateMotion> moti
   if (model_.floating_base)
     throw std::invalid_argument("GroundTruth: floating-base models are not supported");
   if (static_cast<int>(motion_.size()) != model_.nq)
-    throw std::invalid_argument("GroundTruth: " + std::to_string(motion_.size()) +
-                                " coordinate motions for a model with nq = " +
-                                std::to_string(model_.nq));
+    throw std::invalid_argument(
+        "GroundTruth: " + std::to_string(motion_.size()) +
+        " coordinate motions for a model with nq = " + std::to_string(model_.nq));
   for (const WrenchMotion& w : wrenches_) wrench_frames_.push_back(model_.frameIndex(w.link));
   prismatic_ = prismaticCoordinates(model_);
 }
@@ -280,7 +280,8 @@ std::string planarArmUrdf() {
   x << "<?xml version=\"1.0\"?>\n<robot name=\"planar_arm\">\n"
     << "  <link name=\"base\">\n"
     << "    <inertial><origin xyz=\"0 0 0\"/><mass value=\"5\"/>"
-    << "<inertia ixx=\"0.05\" ixy=\"0\" ixz=\"0\" iyy=\"0.05\" iyz=\"0\" izz=\"0.05\"/></inertial>\n"
+    << "<inertia ixx=\"0.05\" ixy=\"0\" ixz=\"0\" iyy=\"0.05\" iyz=\"0\" "
+       "izz=\"0.05\"/></inertial>\n"
     << "  </link>\n";
   const double length[3] = {0.5, 0.4, 0.3}, mass[3] = {3.0, 2.0, 1.0};
   for (int i = 0; i < 3; ++i) {
@@ -310,7 +311,8 @@ std::string randomTreeUrdf(std::uint64_t seed, int links) {
   x << "<?xml version=\"1.0\"?>\n<robot name=\"random_tree_" << seed << "\">\n"
     << "  <link name=\"link0\">\n"
     << "    <inertial><origin xyz=\"0 0 0\"/><mass value=\"2\"/>"
-    << "<inertia ixx=\"0.02\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\" iyz=\"0\" izz=\"0.02\"/></inertial>\n"
+    << "<inertia ixx=\"0.02\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\" iyz=\"0\" "
+       "izz=\"0.02\"/></inertial>\n"
     << "  </link>\n";
   auto triple = [&](double lo, double hi) {
     const double a = rng.uniform(lo, hi), b = rng.uniform(lo, hi), c = rng.uniform(lo, hi);

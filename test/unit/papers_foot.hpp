@@ -46,14 +46,19 @@ struct PapersFoot {
     };
     const auto xy = [&](const Eigen::Vector2d& p) { return num(p.x()) + " " + num(p.y()) + " 0"; };
     return "<robot name=\"foot\"><link name=\"world\"/><link name=\"foot\"><inertial>"
-           "<origin xyz=\"" + xy(G_foot) + "\" rpy=\"0 0 0.3\"/><mass value=\"" + num(m) +
+           "<origin xyz=\"" +
+           xy(G_foot) + "\" rpy=\"0 0 0.3\"/><mass value=\"" + num(m) +
            "\"/><inertia ixx=\"0.0012\" ixy=\"0\" ixz=\"0\" iyy=\"0.0058\" iyz=\"0\" izz=\"" +
-           num(J_G) + "\"/></inertial></link><link name=\"cop\"/>"
+           num(J_G) +
+           "\"/></inertial></link><link name=\"cop\"/>"
            "<joint name=\"ankle\" type=\"revolute\"><parent link=\"world\"/><child link=\"foot\"/>"
-           "<origin xyz=\"" + xy(ankle_world) + "\"/><axis xyz=\"0 0 1\"/>"
+           "<origin xyz=\"" +
+           xy(ankle_world) +
+           "\"/><axis xyz=\"0 0 1\"/>"
            "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>"
            "<joint name=\"cop_joint\" type=\"fixed\"><parent link=\"foot\"/><child link=\"cop\"/>"
-           "<origin xyz=\"" + xy(P_foot) + "\"/></joint></robot>";
+           "<origin xyz=\"" +
+           xy(P_foot) + "\"/></joint></robot>";
   }
 
   /// One instant of a stance-like motion, theta(t) = theta0 + A sin(omega t) at
@@ -62,7 +67,7 @@ struct PapersFoot {
   /// equations, with the scales the tests' tolerances are relative to.
   struct Instant {
     double t, theta, theta_d, theta_dd;
-    Eigen::Matrix2d Q;            ///< the foot's rotation
+    Eigen::Matrix2d Q;  ///< the foot's rotation
     Eigen::Vector2d F_P, a_G, xi_A, xi_P, F_A;
     double M_A, force_scale, moment_scale;
   };

@@ -119,8 +119,8 @@ TEST(Body, NamesAndCoordinates) {
   EXPECT_EQ(model.nq, 10);
   for (const char* side : {"r", "l"}) {
     const std::string s = side;
-    for (const char* j : {"hip_flexion_", "hip_adduction_", "hip_rotation_",
-                                 "knee_flexion_", "ankle_flexion_"})
+    for (const char* j :
+         {"hip_flexion_", "hip_adduction_", "hip_rotation_", "knee_flexion_", "ankle_flexion_"})
       EXPECT_NO_THROW(model.segmentOfJoint(j + s)) << j << s;
     for (const char* l : {"femur_", "tibia_", "foot_", "heel_", "toe_"})
       EXPECT_NO_THROW(model.frameIndex(l + s)) << l << s;
@@ -173,8 +173,8 @@ TEST(Body, InertiasFromTheRadiiOfGyration) {
   EXPECT_NEAR(it(1, 1), mt * std::pow(kThighGyration * lt, 2), tol);
   EXPECT_NEAR(it(2, 2), mt * std::pow(kThighGyration * 14.9 / 32.9 * lt, 2), tol);
   EXPECT_NEAR(model.inertia_com[tibia](1, 1), ms * std::pow(kShankGyration * ls, 2), tol);
-  EXPECT_NEAR(model.inertia_com[tibia](2, 2),
-              ms * std::pow(kShankGyration * 10.3 / 25.5 * ls, 2), tol);
+  EXPECT_NEAR(model.inertia_com[tibia](2, 2), ms * std::pow(kShankGyration * 10.3 / 25.5 * ls, 2),
+              tol);
   // Foot: its long axis runs from the ankle to (0.5 lf, 0, -hf); across it (about y)
   // the transverse radius, along it the longitudinal one.
   const Vector3d axis(0.5 * kFootLength * kHeight, 0.0, -kAnkleHeight * kHeight);
@@ -209,8 +209,10 @@ TEST(Body, StandingGeometryAtZero) {
     EXPECT_LT((linkWorld(model, data, "tibia_" + s) - (hip + Vector3d(0, 0, -lt))).norm(), tol);
     const Vector3d ankle = hip + Vector3d(0, 0, -lt - ls);
     EXPECT_LT((linkWorld(model, data, "foot_" + s) - ankle).norm(), tol);
-    EXPECT_LT((linkWorld(model, data, "heel_" + s) - (ankle + Vector3d(-0.25 * lf, 0, -hf))).norm(), tol);
-    EXPECT_LT((linkWorld(model, data, "toe_" + s) - (ankle + Vector3d(0.75 * lf, 0, -hf))).norm(), tol);
+    EXPECT_LT((linkWorld(model, data, "heel_" + s) - (ankle + Vector3d(-0.25 * lf, 0, -hf))).norm(),
+              tol);
+    EXPECT_LT((linkWorld(model, data, "toe_" + s) - (ankle + Vector3d(0.75 * lf, 0, -hf))).norm(),
+              tol);
     // Soles at 0.530 H below the pelvis origin (the hip height of Fig. 4.1).
     EXPECT_NEAR(linkWorld(model, data, "heel_" + s).z(), -0.530 * kHeight, tol);
   }
@@ -226,7 +228,8 @@ TEST(Body, PositiveAnglesAreTheAnatomicalDirections) {
   const double tol = 1e-14;
   const jle::Data<double> rest = pose(model, "", 0.0);
   const auto moved = [&](const std::string& joint, const std::string& link) {
-    return Vector3d(linkWorld(model, pose(model, joint, 10.0), link) - linkWorld(model, rest, link));
+    return Vector3d(linkWorld(model, pose(model, joint, 10.0), link) -
+                    linkWorld(model, rest, link));
   };
   for (const double side : {1.0, -1.0}) {
     const std::string s = side > 0 ? "r" : "l";
@@ -239,8 +242,7 @@ TEST(Body, PositiveAnglesAreTheAnatomicalDirections) {
     // Knee flexion moves the ankle back.
     EXPECT_NEAR(moved("knee_flexion_" + s, "foot_" + s).x(), -ls * s10, tol);
     // Dorsiflexion raises the toe: (0.75 lf, -hf) turned by 10 deg toward +z.
-    EXPECT_NEAR(moved("ankle_flexion_" + s, "toe_" + s).z(),
-                0.75 * lf * s10 - hf * c10 + hf, tol);
+    EXPECT_NEAR(moved("ankle_flexion_" + s, "toe_" + s).z(), 0.75 * lf * s10 - hf * c10 + hf, tol);
     EXPECT_GT(moved("ankle_flexion_" + s, "toe_" + s).z(), 0.0);
   }
 }
@@ -306,12 +308,12 @@ TEST(Body, LoadsAsAFloatingBase) {
 TEST_F(BodyTool, RefusesBadOptions) {
   const std::string out = path("out/x.urdf");
   const std::vector<std::vector<std::string>> usage_errors = {
-      {"--height", "1.75"},                                   // no mass
-      {"--mass", "75"},                                       // no height
-      {"--mass", "-75", "--height", "1.75"},                  // out of range
-      {"--mass", "75", "--height", "17.5"},                   // centimetres by mistake
-      {"--mass", "seventy", "--height", "1.75"},              // not a number
-      {"--mass", "nan", "--height", "1.75"},                  // not finite
+      {"--height", "1.75"},                                         // no mass
+      {"--mass", "75"},                                             // no height
+      {"--mass", "-75", "--height", "1.75"},                        // out of range
+      {"--mass", "75", "--height", "17.5"},                         // centimetres by mistake
+      {"--mass", "seventy", "--height", "1.75"},                    // not a number
+      {"--mass", "nan", "--height", "1.75"},                        // not finite
       {"--mass", "75", "--height", "1.75", "--thigh-length", "4"},  // 10 x the table's
       {"--mass", "75", "--height", "1.75", "--shank-length", "0"},
       {"--mass", "75", "--height", "1.75", "--knee", "1"},    // unknown option
@@ -336,9 +338,9 @@ TEST_F(BodyTool, RefusesBadOptions) {
 }
 
 TEST_F(BodyTool, MeasuredLengthsOverrideTheTable) {
-  const jle::Model<double> model = generate({"--mass", "60", "--height", "1.6", "--thigh-length",
-                                             "0.41", "--shank-length", "0.4", "--foot-height",
-                                             "0.07", "--pelvis-width", "0.18", "--name", "subject_3"});
+  const jle::Model<double> model =
+      generate({"--mass", "60", "--height", "1.6", "--thigh-length", "0.41", "--shank-length",
+                "0.4", "--foot-height", "0.07", "--pelvis-width", "0.18", "--name", "subject_3"});
   const jle::Data<double> data = pose(model, "", 0.0);
   const double tol = 1e-14;
   EXPECT_LT((linkWorld(model, data, "femur_l") - Vector3d(0, 0.09, 0)).norm(), tol);
@@ -357,8 +359,8 @@ TEST_F(BodyTool, MeasuredLengthsOverrideTheTable) {
 
 struct Plate {
   jle::ForcePlateConfig config;
-  double share;   // of body weight
-  Vector3d cop;   // world [m], on the floor z = 0
+  double share;  // of body weight
+  Vector3d cop;  // world [m], on the floor z = 0
 };
 
 // The body stands still at q = 0 with its soles on the floor z = 0, the pelvis (floating
@@ -379,7 +381,8 @@ struct Standing {
     const double weight = model.totalMass() * kG;
     for (std::size_t k = 0; k < plates.size(); ++k) {
       const jle::ForcePlateConfig& c = plates[k].config;
-      const Vector3d force_plate = c.R_world_plate.transpose() * Vector3d(0, 0, -plates[k].share * weight);
+      const Vector3d force_plate =
+          c.R_world_plate.transpose() * Vector3d(0, 0, -plates[k].share * weight);
       const Vector3d cop_plate = c.R_world_plate.transpose() * (plates[k].cop - c.p_world_plate);
       const jle::PlateReading reading =
           jle::readForcePlate(c, force_plate, cop_plate.cross(force_plate));
@@ -391,9 +394,7 @@ struct Standing {
   jle::Wrench<double> world(const std::string& joint) const {
     return jle::jointWrench(model, data, model.segmentOfJoint(joint), jle::WrenchFrame::kWorld);
   }
-  double effort(const std::string& joint) const {
-    return data.effort[model.segmentOfJoint(joint)];
-  }
+  double effort(const std::string& joint) const { return data.effort[model.segmentOfJoint(joint)]; }
 };
 
 // The loads of one leg standing on a plate carrying P = share x W at the COP (cx, cy)

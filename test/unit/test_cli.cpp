@@ -680,8 +680,8 @@ TEST(CommandLine, IntegersAndTheirMessages) {
   using jle::cli::parseInteger;
   EXPECT_EQ(parseInteger("--seed", "0", 0, 4294967295ULL), 0u);
   EXPECT_EQ(parseInteger("--seed", "4294967295", 0, 4294967295ULL), 4294967295ULL);
-  for (const char* bad : {"-3", "+3", " 3", "3 ", "3x", "0x10", "", "4294967296",
-                          "18446744073709551616"})
+  for (const char* bad :
+       {"-3", "+3", " 3", "3 ", "3x", "0x10", "", "4294967296", "18446744073709551616"})
     EXPECT_EQ(usageError([&] { parseInteger("--seed", bad, 0, 4294967295ULL); }),
               "--seed: '" + std::string(bad) + "' is not an integer in 0 .. 4294967295");
   EXPECT_EQ(usageError([] { parseInteger("--strides", "0", 1, 100); }),
@@ -709,17 +709,20 @@ TEST(CommandLine, NumberLists) {
 TEST_F(CliTest, ToolsReportTheSharedMessages) {
   const Result seed = makeTrajectory({"--urdf", kPanda, "--seed", "-3", "--output", outPath()});
   EXPECT_EQ(seed.status, 2);
-  EXPECT_EQ(seed.err, "make_trajectory: --seed: '-3' is not an integer in 0 .. 4294967295 "
-                      "(see make_trajectory --help)\n");
+  EXPECT_EQ(seed.err,
+            "make_trajectory: --seed: '-3' is not an integer in 0 .. 4294967295 "
+            "(see make_trajectory --help)\n");
   const Result rate = makeTrajectory({"--urdf", kPanda, "--rate", "fast", "--output", outPath()});
   EXPECT_EQ(rate.status, 2);
-  EXPECT_EQ(rate.err, "make_trajectory: --rate: 'fast' is not a finite number "
-                      "(see make_trajectory --help)\n");
-  const Result mass = jointLoads({"--urdf", kPanda, "--input", path("absent.csv"), "--per-kg",
-                                  "--body-mass", "0"});
+  EXPECT_EQ(rate.err,
+            "make_trajectory: --rate: 'fast' is not a finite number "
+            "(see make_trajectory --help)\n");
+  const Result mass =
+      jointLoads({"--urdf", kPanda, "--input", path("absent.csv"), "--per-kg", "--body-mass", "0"});
   EXPECT_EQ(mass.status, 2);
-  EXPECT_EQ(mass.err, "joint_loads: --body-mass: '0' is not a finite number > 0 "
-                      "(see joint_loads --help)\n");
+  EXPECT_EQ(mass.err,
+            "joint_loads: --body-mass: '0' is not a finite number > 0 "
+            "(see joint_loads --help)\n");
   EXPECT_EQ(outEntries(), std::vector<std::string>{});
 }
 

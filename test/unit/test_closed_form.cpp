@@ -519,8 +519,7 @@ TEST(Prismatic, SliderOnATurningArmFeelsCoriolis) {
   jle::Data<double> data(model);
 
   jle_test::Random rng(43);
-  jle_test::UniformIn angle(-M_PI, M_PI), radius(0.1, 0.8), rate(-4.0, 4.0),
-      acc(-30.0, 30.0);
+  jle_test::UniformIn angle(-M_PI, M_PI), radius(0.1, 0.8), rate(-4.0, 4.0), acc(-30.0, 30.0);
   for (int trial = 0; trial < 50; ++trial) {
     const double th = angle(rng), r = radius(rng);
     const double thd = rate(rng), rd = rate(rng), thdd = acc(rng), rdd = acc(rng);
@@ -751,8 +750,7 @@ std::string refusal(const std::string& xml, const jle::ModelOptions& options = {
 
 TEST(BadModel, ValidTemplateIsAccepted) {
   // The refusals below come from their one defect, not from the template.
-  const jle::Model<double> model =
-      jle::modelFromUrdfString(twoLinks(soundArm()));
+  const jle::Model<double> model = jle::modelFromUrdfString(twoLinks(soundArm()));
   EXPECT_EQ(model.nq, 1);
   EXPECT_TRUE(model.warnings.empty());
 }
@@ -827,9 +825,9 @@ TEST(BadModel, NonNumericAttribute) {
 }
 
 TEST(BadModel, MimicOfUnknownJoint) {
-  const std::string finger = "<link name=\"finger\"/>" +
-                             armJoint("finger_joint", "prismatic", "finger",
-                                      "<mimic joint=\"no_such_joint\"/>");
+  const std::string finger =
+      "<link name=\"finger\"/>" +
+      armJoint("finger_joint", "prismatic", "finger", "<mimic joint=\"no_such_joint\"/>");
   EXPECT_THAT(refusal(twoLinks(soundArm(), finger)),
               AllOf(HasSubstr("'finger_joint'"), HasSubstr("'no_such_joint'")));
 }

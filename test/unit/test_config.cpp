@@ -147,39 +147,70 @@ TEST(Config, TopLevel) {
 }
 
 TEST(Config, Differentiator) {
-  auto sg = [](Settings& s) { s.estimator.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay; };
-  expectAll({{"differentiator/order", [&](Settings& s) { sg(s); s.estimator.differentiator.order = 5; }},
-             {"differentiator/window", [&](Settings& s) { sg(s); s.estimator.differentiator.window = 101; }},
-             {"differentiator/delay", [&](Settings& s) { sg(s); s.estimator.differentiator.delay = 8; }},
+  auto sg = [](Settings& s) {
+    s.estimator.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
+  };
+  expectAll({{"differentiator/order",
+              [&](Settings& s) {
+                sg(s);
+                s.estimator.differentiator.order = 5;
+              }},
+             {"differentiator/window",
+              [&](Settings& s) {
+                sg(s);
+                s.estimator.differentiator.window = 101;
+              }},
+             {"differentiator/delay",
+              [&](Settings& s) {
+                sg(s);
+                s.estimator.differentiator.delay = 8;
+              }},
              // A Kalman filter has no window: its Savitzky-Golay fields are not checked.
              {"differentiator/order", [](Settings& s) { s.estimator.differentiator.order = 9; }}},
             true);
-  expectAll({{"differentiator/order", [&](Settings& s) { sg(s); s.estimator.differentiator.order = 1; }},
-             {"differentiator/window", [&](Settings& s) { sg(s); s.estimator.differentiator.window = 2; }},
-             {"differentiator/delay", [&](Settings& s) { sg(s); s.estimator.differentiator.delay = 9; }},
-             {"differentiator/process_noise", [](Settings& s) { s.estimator.differentiator.process_noise = 0; }},
-             {"differentiator/measurement_noise",
-              [](Settings& s) { s.estimator.differentiator.measurement_noise = kInf; }},
-             {"differentiator/max_gap", [](Settings& s) { s.estimator.differentiator.max_gap = -1.0; }}},
-            false);
+  expectAll(
+      {{"differentiator/order",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.order = 1;
+        }},
+       {"differentiator/window",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.window = 2;
+        }},
+       {"differentiator/delay",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.delay = 9;
+        }},
+       {"differentiator/process_noise",
+        [](Settings& s) { s.estimator.differentiator.process_noise = 0; }},
+       {"differentiator/measurement_noise",
+        [](Settings& s) { s.estimator.differentiator.measurement_noise = kInf; }},
+       {"differentiator/max_gap", [](Settings& s) { s.estimator.differentiator.max_gap = -1.0; }}},
+      false);
 }
 
 TEST(Config, Wrenches) {
-  expectAll({{"wrenches[0]/sign", [](Settings& s) { s.estimator.wrenches[0].sign = -1.0; }},
-             {"wrenches[1]/link", [](Settings& s) { s.estimator.wrenches[1].link = "ft_link"; }},
-             {"wrenches[0]/force_noise", [](Settings& s) { s.estimator.wrenches[0].force_noise = 0.5; }}},
-            true);
-  expectAll({{"wrenches[0]/link", [](Settings& s) { s.estimator.wrenches[0].link.clear(); }},
-             {"wrenches[0]/sign", [](Settings& s) { s.estimator.wrenches[0].sign = 0.5; }},
-             {"wrenches[1]/timeout", [](Settings& s) { s.estimator.wrenches[1].timeout = 0.0; }},
-             {"wrenches[0]/force_noise", [](Settings& s) { s.estimator.wrenches[0].force_noise = -1.0; }},
-             {"wrenches[1]/moment_noise", [](Settings& s) { s.estimator.wrenches[1].moment_noise = kNaN; }},
-             {"wrenches[0]/topic", [](Settings& s) { s.wrenches[0].topic.clear(); }},
-             {"wrenches[1]/force_threshold", [](Settings& s) { s.wrenches[1].force_threshold = 0.0; }},
-             {"wrenches[0]/moment_threshold", [](Settings& s) { s.wrenches[0].moment_threshold = kInf; }},
-             // The topics pair with the inputs by index.
-             {"wrenches", [](Settings& s) { s.wrenches.pop_back(); }}},
-            false);
+  expectAll(
+      {{"wrenches[0]/sign", [](Settings& s) { s.estimator.wrenches[0].sign = -1.0; }},
+       {"wrenches[1]/link", [](Settings& s) { s.estimator.wrenches[1].link = "ft_link"; }},
+       {"wrenches[0]/force_noise", [](Settings& s) { s.estimator.wrenches[0].force_noise = 0.5; }}},
+      true);
+  expectAll(
+      {{"wrenches[0]/link", [](Settings& s) { s.estimator.wrenches[0].link.clear(); }},
+       {"wrenches[0]/sign", [](Settings& s) { s.estimator.wrenches[0].sign = 0.5; }},
+       {"wrenches[1]/timeout", [](Settings& s) { s.estimator.wrenches[1].timeout = 0.0; }},
+       {"wrenches[0]/force_noise", [](Settings& s) { s.estimator.wrenches[0].force_noise = -1.0; }},
+       {"wrenches[1]/moment_noise",
+        [](Settings& s) { s.estimator.wrenches[1].moment_noise = kNaN; }},
+       {"wrenches[0]/topic", [](Settings& s) { s.wrenches[0].topic.clear(); }},
+       {"wrenches[1]/force_threshold", [](Settings& s) { s.wrenches[1].force_threshold = 0.0; }},
+       {"wrenches[0]/moment_threshold", [](Settings& s) { s.wrenches[0].moment_threshold = kInf; }},
+       // The topics pair with the inputs by index.
+       {"wrenches", [](Settings& s) { s.wrenches.pop_back(); }}},
+      false);
 }
 
 TEST(Config, ForcePlates) {
@@ -188,49 +219,65 @@ TEST(Config, ForcePlates) {
              {"force_plates[0]/surface_height",
               [](Settings& s) { s.estimator.plates[0].plate.surface_height = -0.04; }},
              {"force_plates[0]/orientation",
-              [](Settings& s) { s.estimator.plates[0].plate.R_world_plate = Eigen::Vector3d(1, -1, -1).asDiagonal(); }}},
+              [](Settings& s) {
+                s.estimator.plates[0].plate.R_world_plate = Eigen::Vector3d(1, -1, -1).asDiagonal();
+              }}},
             true);
   auto second = [](Settings& s) {
     s.force_plates.push_back(s.force_plates[0]);
     s.estimator.plates.push_back(s.estimator.plates[0]);
   };
-  expectAll({{"force_plates[0]/name", [](Settings& s) { s.estimator.plates[0].plate.name.clear(); }},
-             {"force_plates[1]/name", second},
-             {"force_plates[0]/topic", [](Settings& s) { s.force_plates[0].topic.clear(); }},
-             {"force_plates[0]/link", [](Settings& s) { s.estimator.plates[0].plate.link.clear(); }},
-             {"force_plates[0]/timeout", [](Settings& s) { s.estimator.plates[0].timeout = -0.1; }},
-             {"force_plates[0]/contact_threshold",
-              [](Settings& s) { s.estimator.plates[0].plate.contact_threshold = -1.0; }},
-             {"force_plates[0]/surface_height",
-              [](Settings& s) { s.estimator.plates[0].plate.surface_height = kNaN; }},
-             {"force_plates[0]/position", [](Settings& s) { s.estimator.plates[0].plate.p_world_plate.x() = kInf; }},
-             {"force_plates[0]/orientation",  // a reflection
-              [](Settings& s) { s.estimator.plates[0].plate.R_world_plate = Eigen::Vector3d(1, 1, -1).asDiagonal(); }},
-             {"force_plates[0]/orientation",  // scaled
-              [](Settings& s) { s.estimator.plates[0].plate.R_world_plate *= 2.0; }},
-             {"force_plates", [](Settings& s) { s.force_plates.clear(); }}},
-            false);
+  expectAll(
+      {{"force_plates[0]/name", [](Settings& s) { s.estimator.plates[0].plate.name.clear(); }},
+       {"force_plates[1]/name", second},
+       {"force_plates[0]/topic", [](Settings& s) { s.force_plates[0].topic.clear(); }},
+       {"force_plates[0]/link", [](Settings& s) { s.estimator.plates[0].plate.link.clear(); }},
+       {"force_plates[0]/timeout", [](Settings& s) { s.estimator.plates[0].timeout = -0.1; }},
+       {"force_plates[0]/contact_threshold",
+        [](Settings& s) { s.estimator.plates[0].plate.contact_threshold = -1.0; }},
+       {"force_plates[0]/surface_height",
+        [](Settings& s) { s.estimator.plates[0].plate.surface_height = kNaN; }},
+       {"force_plates[0]/position",
+        [](Settings& s) { s.estimator.plates[0].plate.p_world_plate.x() = kInf; }},
+       {"force_plates[0]/orientation",  // a reflection
+        [](Settings& s) {
+          s.estimator.plates[0].plate.R_world_plate = Eigen::Vector3d(1, 1, -1).asDiagonal();
+        }},
+       {"force_plates[0]/orientation",  // scaled
+        [](Settings& s) { s.estimator.plates[0].plate.R_world_plate *= 2.0; }},
+       {"force_plates", [](Settings& s) { s.force_plates.clear(); }}},
+      false);
 }
 
 TEST(Config, Uncertainty) {
   expectAll({{"uncertainty/period", [](Settings& s) { s.estimator.uncertainty.period = 0.0; }},
-             {"uncertainty/position_noise", [](Settings& s) { s.estimator.uncertainty.position_noise = 1e-4; }}},
+             {"uncertainty/position_noise",
+              [](Settings& s) { s.estimator.uncertainty.position_noise = 1e-4; }}},
             true);
-  expectAll({{"uncertainty/position_noise", [](Settings& s) { s.estimator.uncertainty.position_noise = -1e-4; }},
-             {"uncertainty/mass_fraction", [](Settings& s) { s.estimator.uncertainty.mass_fraction = kNaN; }},
-             {"uncertainty/com_offset", [](Settings& s) { s.estimator.uncertainty.com_offset = -0.01; }},
-             {"uncertainty/inertia_fraction", [](Settings& s) { s.estimator.uncertainty.inertia_fraction = kInf; }},
-             {"uncertainty/period", [](Settings& s) { s.estimator.uncertainty.period = -0.018; }},
-             {"uncertainty/gain_tolerance", [](Settings& s) { s.estimator.uncertainty.gain_tolerance = kInf; }}},
-            false);
+  expectAll(
+      {{"uncertainty/position_noise",
+        [](Settings& s) { s.estimator.uncertainty.position_noise = -1e-4; }},
+       {"uncertainty/mass_fraction",
+        [](Settings& s) { s.estimator.uncertainty.mass_fraction = kNaN; }},
+       {"uncertainty/com_offset", [](Settings& s) { s.estimator.uncertainty.com_offset = -0.01; }},
+       {"uncertainty/inertia_fraction",
+        [](Settings& s) { s.estimator.uncertainty.inertia_fraction = kInf; }},
+       {"uncertainty/period", [](Settings& s) { s.estimator.uncertainty.period = -0.018; }},
+       {"uncertainty/gain_tolerance",
+        [](Settings& s) { s.estimator.uncertainty.gain_tolerance = kInf; }}},
+      false);
 }
 
 TEST(Config, Savings) {
-  expectAll({{"savings/static_velocity", [](Settings& s) { s.estimator.savings.static_velocity = 0.01; }},
-             {"savings/static_acceleration", [](Settings& s) { s.estimator.savings.static_acceleration = 0.5; }}},
-            true);
-  expectAll({{"savings/static_velocity", [](Settings& s) { s.estimator.savings.static_velocity = -0.01; }},
-             {"savings/static_acceleration", [](Settings& s) { s.estimator.savings.static_acceleration = kNaN; }}},
+  expectAll(
+      {{"savings/static_velocity", [](Settings& s) { s.estimator.savings.static_velocity = 0.01; }},
+       {"savings/static_acceleration",
+        [](Settings& s) { s.estimator.savings.static_acceleration = 0.5; }}},
+      true);
+  expectAll({{"savings/static_velocity",
+              [](Settings& s) { s.estimator.savings.static_velocity = -0.01; }},
+             {"savings/static_acceleration",
+              [](Settings& s) { s.estimator.savings.static_acceleration = kNaN; }}},
             false);
 }
 

@@ -54,8 +54,8 @@ TEST(NoiseGain, ThreePointCausal) {
   jle::DifferentiatorConfig c;
   c.type = jle::DifferentiatorType::kFiniteDifference;
   Eigen::Matrix3d expected;
-  expected << 1.0, 1.5 / h, 1.0 / (h * h),           //
-      1.5 / h, 6.5 / (h * h), 6.0 / (h * h * h),     // (9 + 16 + 1) / 4h^2, (3 + 8 + 1) / 2h^3
+  expected << 1.0, 1.5 / h, 1.0 / (h * h),        //
+      1.5 / h, 6.5 / (h * h), 6.0 / (h * h * h),  // (9 + 16 + 1) / 4h^2, (3 + 8 + 1) / 2h^3
       1.0 / (h * h), 6.0 / (h * h * h), 6.0 / std::pow(h, 4);
   expectGain(gainAfter(c, 5, h), expected, h);
 }
@@ -68,7 +68,7 @@ TEST(NoiseGain, ThreePointCentred) {
   c.delay = 1;
   Eigen::Matrix3d expected;
   expected << 1.0, 0.0, -2.0 / (h * h),  //
-      0.0, 0.5 / (h * h), 0.0,            //
+      0.0, 0.5 / (h * h), 0.0,           //
       -2.0 / (h * h), 0.0, 6.0 / std::pow(h, 4);
   expectGain(gainAfter(c, 4, h), expected, h);
 }
@@ -84,7 +84,7 @@ TEST(NoiseGain, SavitzkyGolayFivePointCentred) {
   Eigen::Matrix3d expected;
   const double v02 = (-3.0 * 2 + 12.0 * -1 + 17.0 * -2 + 12.0 * -1 + -3.0 * 2) / (35.0 * 7.0);
   expected << 595.0 / 1225.0, 0.0, v02 / (h * h),  //
-      0.0, 10.0 / (100.0 * h * h), 0.0,             //
+      0.0, 10.0 / (100.0 * h * h), 0.0,            //
       v02 / (h * h), 0.0, 14.0 / (49.0 * std::pow(h, 4));
   expectGain(gainAfter(c, 7, h), expected, h);
 }
@@ -132,11 +132,11 @@ struct Scene {
   std::string urdf;
   std::vector<std::string> wrench_links;
   jle::DifferentiatorConfig filter;
-  double rate = 1000.0;        // [Hz]
-  double position_noise = 0;   // [rad or m]
-  double force_noise = 0;      // [N]
-  double moment_noise = 0;     // [N m]
-  std::vector<int> instants;   // sample indices at which the covariance is compared
+  double rate = 1000.0;       // [Hz]
+  double position_noise = 0;  // [rad or m]
+  double force_noise = 0;     // [N]
+  double moment_noise = 0;    // [N m]
+  std::vector<int> instants;  // sample indices at which the covariance is compared
 };
 
 void runMonteCarlo(const Scene& scene, int replays) {
@@ -180,7 +180,8 @@ void runMonteCarlo(const Scene& scene, int replays) {
       for (std::size_t i = 0; i < wrenches.size(); ++i) {
         Vector6 w = w_clean[k][i];
         if (random)
-          for (int c = 0; c < 6; ++c) w[c] += (c < 3 ? scene.force_noise : scene.moment_noise) * random->gaussian();
+          for (int c = 0; c < 6; ++c)
+            w[c] += (c < 3 ? scene.force_noise : scene.moment_noise) * random->gaussian();
         estimator.addWrench(static_cast<int>(i), t, w.head<3>(), w.tail<3>());
       }
       q = q_clean[k];
@@ -236,9 +237,10 @@ void runMonteCarlo(const Scene& scene, int replays) {
         d -= clean[n][j];
         sum[n][j] += d;
         sum2[n][j].noalias() += d * d.transpose();
-        const double e = estimator.data().effort[s] - (model.joint_type[s] == jle::JointType::kRevolute
-                                                           ? model.axis[s].dot(clean[n][j].tail<3>())
-                                                           : model.axis[s].dot(clean[n][j].head<3>()));
+        const double e =
+            estimator.data().effort[s] - (model.joint_type[s] == jle::JointType::kRevolute
+                                              ? model.axis[s].dot(clean[n][j].tail<3>())
+                                              : model.axis[s].dot(clean[n][j].head<3>()));
         effort_sum2[n][j] += e * e;
       }
     });
@@ -275,9 +277,8 @@ void runMonteCarlo(const Scene& scene, int replays) {
         std::printf(" %6.3f", ratio);
         worst = std::max(worst, std::abs(ratio - 1.0));
         largest_state_share = std::max(largest_state_share, 1.0 - qdd_only[n][j](c, c) / P(c, c));
-        EXPECT_NEAR(ratio, 1.0, tolerance)
-            << scene.name << " t=" << scene.instants[n] << " joint "
-            << model.joint_name[published[j]] << " component " << c;
+        EXPECT_NEAR(ratio, 1.0, tolerance) << scene.name << " t=" << scene.instants[n] << " joint "
+                                           << model.joint_name[published[j]] << " component " << c;
       }
       const double ev = effort_sum2[n][j] / replays;
       std::printf("  effort %6.3f\n", effort_variance[n][j] > 0 ? ev / effort_variance[n][j] : 0.0);
@@ -286,9 +287,10 @@ void runMonteCarlo(const Scene& scene, int replays) {
       }
     }
   }
-  std::printf("%s: worst |ratio - 1| = %.3f; largest share of the linearised q, q-dot part "
-              "in a variance: %.3f\n",
-              scene.name.c_str(), worst, largest_state_share);
+  std::printf(
+      "%s: worst |ratio - 1| = %.3f; largest share of the linearised q, q-dot part "
+      "in a variance: %.3f\n",
+      scene.name.c_str(), worst, largest_state_share);
 }
 
 jle::DifferentiatorConfig savitzkyGolay(int window, int delay) {
@@ -303,16 +305,16 @@ constexpr int kReplays = 10000;
 
 // Savitzky-Golay, 9 samples, causal at 1 kHz: q-ddot's noise dominates, wrench noise on top.
 TEST(CovarianceMonteCarlo, PandaDefaultFilter) {
-  Scene s{"panda", "panda.urdf", {"panda_hand"}, savitzkyGolay(9, 0), 1000.0, 1e-4, 0.5, 0.05,
-          {12, 20}};
+  Scene s{"panda", "panda.urdf", {"panda_hand"}, savitzkyGolay(9, 0), 1000.0, 1e-4,
+          0.5,     0.05,         {12, 20}};
   runMonteCarlo(s, kReplays);
 }
 
 // A long centred window at 100 Hz and a noisy encoder: q-ddot is so well smoothed that
 // the linearised q and q-dot terms (gravity, Coriolis) carry a visible share.
 TEST(CovarianceMonteCarlo, PandaLongWindow) {
-  Scene s{"panda_lw", "panda.urdf", {"panda_hand"}, savitzkyGolay(41, 20), 100.0, 1e-2, 0.0,
-          0.0, {45, 60}};
+  Scene s{"panda_lw", "panda.urdf", {"panda_hand"}, savitzkyGolay(41, 20), 100.0, 1e-2,
+          0.0,        0.0,          {45, 60}};
   runMonteCarlo(s, kReplays);
 }
 
@@ -322,14 +324,28 @@ TEST(CovarianceMonteCarlo, TalosKalman) {
   k.process_noise = 1e4;
   k.kalman_model = jle::KalmanModel::kConstantAcceleration;
   k.measurement_noise = 1e-4;
-  Scene s{"talos", "talos_reduced.urdf", {"left_sole_link", "right_sole_link", "gripper_left_base_link"},
-          k, 1000.0, 1e-4, 1.0, 0.1, {15, 30}};
+  Scene s{"talos",
+          "talos_reduced.urdf",
+          {"left_sole_link", "right_sole_link", "gripper_left_base_link"},
+          k,
+          1000.0,
+          1e-4,
+          1.0,
+          0.1,
+          {15, 30}};
   runMonteCarlo(s, kReplays);
 }
 
 TEST(CovarianceMonteCarlo, TalosLongWindow) {
-  Scene s{"talos_lw", "talos_reduced.urdf", {"left_sole_link"}, savitzkyGolay(41, 20), 100.0,
-          1e-2, 2.0, 0.2, {45}};
+  Scene s{"talos_lw",
+          "talos_reduced.urdf",
+          {"left_sole_link"},
+          savitzkyGolay(41, 20),
+          100.0,
+          1e-2,
+          2.0,
+          0.2,
+          {45}};
   runMonteCarlo(s, kReplays);
 }
 
@@ -476,8 +492,8 @@ Eigen::Vector3d extrapolationWeights(int order, const double t[3], double x) {
 }
 
 // The rule, replayed on the stamps (a stamp difference is compared with the period to
-// a millionth of it, the rounding of the time axis): per published sample, -1 if computed, else the index
-// of its entry in `nodes` (the three computed samples it is extrapolated from, newest first).
+// a millionth of it, the rounding of the time axis): per published sample, -1 if computed, else the
+// index of its entry in `nodes` (the three computed samples it is extrapolated from, newest first).
 struct Schedule {
   std::vector<int> node_of;
   std::vector<std::array<std::size_t, 3>> nodes;
@@ -557,7 +573,7 @@ ExtrapolationError extrapolationError(const std::vector<double>& stamps,
 // count (18 samples at 100 Hz = 180 ms) gives 100% (variances clamped).
 constexpr double kDefaultPeriod = 0.018;
 constexpr double kExtrapolationBound[2] = {0.003, 0.03};  // panda, talos at 1 kHz
-constexpr double kAnyRateBound = 0.03;                     // both, at any rate
+constexpr double kAnyRateBound = 0.03;                    // both, at any rate
 
 enum class Stamps { k1kHz, k100Hz, kIrregular };
 
@@ -569,14 +585,15 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
                  std::vector<std::vector<double>>& var, std::vector<std::string>& names,
                  double jitter = 0.0) {
   const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/" + urdf);
-  const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31), {});
+  const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31),
+                               {});
   std::vector<double> stamps;
   if (kind == Stamps::kIrregular) {
     // dt uniform in 1 ms (1 +- jitter), and a 100 ms gap at 1 s (over 3 periods: the
     // history starts again; under the filter's max_gap of 0.5 s: the filter goes on).
     jle_test::Random rng(7);
     const jle_test::UniformIn dt(1e-3 * (1.0 - jitter), 1e-3 * (1.0 + jitter));
-    for (double t = 0.0; t < 2.0; t += t > 1.0 && t < 1.0015 ? 0.1 : dt(rng)) stamps.push_back(t);
+    for (double t = 0.0; t<2.0; t += t> 1.0 && t < 1.0015 ? 0.1 : dt(rng)) stamps.push_back(t);
   } else {
     const double h = kind == Stamps::k1kHz ? 1e-3 : 1e-2;
     for (int k = 0; k * h < 2.0 - 1e-9; ++k) stamps.push_back(k * h);
@@ -655,10 +672,11 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
         for (int r = 0; r < 6; ++r) {
           EXPECT_GE(P(r, r), 0.0);
           for (int col = 0; col < 6; ++col) {
-            const double scale = tolerance * (std::abs(w[0] * cov[n[0]][m](r, col)) +
-                                              std::abs(w[1] * cov[n[1]][m](r, col)) +
-                                              std::abs(w[2] * cov[n[2]][m](r, col)) +
-                                              std::abs(cov[b][m](r, col))) + 1e-300;
+            const double scale =
+                tolerance *
+                    (std::abs(w[0] * cov[n[0]][m](r, col)) + std::abs(w[1] * cov[n[1]][m](r, col)) +
+                     std::abs(w[2] * cov[n[2]][m](r, col)) + std::abs(cov[b][m](r, col))) +
+                1e-300;
             EXPECT_NEAR(P(r, col), E(r, col), scale) << urdf << " sample " << b;
             EXPECT_NEAR(P(r, col), P(col, r), scale) << urdf << " sample " << b;  // symmetric
           }
@@ -672,7 +690,8 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
             std::max(0.0, w[0] * var[n[0]][i] + w[1] * var[n[1]][i] + w[2] * var[n[2]][i]);
         EXPECT_NEAR(d.effortVariance(model.moving_segments[i]), v_e,
                     1e-12 * (std::abs(w[0] * var[n[0]][i]) + std::abs(w[1] * var[n[1]][i]) +
-                             std::abs(w[2] * var[n[2]][i])) + 1e-300)
+                             std::abs(w[2] * var[n[2]][i])) +
+                        1e-300)
             << urdf << " " << names[i] << " sample " << b;
       }
     }
@@ -683,9 +702,10 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
 void printErrors(const std::string& label, const std::vector<double>& published,
                  const std::vector<std::vector<double>>& var,
                  const std::vector<std::string>& names) {
-  std::printf("%s: period [ms] | hold worst, mean | line worst, mean | quadratic worst, "
-              "mean, clamped | extrapolated samples | where the worst (hold; line; quadratic)\n",
-              label.c_str());
+  std::printf(
+      "%s: period [ms] | hold worst, mean | line worst, mean | quadratic worst, "
+      "mean, clamped | extrapolated samples | where the worst (hold; line; quadratic)\n",
+      label.c_str());
   for (int ms : {2, 4, 8, 10, 12, 16, 17, 18, 20, 24, 32, 50, 100, 160}) {
     ExtrapolationError e[3];
     for (int order = 0; order < 3; ++order)
@@ -863,7 +883,8 @@ TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
   int robot = 0;
   for (const std::string urdf : {"panda.urdf", "talos_reduced.urdf"}) {
     const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/" + urdf);
-    const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31), {});
+    const jle::GroundTruth truth(model, jle::randomMotion(model, jle::MotionKind::kSines, 5.0, 31),
+                                 {});
     for (double jitter : {0.0, 0.01}) {
       jle::EstimatorConfig config;
       config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;

@@ -21,20 +21,24 @@ constexpr double kG = 9.80665;
 
 // A pendulum turning about y at the base origin: a point-like mass m [kg] at (L, 0, 0) of
 // its link with inertia iyy [kg m^2] about its centre (about every axis).
-std::string pendulum(const std::string& name, double m, double L, double iyy, const std::string& extra) {
+std::string pendulum(const std::string& name, double m, double L, double iyy,
+                     const std::string& extra) {
   const std::string i = std::to_string(iyy);
-  return "<joint name=\"" + name + "\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm_" + name +
-         "\"/><axis xyz=\"0 1 0\"/>" + extra + "<limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"5\"/></joint>" +
-         "<link name=\"arm_" + name + "\"><inertial><origin xyz=\"" + std::to_string(L) + " 0 0\"/><mass value=\"" +
-         std::to_string(m) + "\"/><inertia ixx=\"" + i + "\" ixy=\"0\" ixz=\"0\" iyy=\"" + i +
-         "\" iyz=\"0\" izz=\"" + i + "\"/></inertial></link>";
+  return "<joint name=\"" + name +
+         "\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm_" + name +
+         "\"/><axis xyz=\"0 1 0\"/>" + extra +
+         "<limit lower=\"-3\" upper=\"3\" effort=\"100\" velocity=\"5\"/></joint>" +
+         "<link name=\"arm_" + name + "\"><inertial><origin xyz=\"" + std::to_string(L) +
+         " 0 0\"/><mass value=\"" + std::to_string(m) + "\"/><inertia ixx=\"" + i +
+         "\" ixy=\"0\" ixz=\"0\" iyy=\"" + i + "\" iyz=\"0\" izz=\"" + i + "\"/></inertial></link>";
 }
 
 // Two pendulums on a fixed base: a (m 2, L 0.5, Iyy 0.01) and b (m 1, L 0.25, Iyy 0.02),
 // which mimics a with multiplier 2.
-const std::string kPendulums = "<?xml version=\"1.0\"?><robot name=\"mimic_pendulums\"><link name=\"base\"/>" +
-                               pendulum("a", 2.0, 0.5, 0.01, "") +
-                               pendulum("b", 1.0, 0.25, 0.02, "<mimic joint=\"a\" multiplier=\"2.0\"/>") + "</robot>";
+const std::string kPendulums =
+    "<?xml version=\"1.0\"?><robot name=\"mimic_pendulums\"><link name=\"base\"/>" +
+    pendulum("a", 2.0, 0.5, 0.01, "") +
+    pendulum("b", 1.0, 0.25, 0.02, "<mimic joint=\"a\" multiplier=\"2.0\"/>") + "</robot>";
 // Inertia about the joint: Iyy + m L^2.
 constexpr double kIa = 0.01 + 2.0 * 0.25, kIb = 0.02 + 1.0 * 0.0625;
 
@@ -176,7 +180,8 @@ TEST(CovarianceWorkspace, ComputedAgainAfterAPeriodAGapOrANewGain) {
   const jle::Model<double> model = jle::modelFromUrdfString(kPendulums);
   const jle::CovarianceModel cm = periodModel(model);
   jle::CovarianceWorkspace ws = quadraticHistory(cm, 2.0, 0.01);
-  EXPECT_FALSE(jle::extrapolateCovariance(cm, ws, Eigen::Matrix3d::Identity(), 2.01));  // a period on
+  EXPECT_FALSE(
+      jle::extrapolateCovariance(cm, ws, Eigen::Matrix3d::Identity(), 2.01));  // a period on
   EXPECT_EQ(ws.history, 3);
   EXPECT_FALSE(jle::extrapolateCovariance(cm, ws, Eigen::Matrix3d::Identity(), 2.05));  // a gap
   EXPECT_EQ(ws.history, 0);

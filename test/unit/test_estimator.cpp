@@ -25,7 +25,8 @@ struct Quadratic {
   double t0 = 5.0;
   Eigen::VectorXd q(const jle::Model<double>& m, double t) const {
     Eigen::VectorXd out(m.nq);
-    for (int i = 0; i < m.nq; ++i) out[i] = 0.1 * i - 0.3 + (0.5 - 0.2 * i) * (t - t0) + 0.7 * std::cos(i) * (t - t0) * (t - t0);
+    for (int i = 0; i < m.nq; ++i)
+      out[i] = 0.1 * i - 0.3 + (0.5 - 0.2 * i) * (t - t0) + 0.7 * std::cos(i) * (t - t0) * (t - t0);
     return out;
   }
   Eigen::VectorXd qd(const jle::Model<double>& m, double t) const {

@@ -214,8 +214,9 @@ void expectFootHeldByThePlate(double tol) {
                          Eigen::Matrix<Scalar, 3, 1>(0, 0, static_cast<Scalar>(-g)));
   jle::applyPlateReaction(model, data, model.frameIndex("foot"), plate, jle::PlateReading());
   jle::inverseDynamics(model, data);
-  EXPECT_NEAR(static_cast<double>(jle::jointWrench(model, data, s, jle::WrenchFrame::kWorld).force.z()),
-              m * g, tol * m * g);
+  EXPECT_NEAR(
+      static_cast<double>(jle::jointWrench(model, data, s, jle::WrenchFrame::kWorld).force.z()),
+      m * g, tol * m * g);
 }
 
 // Tolerances relative to m g: a few roundings of numbers of order 20 in double (1e-14);

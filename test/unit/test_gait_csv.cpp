@@ -24,12 +24,13 @@ class GaitCsv : public jle_test::ToolTest {
 
 TEST_F(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   const std::string urdf = std::string(JLE_TEST_DATA) + "/urdf/body_75kg_175cm.urdf";
-  const Result make = run(JLE_MAKE_GAIT_BAG, {"--urdf", urdf, "--output", path("gait.bag"),
-                                              "--csv", path("gait.csv")});
+  const Result make = run(
+      JLE_MAKE_GAIT_BAG, {"--urdf", urdf, "--output", path("gait.bag"), "--csv", path("gait.csv")});
   ASSERT_EQ(make.status, 0) << make.err;
   // The generator prints the plate options to give joint_loads.
-  std::vector<std::string> loads_args = {"--urdf",   urdf, "--input", path("gait.csv"),
-                                         "--output", path("loads.csv"), "--floating-base"};
+  std::vector<std::string> loads_args = {"--urdf",         urdf,       "--input",
+                                         path("gait.csv"), "--output", path("loads.csv"),
+                                         "--floating-base"};
   std::istringstream report(make.out);
   std::string line, plates;
   while (std::getline(report, line))
@@ -46,8 +47,10 @@ TEST_F(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   const std::vector<std::string>& header = table.header;
   std::vector<int> force, moment;
   for (int i = 0; i < static_cast<int>(header.size()); ++i) {
-    if (header[i] == "base.fx" || header[i] == "base.fy" || header[i] == "base.fz") force.push_back(i);
-    if (header[i] == "base.mx" || header[i] == "base.my" || header[i] == "base.mz") moment.push_back(i);
+    if (header[i] == "base.fx" || header[i] == "base.fy" || header[i] == "base.fz")
+      force.push_back(i);
+    if (header[i] == "base.mx" || header[i] == "base.my" || header[i] == "base.mz")
+      moment.push_back(i);
   }
   ASSERT_EQ(force.size(), 3u);
   ASSERT_EQ(moment.size(), 3u);

@@ -107,9 +107,8 @@ void expectConsistent(const jle::Model<double>& model, jle::MotionKind kind, dou
       const double rounding = 8 * eps * (1.0 + std::abs(s.q));
       excess_qd = std::max(excess_qd, std::abs((after.q - before.q) / (2 * h) - s.qd) -
                                           (h * h / 6 * jerk_bound + rounding / h));
-      excess_qdd =
-          std::max(excess_qdd, std::abs((after.q - 2 * s.q + before.q) / (h * h) - s.qdd) -
-                                   (h * h / 12 * snap_bound + rounding / (h * h)));
+      excess_qdd = std::max(excess_qdd, std::abs((after.q - 2 * s.q + before.q) / (h * h) - s.qdd) -
+                                            (h * h / 12 * snap_bound + rounding / (h * h)));
       largest_qdd = std::max(largest_qdd, std::abs(s.qdd));
     }
   EXPECT_LE(excess_qd, 0.0);
@@ -260,7 +259,8 @@ TEST(GroundTruth, SameSeedSameReadingsAndStreamsAreIndependent) {
   sensor.drop_probability = 0.01;
   sensor.force_noise = 0.1;
   auto make = [&](std::uint64_t motion_seed) {
-    return jle::GroundTruth(model, jle::randomMotion(model, jle::MotionKind::kSines, 2.0, motion_seed),
+    return jle::GroundTruth(model,
+                            jle::randomMotion(model, jle::MotionKind::kSines, 2.0, motion_seed),
                             {jle::randomWrench("panda_hand", 4)});
   };
   const jle::SensorReadings a = make(1).sample(sensor, 2.0, 8), b = make(1).sample(sensor, 2.0, 8);

@@ -80,7 +80,8 @@ TEST(InputBuffer, PoliciesOfAStaleInput) {
   EXPECT_EQ(zero.valueAt(3.0), v6(6, 4, 4, 3, 6, 3));
 
   double out[6] = {0, 0, 0, 0, 0, 0};
-  for (jle::StalePolicy p : {jle::StalePolicy::kHold, jle::StalePolicy::kZero, jle::StalePolicy::kStop}) {
+  for (jle::StalePolicy p :
+       {jle::StalePolicy::kHold, jle::StalePolicy::kZero, jle::StalePolicy::kStop}) {
     jle::InputBuffer b = threeSamples(p);
     EXPECT_TRUE(b.stale());  // before the first joint sample
     b.resample(3.0, true, out);

@@ -156,9 +156,7 @@ void setOrigin(tinyxml2::XMLElement* parent, const Pose& pose) {
   o->SetAttribute("rpy", vec(rpyOf(pose.R)).c_str());
 }
 
-Pose randomPose(jle_test::Random& rng) {
-  return {rpyMatrix(rng.vector(1.2)), rng.vector(0.3)};
-}
+Pose randomPose(jle_test::Random& rng) { return {rpyMatrix(rng.vector(1.2)), rng.vector(0.3)}; }
 
 tinyxml2::XMLElement* addLink(tinyxml2::XMLElement* robot, const std::string& name) {
   tinyxml2::XMLElement* l = robot->InsertNewChildElement("link");

@@ -174,8 +174,7 @@ KdlState toKdlState(const jle::Model<double>& model, const KDL::Tree& tree,
       multiplier *= m->second.multiplier;
       leader = m->second.leader;
     }
-    const auto it =
-        std::find(model.coordinate_names.begin(), model.coordinate_names.end(), leader);
+    const auto it = std::find(model.coordinate_names.begin(), model.coordinate_names.end(), leader);
     if (it == model.coordinate_names.end()) {
       ADD_FAILURE() << "KDL joint '" << name << "' (leader '" << leader
                     << "') is no coordinate of the model";
@@ -248,8 +247,8 @@ void report(const std::string& label, const Worst& worst, double tolerance) {
   std::ostringstream os;
   os.precision(3);
   os << std::scientific << worst.rel;
-  std::cout << "[ KDL      ] " << label << ": largest relative disagreement " << os.str()
-            << " (" << worst.where << ")" << std::endl;
+  std::cout << "[ KDL      ] " << label << ": largest relative disagreement " << os.str() << " ("
+            << worst.where << ")" << std::endl;
   ::testing::Test::RecordProperty("max_relative_disagreement", os.str());
   EXPECT_LE(worst.rel, tolerance) << label << ": worst case " << worst.where;
 }
@@ -385,8 +384,8 @@ TEST(KdlMimic, ScaledAndOffsetMimicAgreesWithTreeIdSolverRne) {
   const std::string xml = readFile(urdfPath("panda.urdf"));
   ASSERT_EQ(doc.Parse(xml.c_str(), xml.size()), tinyxml2::XML_SUCCESS);
   tinyxml2::XMLElement* mimic = nullptr;
-  for (tinyxml2::XMLElement* j = doc.FirstChildElement("robot")->FirstChildElement("joint");
-       j; j = j->NextSiblingElement("joint"))
+  for (tinyxml2::XMLElement* j = doc.FirstChildElement("robot")->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint"))
     if (std::string(j->Attribute("name")) == "panda_finger_joint2")
       mimic = j->FirstChildElement("mimic");
   ASSERT_NE(mimic, nullptr);
@@ -439,8 +438,8 @@ TEST_P(KdlTree, LinkPosesAgreeWithTreeFkSolverPos) {
       ASSERT_GE(fk.JntToCart(k.q, X, frame.name), 0) << frame.name;
       const int i = frame.segment;
       compare(data.R_world[i] * frame.R_segment_frame,
-              data.p_world[i] + data.R_world[i] * frame.p_segment_frame, X,
-              "link " + frame.name, n);
+              data.p_world[i] + data.R_world[i] * frame.p_segment_frame, X, "link " + frame.name,
+              n);
     }
   }
   std::cout << "[ KDL      ] " << GetParam().name

@@ -63,8 +63,7 @@ std::vector<jle::DifferentiatorConfig> eachDifferentiator() {
 }
 
 TEST(NoAllocation, EstimatorWithEachDifferentiator) {
-  const jle::Model<double> model =
-      jle::modelFromUrdfFile(kData + "/urdf/chains/panda_chain.urdf");
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/chains/panda_chain.urdf");
   const std::vector<jle::DifferentiatorConfig> filters = eachDifferentiator();
   for (std::size_t f = 0; f < filters.size(); ++f) {
     jle::EstimatorConfig config;
@@ -121,8 +120,8 @@ TEST(NoAllocation, EstimatorWithCovariance) {
       estimator.addWrench(0, t, Eigen::Vector3d(1, 0, -5), Eigen::Vector3d(0, 0.1, 0));
       estimator.addJointSample(t, q.data());
     }
-    EXPECT_EQ(g_allocations - before, 0) << "linearize_state " << linearize << ", period "
-                                          << config.uncertainty.period;
+    EXPECT_EQ(g_allocations - before, 0)
+        << "linearize_state " << linearize << ", period " << config.uncertainty.period;
     EXPECT_GT(estimator.covariance(model.moving_segments[0])(5, 5), 0.0);
   }
 }
@@ -145,8 +144,10 @@ TEST(NoAllocation, EstimatorOnThePlanarPath) {
     const double t = 1e-3 * k;
     for (std::size_t i = 0; i < q.size(); ++i) q[i] = 0.5 * std::sin(t + i);
     // Out of the plane for 10 samples: the fallback must not allocate either.
-    estimator.addWrench(0, t, Eigen::Vector3d(1, 0, k >= 1900 && k < 1910 ? 1.0 : 0.0), Eigen::Vector3d(0, 0, 0.1));
-    if (estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished) planar += estimator.lastWasPlanar();
+    estimator.addWrench(0, t, Eigen::Vector3d(1, 0, k >= 1900 && k < 1910 ? 1.0 : 0.0),
+                        Eigen::Vector3d(0, 0, 0.1));
+    if (estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished)
+      planar += estimator.lastWasPlanar();
   }
   EXPECT_EQ(g_allocations - before, 0);
   EXPECT_GT(planar, 1700);

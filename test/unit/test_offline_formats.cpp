@@ -59,7 +59,9 @@ Sto parseSto(const std::string& text) {
 class OfflineFormatsTest : public jle_test::ToolTest {
  protected:
   OfflineFormatsTest() : ToolTest("jle_test_offline") {}
-  Result jointLoads(const std::vector<std::string>& args) const { return run(JLE_JOINT_LOADS, args); }
+  Result jointLoads(const std::vector<std::string>& args) const {
+    return run(JLE_JOINT_LOADS, args);
+  }
 };
 
 // ------------------------------------------------------------- one free rigid body
@@ -96,7 +98,11 @@ TEST_F(OfflineFormatsTest, FreeBodyResidualIsNewtonEuler) {
   const std::vector<State> states = {
       {Eigen::Quaterniond::Identity(), {0, 0, 1}, {0, 0, 0}, {0, 0, 2}, {1, 2, 3}, {0, 0, 5}},
       {Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
-       {0.3, -0.2, 1.1}, {0.5, 0, 0}, {1.5, -0.5, 0.8}, {-2, 0.5, 1}, {3, -1, 2}}};
+       {0.3, -0.2, 1.1},
+       {0.5, 0, 0},
+       {1.5, -0.5, 0.8},
+       {-2, 0.5, 1},
+       {3, -1, 2}}};
   std::string csv = std::string(kBaseHeader) + "\n";
   for (std::size_t i = 0; i < states.size(); ++i) {
     const State& s = states[i];
@@ -223,7 +229,8 @@ std::string standRow(double t, double left_fz, double left_mx, double left_my, d
     (void)j;
     row += ",0,0,0";
   }
-  for (double x : {0.0, 0.0, left_fz, left_mx, left_my, 0.0, 0.0, 0.0, right_fz, right_mx, right_my, 0.0})
+  for (double x :
+       {0.0, 0.0, left_fz, left_mx, left_my, 0.0, 0.0, 0.0, right_fz, right_mx, right_my, 0.0})
     row += "," + num(x);
   return row + "\n";
 }
@@ -328,7 +335,8 @@ TEST_F(OfflineFormatsTest, PerKgEffortsDivideByTheBodyMass) {
 
 // ------------------------------------------------------------------- OpenSim .sto
 
-void expectStoMatchesCsv(const Sto& sto, const Table& csv, const std::map<std::string, std::string>& names) {
+void expectStoMatchesCsv(const Sto& sto, const Table& csv,
+                         const std::map<std::string, std::string>& names) {
   // OpenSim's Storage header.
   ASSERT_GE(sto.header_lines.size(), 5u);
   EXPECT_EQ(sto.header_lines[0], "Inverse Dynamics Generalized Forces");
@@ -352,8 +360,9 @@ TEST_F(OfflineFormatsTest, JointLoadsWritesOpenSimStorage) {
   for (const char* frame : {"child", "parent", "world"}) {
     const Result csv = jointLoads(standArgs(path("in.csv"), {"--per-kg", "--frame", frame}));
     ASSERT_EQ(csv.status, 0) << csv.err;
-    const Result sto = jointLoads(standArgs(
-        path("in.csv"), {"--per-kg", "--frame", frame, "--format", "sto", "--output", path("o.sto")}));
+    const Result sto =
+        jointLoads(standArgs(path("in.csv"), {"--per-kg", "--frame", frame, "--format", "sto",
+                                              "--output", path("o.sto")}));
     ASSERT_EQ(sto.status, 0) << sto.err;
     const std::string in = std::string(frame) == "child"    ? "foot_l"
                            : std::string(frame) == "parent" ? "leg_l"
@@ -379,8 +388,8 @@ TEST_F(OfflineFormatsTest, ProcessBagWritesOpenSimStorage) {
   Result r = run(JLE_MAKE_EXAMPLE_BAG,
                  {"--urdf", kPandaDemo, "--samples", "200", "--output", path("in.bag")});
   ASSERT_EQ(r.status, 0) << r.err;
-  r = run(JLE_PROCESS_BAG, {"--bag", path("in.bag"), "--urdf", kPandaDemo, "--csv",
-                            path("o.csv"), "--sto", path("o.sto")});
+  r = run(JLE_PROCESS_BAG, {"--bag", path("in.bag"), "--urdf", kPandaDemo, "--csv", path("o.csv"),
+                            "--sto", path("o.sto")});
   ASSERT_EQ(r.status, 0) << r.err;
   const Table csv = parseCsv(readFile(path("o.csv")));
   ASSERT_GT(csv.rows.size(), 10u);
@@ -408,25 +417,33 @@ TEST_F(OfflineFormatsTest, RefusesBadPlatesBaseColumnsAndPlateNames) {
   const std::string in = path("in.csv");
   const std::vector<Case> cases = {
       {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0.1"},
-       2, "--plate: 'left=foot_l,0,0.1' is not NAME=LINK,X,Y,Z[,YAW_DEG]"},
+       2,
+       "--plate: 'left=foot_l,0,0.1' is not NAME=LINK,X,Y,Z[,YAW_DEG]"},
       {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,a,0"},
-       2, "--plate: 'left=foot_l,0,a,0'"},
-      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=toe,0,0,0"}, 2,
+       2,
+       "--plate: 'left=foot_l,0,a,0'"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=toe,0,0,0"},
+       2,
        "--plate left: unknown link 'toe'"},
       {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0,0",
         "--plate", "left=foot_r,0,0,0"},
-       2, "plate 'left' is given twice"},
+       2,
+       "plate 'left' is given twice"},
       // The CSV has plate@right.* columns, but only the left plate is declared.
-      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0.1,0"}, 1,
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--plate", "left=foot_l,0,0.1,0"},
+       1,
        "in.csv:1: columns 'plate@right.fx', 'plate@right.fy', 'plate@right.fz', "
        "'plate@right.mx', 'plate@right.my', 'plate@right.mz': unknown plate 'right'"},
       // Base columns for a fixed base.
       {{"--urdf", kStand, "--input", in, "--plate", "left=foot_l,0,0.1,0", "--plate",
         "right=foot_r,0,-0.1,0,90"},
-       1, "a floating-base column, but the base is fixed"},
-      {{"--urdf", kStand, "--input", in, "--floating-base", "--body-mass", "70"}, 2,
+       1,
+       "a floating-base column, but the base is fixed"},
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--body-mass", "70"},
+       2,
        "--body-mass is only used with --per-kg"},
-      {{"--urdf", kStand, "--input", in, "--floating-base", "--format", "mot"}, 2,
+      {{"--urdf", kStand, "--input", in, "--floating-base", "--format", "mot"},
+       2,
        "--format: 'mot' is not csv or sto"},
   };
   for (const Case& c : cases) {
@@ -445,21 +462,24 @@ TEST_F(OfflineFormatsTest, RefusesBadPlatesBaseColumnsAndPlateNames) {
             std::string::npos)
       << r.err;
   // A quaternion that is not a unit one, named with its line.
-  write("q.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
-                 "0.1,0,0,1,0,0,0,2\n0.2,0,0,1,0,0,0,1\n");
+  write("q.csv",
+        "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
+        "0.1,0,0,1,0,0,0,2\n0.2,0,0,1,0,0,0,1\n");
   r = jointLoads({"--urdf", kFreeBody, "--input", path("q.csv"), "--floating-base"});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("q.csv:3: column 'base.qw': the quaternion"), std::string::npos) << r.err;
   // Times that do not increase (the estimate needs them), and too few rows.
-  write("t.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
-                 "0.1,0,0,1,0,0,0,1\n0.1,0,0,1,0,0,0,1\n");
+  write("t.csv",
+        "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
+        "0.1,0,0,1,0,0,0,1\n0.1,0,0,1,0,0,0,1\n");
   r = jointLoads({"--urdf", kFreeBody, "--input", path("t.csv"), "--floating-base"});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("t.csv:4: column 't': time does not increase"), std::string::npos) << r.err;
-  write("two.csv", "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
-                   "0.1,0,0,1,0,0,0,1\n");
-  r = jointLoads({"--urdf", kFreeBody, "--input", path("two.csv"), "--floating-base",
-                  "--output", path("two.out")});
+  write("two.csv",
+        "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw\n0,0,0,1,0,0,0,1\n"
+        "0.1,0,0,1,0,0,0,1\n");
+  r = jointLoads({"--urdf", kFreeBody, "--input", path("two.csv"), "--floating-base", "--output",
+                  path("two.out")});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("2 rows; estimating the base twist"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("two.out")));

@@ -58,8 +58,8 @@ class FixedFrames : public jle::FrameSource {
  public:
   std::map<std::pair<std::string, std::string>, Eigen::Isometry3d> poses;
   long lookups = 0;
-  bool lookup(const std::string& target, const std::string& frame, Stamp,
-              Eigen::Isometry3d& X, std::string& error) override {
+  bool lookup(const std::string& target, const std::string& frame, Stamp, Eigen::Isometry3d& X,
+              std::string& error) override {
     ++lookups;
     const auto it = poses.find({target, frame});
     if (it == poses.end()) {
@@ -98,8 +98,7 @@ TEST(Pipeline, PartialMessagesGiveTheExactLoads) {
       EXPECT_NE(pipeline.problem().find("'" + arm[0] + "'"), std::string::npos)
           << pipeline.problem();
     }
-    if (pipeline.onJointState(stamp, stamp, arm, pa, kNone, kNone) != Outcome::kPublished)
-      continue;
+    if (pipeline.onJointState(stamp, stamp, arm, pa, kNone, kNone) != Outcome::kPublished) continue;
     ++published;
     const jle::LoadsRecord& r = pipeline.record();
     Eigen::VectorXd qv(6), qdv(6), qddv(6);

@@ -95,8 +95,9 @@ PlanarRobot randomPlanar(const PlanarSpec& spec) {
     const Vec3 e1 = inPlane(rng, n), e2 = n.cross(e1);
     const double a = rng.uniform(0.05, 0.3), b = rng.uniform(0.05, 0.3), c = rng.uniform(0.05, 0.3);
     // A box of sides a, b, c, its c side along n: n is a principal axis.
-    const Mat3 J = m / 12.0 * ((b * b + c * c) * e1 * e1.transpose() + (a * a + c * c) * e2 * e2.transpose() +
-                               (a * a + b * b) * n * n.transpose());
+    const Mat3 J = m / 12.0 *
+                   ((b * b + c * c) * e1 * e1.transpose() + (a * a + c * c) * e2 * e2.transpose() +
+                    (a * a + b * b) * n * n.transpose());
     Vec3 com = 0.2 * rng.uniform(0, 1) * inPlane(rng, n);
     if (spec.offsets) com += rng.uniform(-0.1, 0.1) * n;
     xml += "<link name=\"link" + std::to_string(k) + "\"><inertial><origin xyz=\"" + vec(com) +
@@ -114,7 +115,9 @@ PlanarRobot randomPlanar(const PlanarSpec& spec) {
     // Away from rpy's gimbal lock (pitch near +-pi/2), where the angles, hence the
     // matrix the reader rebuilds, lose digits (1e-13 measured).
     Mat3 R_pj;
-    do R_pj = Eigen::AngleAxisd(rng.uniform(-M_PI, M_PI), n_p).toRotationMatrix() * cubeRotation(rng);
+    do
+      R_pj =
+          Eigen::AngleAxisd(rng.uniform(-M_PI, M_PI), n_p).toRotationMatrix() * cubeRotation(rng);
     while (std::abs(R_pj(2, 0)) > 0.9);
     R_root.push_back(R_root[parent] * R_pj);
     const Vec3 n_c = R_pj.transpose() * n_p;
@@ -123,9 +126,11 @@ PlanarRobot randomPlanar(const PlanarSpec& spec) {
     const bool prismatic = spec.prismatic_every > 0 && k % spec.prismatic_every == 0;
     const Vec3 axis = prismatic ? inPlane(rng, n_c) : (rng.uniform(0, 1) < 0.5 ? -n_c : n_c);
     link(k, n_c);
-    xml += "<joint name=\"j" + std::to_string(k) + "\" type=\"" + (prismatic ? "prismatic" : "revolute") +
-           "\"><parent link=\"link" + std::to_string(parent) + "\"/><child link=\"link" + std::to_string(k) +
-           "\"/><origin xyz=\"" + vec(xyz) + "\" rpy=\"" + rpyOf(R_pj) + "\"/><axis xyz=\"" + vec(axis) +
+    xml += "<joint name=\"j" + std::to_string(k) + "\" type=\"" +
+           (prismatic ? "prismatic" : "revolute") + "\"><parent link=\"link" +
+           std::to_string(parent) + "\"/><child link=\"link" + std::to_string(k) +
+           "\"/><origin xyz=\"" + vec(xyz) + "\" rpy=\"" + rpyOf(R_pj) + "\"/><axis xyz=\"" +
+           vec(axis) +
            "\"/><limit lower=\"-1e9\" upper=\"1e9\" effort=\"1e9\" velocity=\"1e9\"/></joint>\n";
     // A massless tool frame on every link, turned arbitrarily: wrench inputs act there.
     Mat3 R_tip;
@@ -134,8 +139,9 @@ PlanarRobot randomPlanar(const PlanarSpec& spec) {
     Vec3 tip = 0.2 * rng.uniform(0, 1) * inPlane(rng, n_c);
     if (spec.offsets) tip += rng.uniform(-0.1, 0.1) * n_c;
     xml += "<link name=\"tip" + std::to_string(k) + "\"/><joint name=\"tip" + std::to_string(k) +
-           "_joint\" type=\"fixed\"><parent link=\"link" + std::to_string(k) + "\"/><child link=\"tip" +
-           std::to_string(k) + "\"/><origin xyz=\"" + vec(tip) + "\" rpy=\"" + rpyOf(R_tip) + "\"/></joint>\n";
+           "_joint\" type=\"fixed\"><parent link=\"link" + std::to_string(k) +
+           "\"/><child link=\"tip" + std::to_string(k) + "\"/><origin xyz=\"" + vec(tip) +
+           "\" rpy=\"" + rpyOf(R_tip) + "\"/></joint>\n";
     out.tip_normal.push_back(R_tip.transpose() * n_c);
   }
   out.urdf = xml + "</robot>\n";
@@ -184,7 +190,7 @@ std::vector<int> allSegments(const jle::Model<double>& m) {
 
 // In-plane wrench for a frame whose normal is n (link frame): force across n, moment along n.
 void inPlaneWrench(jle_test::Random& rng, const Vec3& n, Vec3& f, Vec3& m) {
-  f = rng.uniform(-50, 50) * inPlane(rng, n) ;
+  f = rng.uniform(-50, 50) * inPlane(rng, n);
   m = rng.uniform(-5, 5) * n;
 }
 
@@ -242,7 +248,8 @@ struct EstimatorRun {
 };
 
 EstimatorRun runEstimator(const jle::Model<double>& model, jle::EstimatorConfig config,
-                 const std::function<void(jle::Estimator&, int, double)>& wrenches, int n = 80) {
+                          const std::function<void(jle::Estimator&, int, double)>& wrenches,
+                          int n = 80) {
   jle::Estimator estimator(model, config);
   EstimatorRun out;
   Eigen::VectorXd q(model.nq);
@@ -273,7 +280,8 @@ TEST(Planar, EstimatorAutoMatchesOffOnATreeWithWrenchInputs) {
   spec.seed = 7;
   const PlanarRobot robot = randomPlanar(spec);
   const jle::Model<double> model = jle::modelFromUrdfString(robot.urdf);
-  jle::EstimatorConfig on = withPlanar(jle::PlanarMode::kAuto), off = withPlanar(jle::PlanarMode::kOff);
+  jle::EstimatorConfig on = withPlanar(jle::PlanarMode::kAuto),
+                       off = withPlanar(jle::PlanarMode::kOff);
   for (jle::EstimatorConfig* c : {&on, &off}) {
     c->gravity_world = robot.gravity;
     for (int k : {2, 5, 9}) {
@@ -289,7 +297,8 @@ TEST(Planar, EstimatorAutoMatchesOffOnATreeWithWrenchInputs) {
     int input = 0;
     for (int k : {2, 5, 9}) {
       const Vec3& n = robot.tip_normal[k];
-      const Vec3 across = n.cross(Vec3(1, 0, 0)).norm() > 0.1 ? n.cross(Vec3(1, 0, 0)) : n.cross(Vec3(0, 1, 0));
+      const Vec3 across =
+          n.cross(Vec3(1, 0, 0)).norm() > 0.1 ? n.cross(Vec3(1, 0, 0)) : n.cross(Vec3(0, 1, 0));
       e.addWrench(input++, t, (20 + 100 * t) * across.normalized(), (1 - 30 * t) * n);
     }
   };
@@ -298,12 +307,14 @@ TEST(Planar, EstimatorAutoMatchesOffOnATreeWithWrenchInputs) {
   ASSERT_GT(a.loads.size(), 50u);
   EXPECT_EQ(a.planar, static_cast<int>(a.loads.size()));
   EXPECT_EQ(b.planar, 0);
-  for (std::size_t k = 0; k < a.loads.size(); ++k) expectClose(a.loads[k], b.loads[k], kRel, "sample");
+  for (std::size_t k = 0; k < a.loads.size(); ++k)
+    expectClose(a.loads[k], b.loads[k], kRel, "sample");
 }
 
 TEST(Planar, OutOfPlaneWrenchSampleFallsBackTo6x6) {
   const jle::Model<double> arm = jle::modelFromUrdfFile(kData + "/urdf/planar_arm.urdf");
-  jle::EstimatorConfig on = withPlanar(jle::PlanarMode::kAuto), off = withPlanar(jle::PlanarMode::kOff);
+  jle::EstimatorConfig on = withPlanar(jle::PlanarMode::kAuto),
+                       off = withPlanar(jle::PlanarMode::kOff);
   for (jle::EstimatorConfig* c : {&on, &off}) {
     jle::WrenchInputConfig w;
     w.name = "tool";
@@ -323,7 +334,8 @@ TEST(Planar, OutOfPlaneWrenchSampleFallsBackTo6x6) {
   const int fallback = static_cast<int>(a.loads.size()) - a.planar;
   EXPECT_GE(fallback, 20);
   EXPECT_LE(fallback, 22);
-  for (std::size_t k = 0; k < a.loads.size(); ++k) expectClose(a.loads[k], b.loads[k], kRel, "sample");
+  for (std::size_t k = 0; k < a.loads.size(); ++k)
+    expectClose(a.loads[k], b.loads[k], kRel, "sample");
 }
 
 // ---------------------------------------------------------------------------------
@@ -352,7 +364,8 @@ TEST(Planar, PapersFootThroughThePlanarPath) {
     jle::planarKinematics(model, pm, pd, q, qd, qdd, gravity, segments);
     // The plate's force in the cop frame (which turns with the foot).
     const Eigen::Vector2d F_P_foot = i.Q.transpose() * i.F_P;
-    jle::planarAddExternalWrench(model, pm, pd, cop, Vec3(F_P_foot.x(), F_P_foot.y(), 0), Vec3(Vec3::Zero()));
+    jle::planarAddExternalWrench(model, pm, pd, cop, Vec3(F_P_foot.x(), F_P_foot.y(), 0),
+                                 Vec3(Vec3::Zero()));
     jle::planarInverseDynamics(model, pm, pd, data, segments);
     // Child frame -> world: the foot frame is turned by theta about z.
     const Vec3 F = Eigen::AngleAxisd(theta, Vec3::UnitZ()) * data.force[s];
@@ -370,25 +383,32 @@ TEST(Planar, PapersFootThroughThePlanarPath) {
 // ---------------------------------------------------------------------------------
 // Detection.
 
-std::string twoLinks(const std::string& axis2, const std::string& inertia2 = "ixy=\"0\" ixz=\"0\" iyz=\"0\"",
+std::string twoLinks(const std::string& axis2,
+                     const std::string& inertia2 = "ixy=\"0\" ixz=\"0\" iyz=\"0\"",
                      const std::string& rpy2 = "0 0 0.4") {
   return "<robot name=\"two\"><link name=\"base\"/>"
          "<link name=\"a\"><inertial><origin xyz=\"0.2 0.01 0.03\"/><mass value=\"2\"/>"
-         "<inertia ixx=\"0.01\" ixy=\"0.001\" ixz=\"0\" iyy=\"0.02\" iyz=\"0\" izz=\"0.025\"/></inertial></link>"
+         "<inertia ixx=\"0.01\" ixy=\"0.001\" ixz=\"0\" iyy=\"0.02\" iyz=\"0\" "
+         "izz=\"0.025\"/></inertial></link>"
          "<link name=\"b\"><inertial><origin xyz=\"0.1 0 0\"/><mass value=\"1\"/>"
-         "<inertia ixx=\"0.004\" iyy=\"0.005\" izz=\"0.006\" " + inertia2 + "/></inertial></link>"
+         "<inertia ixx=\"0.004\" iyy=\"0.005\" izz=\"0.006\" " +
+         inertia2 +
+         "/></inertial></link>"
          "<joint name=\"j1\" type=\"revolute\"><parent link=\"base\"/><child link=\"a\"/>"
-         "<axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>"
+         "<axis xyz=\"0 0 1\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" "
+         "velocity=\"1\"/></joint>"
          "<joint name=\"j2\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
-         "<origin xyz=\"0.4 0 0.05\" rpy=\"" + rpy2 + "\"/><axis xyz=\"" + axis2 +
+         "<origin xyz=\"0.4 0 0.05\" rpy=\"" +
+         rpy2 + "\"/><axis xyz=\"" + axis2 +
          "\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint></robot>";
 }
 
 TEST(Planar, DetectionAcceptsPlanarModels) {
   const Vec3 g(0, -kG, 0);
-  for (const std::string& urdf : {twoLinks("0 0 1"), twoLinks("0 0 -1"),
-                                  // A child frame flipped about x: its axis is -z... of the parent.
-                                  twoLinks("0 0 -1", "ixy=\"0\" ixz=\"0\" iyz=\"0\"", "3.141592653589793 0 0")}) {
+  for (const std::string& urdf :
+       {twoLinks("0 0 1"), twoLinks("0 0 -1"),
+        // A child frame flipped about x: its axis is -z... of the parent.
+        twoLinks("0 0 -1", "ixy=\"0\" ixz=\"0\" iyz=\"0\"", "3.141592653589793 0 0")}) {
     const jle::Model<double> model = jle::modelFromUrdfString(urdf);
     const jle::PlanarCheck<double> c = jle::detectPlanar(model, g);
     EXPECT_TRUE(c.planar) << c.reason;
@@ -418,7 +438,8 @@ TEST(Planar, DetectionRefusesWhatIsNotPlanar) {
   // Gravity with a component along the normal.
   refused(jle::modelFromUrdfString(twoLinks("0 0 1")), Vec3(0, -kG, -1e-6), "gravity");
   // A product of inertia coupling n (ixz).
-  refused(jle::modelFromUrdfString(twoLinks("0 0 1", "ixy=\"0\" ixz=\"0.0001\" iyz=\"0\"")), g, "'b'");
+  refused(jle::modelFromUrdfString(twoLinks("0 0 1", "ixy=\"0\" ixz=\"0.0001\" iyz=\"0\"")), g,
+          "'b'");
   // A floating base.
   jle::ModelOptions floating;
   floating.floating_base = true;
@@ -441,11 +462,15 @@ TEST(Planar, PruningLeavesOnlyTheJointsThatMatter) {
   // joints published, detection looks at the leg alone.
   const std::string urdf =
       "<robot name=\"mixed\"><link name=\"base\"/>"
-      "<link name=\"leg\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>"
-      "<link name=\"arm\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>"
-      "<joint name=\"knee\" type=\"revolute\"><parent link=\"base\"/><child link=\"leg\"/><axis xyz=\"0 0 1\"/>"
+      "<link name=\"leg\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" "
+      "iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>"
+      "<link name=\"arm\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" ixy=\"0\" ixz=\"0\" "
+      "iyy=\"0.01\" iyz=\"0\" izz=\"0.01\"/></inertial></link>"
+      "<joint name=\"knee\" type=\"revolute\"><parent link=\"base\"/><child link=\"leg\"/><axis "
+      "xyz=\"0 0 1\"/>"
       "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>"
-      "<joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm\"/><axis xyz=\"1 0 0\"/>"
+      "<joint name=\"shoulder\" type=\"revolute\"><parent link=\"base\"/><child "
+      "link=\"arm\"/><axis xyz=\"1 0 0\"/>"
       "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint></robot>";
   const jle::Model<double> model = jle::modelFromUrdfString(urdf);
   jle::EstimatorConfig c;
@@ -459,7 +484,8 @@ TEST(Planar, ForcedModeDropsWhatDetectionRefused) {
   // Axis tilted by 1e-9: forced, the planar path runs and agrees with 6x6 to the size
   // of what it drops (1e-9 relative; bound 1e-7 with margin for the lever arms).
   const jle::Model<double> tilted = jle::modelFromUrdfString(twoLinks("0 1e-9 1"));
-  jle::EstimatorConfig on = withPlanar(jle::PlanarMode::kOn), off = withPlanar(jle::PlanarMode::kOff);
+  jle::EstimatorConfig on = withPlanar(jle::PlanarMode::kOn),
+                       off = withPlanar(jle::PlanarMode::kOff);
   on.gravity_world = off.gravity_world = Vec3(0, -kG, 0);
   jle::Estimator probe(tilted, on);
   EXPECT_TRUE(probe.planar());
@@ -468,7 +494,8 @@ TEST(Planar, ForcedModeDropsWhatDetectionRefused) {
   const EstimatorRun a = runEstimator(tilted, on, none), b = runEstimator(tilted, off, none);
   ASSERT_EQ(a.loads.size(), b.loads.size());
   EXPECT_EQ(a.planar, static_cast<int>(a.loads.size()));
-  for (std::size_t k = 0; k < a.loads.size(); ++k) expectClose(a.loads[k], b.loads[k], 1e-7, "forced");
+  for (std::size_t k = 0; k < a.loads.size(); ++k)
+    expectClose(a.loads[k], b.loads[k], 1e-7, "forced");
   // Forced on a planar model: same as auto.
   const jle::Model<double> planar = jle::modelFromUrdfString(twoLinks("0 0 1"));
   jle::EstimatorConfig aut = withPlanar(jle::PlanarMode::kAuto);
@@ -483,7 +510,8 @@ TEST(Planar, ForcedModeDropsWhatDetectionRefused) {
   // What cannot be forced: a floating base, a model without a revolute joint.
   jle::ModelOptions floating;
   floating.floating_base = true;
-  EXPECT_THROW(jle::Estimator(jle::modelFromUrdfString(twoLinks("0 0 1"), floating), on), std::invalid_argument);
+  EXPECT_THROW(jle::Estimator(jle::modelFromUrdfString(twoLinks("0 0 1"), floating), on),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 // The force plates' unit (plate_inputs.hpp): a static plate under a known foot, the
 // contact threshold on the raw samples, the contact at the estimate's stamp, the stale
 // policies and the refused configurations, against numbers worked by hand.
+#include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/estimator.hpp>  // PlateInputConfig
 #include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/plate_inputs.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -47,7 +47,8 @@ jle::PlateInputConfig plateConfig(jle::StalePolicy policy = jle::StalePolicy::kZ
 // The plates with a 3-point filter bank beside them, fed like the estimator feeds them:
 // each plate sample, then the plates resampled at the joint stamp into the bank.
 struct Rig {
-  explicit Rig(const jle::DifferentiatorConfig& d, jle::StalePolicy policy = jle::StalePolicy::kZero)
+  explicit Rig(const jle::DifferentiatorConfig& d,
+               jle::StalePolicy policy = jle::StalePolicy::kZero)
       : model(jle::modelFromUrdfFile(kUrdf)),
         data(model),
         plates(model, {plateConfig(policy)}, 0),
@@ -133,7 +134,8 @@ TEST(PlateInputs, ContactIsTakenOnTheRawSignalAtTheStamp) {
 
 // Timeout 0.5 s: a joint sample 0.6 s after the last plate sample finds it stale.
 TEST(PlateInputs, StalePolicies) {
-  for (jle::StalePolicy p : {jle::StalePolicy::kHold, jle::StalePolicy::kZero, jle::StalePolicy::kStop}) {
+  for (jle::StalePolicy p :
+       {jle::StalePolicy::kHold, jle::StalePolicy::kZero, jle::StalePolicy::kStop}) {
     Rig rig(threePoint(), p);
     rig.step(1.0, kF, kM);
     EXPECT_FALSE(rig.plates.stale(0));
@@ -146,7 +148,8 @@ TEST(PlateInputs, StalePolicies) {
 
 TEST(PlateInputs, NotNeededIsNeitherReadNorStale) {
   Rig rig(threePoint(), jle::StalePolicy::kStop);
-  rig.plates.setNeeded(rig.model, std::vector<char>(static_cast<std::size_t>(rig.model.nsegments()), 0));
+  rig.plates.setNeeded(rig.model,
+                       std::vector<char>(static_cast<std::size_t>(rig.model.nsegments()), 0));
   EXPECT_FALSE(rig.plates.needed(0));
   rig.plates.add(0, 1.0, kF, kM);
   rig.plates.resample(5.0, rig.channels.data());
@@ -170,7 +173,8 @@ TEST(PlateInputs, PoseMovesTheReaction) {
   for (int k = 0; k < 3; ++k) rig.step(1.0 + 1e-3 * k, kF, kM);
   rig.apply();
   const int foot = rig.model.segmentOfJoint("ankle_l");
-  EXPECT_NEAR((rig.data.n_ext[foot] - (kReactionMoment + Vector3d(70.0, 0.0, 0.0))).norm(), 0.0, kTol);
+  EXPECT_NEAR((rig.data.n_ext[foot] - (kReactionMoment + Vector3d(70.0, 0.0, 0.0))).norm(), 0.0,
+              kTol);
 }
 
 TEST(PlateInputs, RefusedConfigurationsNameThePlate) {

@@ -177,9 +177,7 @@ void runStanceSwingStance(const jle::DifferentiatorConfig& differentiator, Stanc
   EXPECT_GE(swing_checked, 55);
   // Every published stance stamp was checked: Kalman (4 samples of warm-up, stamp = the
   // newest) 3..59; Savitzky-Golay (9 samples, stamp 4 behind) 4..59 and 120..195.
-  EXPECT_EQ(stance_checked, differentiator.type == jle::DifferentiatorType::kKalman
-                                ? 57
-                                : 56 + 76);
+  EXPECT_EQ(stance_checked, differentiator.type == jle::DifferentiatorType::kKalman ? 57 : 56 + 76);
 }
 
 TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootSavitzkyGolayCentred) {

@@ -84,13 +84,14 @@ TEST_F(PlatesOffline, SettingsParsed) {
   EXPECT_TRUE(p.pose_configured);
   EXPECT_EQ(input.plate.p_world_plate, Eigen::Vector3d(0.3, 0.2, -0.04));
   // [0, 0, 1, 1] normalised: 90 degrees about z, x -> y (exact to rounding, 1e-15).
-  EXPECT_NEAR((input.plate.R_world_plate * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY())
-                  .norm(), 0.0, 1e-15);
+  EXPECT_NEAR(
+      (input.plate.R_world_plate * Eigen::Vector3d::UnitX() - Eigen::Vector3d::UnitY()).norm(), 0.0,
+      1e-15);
   EXPECT_EQ(s.body_mass, 70.0);
 
   // Defaults: zero policy, 20 N, 0.1 s, no pose (tf2), body_mass 0.
-  const jle::Settings d = jle::parseSettings(
-      yaml("force_plates: [{name: a, topic: t, link: foot}]", dir_));
+  const jle::Settings d =
+      jle::parseSettings(yaml("force_plates: [{name: a, topic: t, link: foot}]", dir_));
   EXPECT_EQ(d.estimator.plates[0].stale_policy, jle::StalePolicy::kZero);
   EXPECT_EQ(d.estimator.plates[0].plate.contact_threshold, 20.0);
   EXPECT_EQ(d.estimator.plates[0].timeout, 0.1);

@@ -244,8 +244,7 @@ Expected expectedLoads(const Messages& m) {
     for (const char* name : {"panda_joint2", "panda_joint4", "panda_joint7"})
       for (std::size_t i = 0; i < j.second.name.size(); ++i)
         if (j.second.name[i] == name) effort.push_back(j.second.effort[i]);
-    if (estimator.addJointSample(rel(j.first), q.data()) != jle::SampleStatus::kPublished)
-      continue;
+    if (estimator.addJointSample(rel(j.first), q.data()) != jle::SampleStatus::kPublished) continue;
     e.t.push_back((origin + ros::Duration(estimator.stamp())).toSec());
     std::vector<double> row;
     for (int s : published) {

@@ -72,7 +72,8 @@ void expectIdentical(const std::vector<std::vector<double>>& a,
 
 TEST(Savings, PruningToTheAskedJointsIsBitExact) {
   const jle::Model<double> talos = jle::modelFromUrdfFile(kData + "/urdf/talos_reduced.urdf");
-  const std::vector<std::string> asked = {"leg_left_4_joint", "leg_left_5_joint", "arm_right_7_joint"};
+  const std::vector<std::string> asked = {"leg_left_4_joint", "leg_left_5_joint",
+                                          "arm_right_7_joint"};
   jle::EstimatorConfig pruned = noSavings(), full = noSavings();
   pruned.savings.prune = true;
   pruned.joints = asked;

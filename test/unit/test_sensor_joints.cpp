@@ -67,8 +67,8 @@ struct Rig {
     const double x[6] = {f.x(), f.y(), f.z(), m.x(), m.y(), m.z()};
     for (int k = 0; k < 3; ++k) bank.update(1.0 + 1e-3 * k, x);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1);
-    jle::forwardKinematics(model, data, Eigen::VectorXd(Eigen::VectorXd::Constant(1, q)), zero, zero,
-                           Vector3d(0.0, 0.0, -kG));
+    jle::forwardKinematics(model, data, Eigen::VectorXd(Eigen::VectorXd::Constant(1, q)), zero,
+                           zero, Vector3d(0.0, 0.0, -kG));
     sensors.setUsed(1, used);
     std::vector<int> all;
     for (int i = 0; i < model.nsegments(); ++i) all.push_back(i);
@@ -135,7 +135,8 @@ TEST(SensorJoints, ProximalJointsCarryTheMeasurement) {
 
 TEST(SensorJoints, RefusedConfigurationsNameTheInput) {
   const jle::Model<double> model = arm();
-  auto message = [](const jle::Model<double>& mdl, const std::vector<jle::WrenchInputConfig>& inputs) {
+  auto message = [](const jle::Model<double>& mdl,
+                    const std::vector<jle::WrenchInputConfig>& inputs) {
     jle::SensorJoints sensors(mdl.nsegments());
     try {
       for (const jle::WrenchInputConfig& c : inputs) sensors.add(mdl, c, 0);

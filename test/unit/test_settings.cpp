@@ -28,7 +28,8 @@ Settings parseFile(const std::string& path) { return jle::parseSettings(jle::loa
 
 // Parses YAML text (through a file, as process_bag reads it).
 Settings parseText(const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("jle_settings_" + std::to_string(getpid()) + ".yaml");
+  const fs::path path =
+      fs::temp_directory_path() / ("jle_settings_" + std::to_string(getpid()) + ".yaml");
   std::ofstream(path) << text;
   try {
     Settings s = parseFile(path.string());
@@ -193,7 +194,8 @@ const Refused kRefused[] = {
 TEST(SettingsReader, EachKoFileIsRefusedWithItsReason) {
   for (const Refused& r : kRefused) {
     const std::string why = refusal(kConfig + "/" + r.file);
-    EXPECT_NE(why.find(std::string("parameter ") + r.key), std::string::npos) << r.file << ": " << why;
+    EXPECT_NE(why.find(std::string("parameter ") + r.key), std::string::npos)
+        << r.file << ": " << why;
     EXPECT_NE(why.find(r.reason), std::string::npos) << r.file << ": " << why;
   }
 }
@@ -322,11 +324,13 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
   expectRefused("decimation: 1.5", "parameter 'decimation' must be an integer");
   expectRefused("gravity: [0, 0]", "parameter 'gravity' must be a list of 3 numbers");
   expectRefused("gravity: [0, 0, g]", "parameter 'gravity[2]' must be a number");
-  expectRefused("precision: half", "parameter 'precision' is 'half'; expected one of double, float");
+  expectRefused("precision: half",
+                "parameter 'precision' is 'half'; expected one of double, float");
   expectRefused("differentiator: {delay: middle}", "'differentiator/delay' must be an integer or");
   expectRefused("savings: {prune: 1}", "parameter 'savings/prune' must be true or false");
   expectRefused("uncertainty: {decimation: 4}", "'uncertainty/decimation' is replaced by");
-  expectRefused("wrenches: [{topic: t, link: l, stale_policy: keep}]", "'wrenches[0]/stale_policy'");
+  expectRefused("wrenches: [{topic: t, link: l, stale_policy: keep}]",
+                "'wrenches[0]/stale_policy'");
   expectRefused("wrenches: [{topic: t, lnk: l}]", "unknown parameter 'wrenches[0]/lnk'");
   expectRefused("wrenches: [{topic: t}]", "parameter 'wrenches[0]/link' is required");
   expectRefused("force_plates: [{name: a, topic: t, link: f, orientation: [0, 0, 0, 0]}]",

@@ -27,8 +27,8 @@ std::string readFile(const std::string& path) {
 Eigen::Isometry3d toEigen(const urdf::Pose& p) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() << p.position.x, p.position.y, p.position.z;
-  X.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z)
-                   .toRotationMatrix();
+  X.linear() =
+      Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).toRotationMatrix();
   return X;
 }
 

@@ -54,9 +54,9 @@ class EstimatorNode {
   // ~calibrate_bias in progress: fed by publishConsistency(), read by the service
   // thread.
   struct Calibration {
-    bool active = false;        // a service call is waiting for its window
-    ros::WallTime last_sample;  // when the window last took a sample (or started)
-    BiasEstimator estimator;    // one sensor per entry of sensor_topics_, in their order
+    bool active = false;             // a service call is waiting for its window
+    ros::WallTime last_sample;       // when the window last took a sample (or started)
+    BiasEstimator estimator;         // one sensor per entry of sensor_topics_, in their order
     std::vector<BiasSample> sample;  // the sample handed to it (kept: no allocation)
     std::vector<char> needed;        // per coordinate: whether the loads need it
   };
@@ -113,9 +113,9 @@ class EstimatorNode {
   double latency_sum_ = 0.0, latency_max_ = 0.0;
   long latency_count_ = 0;
   // Consistency.
-  std::vector<std::size_t> sensor_topics_;  // indices of the sensor inputs
+  std::vector<std::size_t> sensor_topics_;               // indices of the sensor inputs
   double base_force_max_ = 0.0, base_moment_max_ = 0.0;  // since the last diagnosis
-  double total_weight_ = 0.0;                             // [N] m |g|
+  double total_weight_ = 0.0;                            // [N] m |g|
   // ~calibrate_bias runs on its own queue and thread, so that collecting its window
   // does not stall the joint-state callbacks it is waiting for. The biases it finds are
   // handed to the pipeline on the callbacks' thread (bias_pending_).

@@ -130,11 +130,11 @@ struct SensorModel {
   double drop_probability = 0.0;  ///< probability that a joint sample is lost
 
   /// Force/torque inputs: samples at wrench_offset + j / wrench_rate, stamped exactly.
-  double wrench_rate = 0.0;    ///< [Hz]; 0: the joint rate
-  double wrench_offset = 0.0;  ///< [s] the first sample's time
-  double force_noise = 0.0;    ///< standard deviation per component [N]
-  double moment_noise = 0.0;   ///< standard deviation per component [N m]
-  Eigen::Vector3d force_bias = Eigen::Vector3d::Zero();   ///< added to every sample [N]
+  double wrench_rate = 0.0;                              ///< [Hz]; 0: the joint rate
+  double wrench_offset = 0.0;                            ///< [s] the first sample's time
+  double force_noise = 0.0;                              ///< standard deviation per component [N]
+  double moment_noise = 0.0;                             ///< standard deviation per component [N m]
+  Eigen::Vector3d force_bias = Eigen::Vector3d::Zero();  ///< added to every sample [N]
   Eigen::Vector3d moment_bias = Eigen::Vector3d::Zero();  ///< [N m]
   double wrench_drop_probability = 0.0;
 };
@@ -151,7 +151,7 @@ struct JointReading {
 /// in the link's frame, applied to the robot.
 struct WrenchReading {
   int input = 0;
-  double stamp = 0.0;  ///< [s]
+  double stamp = 0.0;                                ///< [s]
   Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< [N]
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< [N m]
 };

@@ -1,8 +1,8 @@
 // The tests' random numbers (jle::PortableRandom with the draws tests need: vectors,
 // rotations, log-uniform numbers), random robot models as URDF strings, deterministic
 // from a seed, and the error of the joint loads computed in one scalar type against a
-// more precise one on the same inputs. Part of the test support library (joint_load_estimator_testing):
-// shared by the unit tests and bench/ (stability, speed_core).
+// more precise one on the same inputs. Part of the test support library
+// (joint_load_estimator_testing): shared by the unit tests and bench/ (stability, speed_core).
 #pragma once
 
 #include <joint_load_estimator/dynamics.hpp>
@@ -158,7 +158,7 @@ struct State {
 /// {q, qd, qdd, prismatic_centre, prismatic_q, prismatic_qd, prismatic_qdd}.
 struct StateRanges {
   double q = M_PI, qd = 1.0, qdd = 5.0;  ///< revolute: q in [-q, q)
-  double prismatic_centre = 0.0;          ///< prismatic: q in prismatic_centre +- prismatic_q
+  double prismatic_centre = 0.0;         ///< prismatic: q in prismatic_centre +- prismatic_q
   double prismatic_q = 0.3, prismatic_qd = 1.0, prismatic_qdd = 5.0;
 };
 
