@@ -408,18 +408,14 @@ void BagProcessor::checkTopics(const rosbag::Bag& in, rosbag::View& view) {
         options_.bag + ": no messages on the joint states topic '" + joint_topic_ +
         "' (parameter joint_states_topic); the bag has: " + (all.empty() ? "nothing" : all));
   }
-  for (const std::string& w : wrench_topics_)
-    if (!present.count(w))
-      std::fprintf(stderr,
-                   "process_bag: warning: no messages on wrench topic '%s' in %s: the loads "
-                   "are computed without it\n",
-                   w.c_str(), options_.bag.c_str());
-  for (const std::string& p : plate_topics_)
-    if (!present.count(p))
-      std::fprintf(stderr,
-                   "process_bag: warning: no messages on force plate topic '%s' in %s: the "
-                   "loads are computed without it\n",
-                   p.c_str(), options_.bag.c_str());
+  for (const auto& inputs :
+       {std::make_pair("wrench", &wrench_topics_), std::make_pair("force plate", &plate_topics_)})
+    for (const std::string& topic : *inputs.second)
+      if (!present.count(topic))
+        std::fprintf(stderr,
+                     "process_bag: warning: no messages on %s topic '%s' in %s: the loads are "
+                     "computed without it\n",
+                     inputs.first, topic.c_str(), options_.bag.c_str());
 }
 
 void BagProcessor::summarize(double total_s) const {
