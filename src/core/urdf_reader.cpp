@@ -205,10 +205,14 @@ struct Builder {
   const ModelOptions& options;
   std::map<std::string, int> link_index;
   Model<double> model;
-  // Per segment: accumulated mass, first moment and inertia about the segment origin.
-  std::vector<double> mass;
-  std::vector<Vector3> first_moment;
-  std::vector<Matrix3> inertia_origin;
+  // Per segment: the inertials of its links (several where fixed joints merged links),
+  // each in the segment frame about its own centre of mass.
+  struct Part {
+    double mass;
+    Vector3 com;
+    Matrix3 inertia;
+  };
+  std::vector<std::vector<Part>> parts;
 
   int addSegment(int parent, JointType type, const std::string& link, const std::string& joint) {
     model.parent.push_back(parent);
@@ -223,9 +227,7 @@ struct Builder {
     model.coordinate.push_back(-1);
     model.multiplier.push_back(1.0);
     model.offset.push_back(0.0);
-    mass.push_back(0.0);
-    first_moment.push_back(Vector3::Zero());
-    inertia_origin.push_back(Matrix3::Zero());
+    parts.emplace_back();
     return static_cast<int>(model.parent.size()) - 1;
   }
 
@@ -240,12 +242,26 @@ struct Builder {
     if (!l.has_inertial) return;
     checkInertia(l, options.triangle_tolerance, model.warnings);
     const Pose X = X_segment_link * l.inertial_origin;
-    const Matrix3 I = X.R * l.inertia * X.R.transpose();
-    mass[segment] += l.mass;
-    first_moment[segment] += l.mass * X.p;
-    // Parallel-axis theorem to the segment origin.
-    inertia_origin[segment] +=
-        I + l.mass * (X.p.squaredNorm() * Matrix3::Identity() - X.p * X.p.transpose());
+    parts[segment].push_back({l.mass, X.p, X.R * l.inertia * X.R.transpose()});
+  }
+
+  // Mass, centre of mass and inertia about it of a segment's parts. The parallel-axis
+  // terms use each part's offset from the common centre of mass, never from the segment
+  // origin: a centre of mass D from the origin would otherwise enter as m D^2 added and
+  // subtracted again, losing the inertia's digits (with one part the offset is zero and
+  // the inertia is the URDF's, rotated).
+  static void combine(const std::vector<Part>& parts, double& mass, Vector3& com,
+                      Matrix3& inertia) {
+    mass = 0.0;
+    for (const Part& p : parts) mass += p.mass;
+    com.setZero();
+    inertia.setZero();
+    if (!(mass > 0.0)) return;
+    for (const Part& p : parts) com += (p.mass / mass) * p.com;
+    for (const Part& p : parts) {
+      const Vector3 d = p.com - com;
+      inertia += p.inertia + p.mass * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose());
+    }
   }
 
   // Depth first from `link` (already placed on `segment` at X_segment_link), children
@@ -340,12 +356,13 @@ struct Builder {
 
   void finish() {
     for (int s = 0; s < model.nsegments(); ++s) {
-      const double m = mass[s];
-      const Vector3 c = m > 0.0 ? Vector3(first_moment[s] / m) : Vector3::Zero();
+      double m;
+      Vector3 c;
+      Matrix3 inertia;
+      combine(parts[s], m, c, inertia);
       model.mass.push_back(m);
       model.com.push_back(c);
-      model.inertia_com.push_back(inertia_origin[s] -
-                                  m * (c.squaredNorm() * Matrix3::Identity() - c * c.transpose()));
+      model.inertia_com.push_back(inertia);
       if (isMoving(model.joint_type[s])) model.moving_segments.push_back(s);
     }
     if (!(model.totalMass() > 0.0))
@@ -468,7 +485,7 @@ void checkReached(const Builder& b, const Description& d, int root, bool root_le
 Model<double> modelFromUrdfString(const std::string& xml, const ModelOptions& options) {
   const Description d = parseRobot(xml, options);
   const int root = rootLink(d);
-  Builder b{d.links, d.joints, options, d.link_index, {}, {}, {}, {}};
+  Builder b{d.links, d.joints, options, d.link_index, {}, {}};
   const bool root_left_out = buildTree(b, d, root);
   checkReached(b, d, root, root_left_out);
   b.resolveMimics();
