@@ -168,35 +168,55 @@ double relativeCutoff(const Grid& grid, double cutoff) {
   return w;
 }
 
-// Mean square of x - smooth(x) over every channel, cutoff w [1/sample], away from the
-// ends: the padding's transient (odd reflection bends the curvature) would otherwise
-// dominate the residual at low cutoffs. The margin is 2 / w samples (two periods of the
-// cutoff) at each end, at most a quarter of the record.
-double meanSquareResidual(const Eigen::MatrixXd& xg, double w, int order, int pad) {
-  const Eigen::MatrixXd s = smoothPadded(xg, w, order, pad);
-  const Eigen::Index n = xg.rows();
-  const Eigen::Index margin = std::min<Eigen::Index>(static_cast<Eigen::Index>(std::ceil(2.0 / w)), n / 4);
-  const Eigen::Index inner = n - 2 * margin;
-  return (xg.middleRows(margin, inner) - s.middleRows(pad + margin, inner)).squaredNorm() /
-         static_cast<double>(inner * xg.cols());
-}
+// The channels on the grid that a cutoff is chosen for, and the search's constants.
+struct CutoffSearch {
+  const Eigen::MatrixXd& xg;
+  int order, pad;
+  double w_lo;          // the lowest cutoff searched [1/sample]
+  Eigen::Index margin;  // samples left out of the residual at each end
+
+  // Mean square of x - smooth(x) over every channel at cutoff w [1/sample], away from
+  // the ends: there the padding's transient (odd reflection bends the curvature) would
+  // dominate the residual at low cutoffs.
+  double meanSquareResidual(double w) const {
+    const Eigen::MatrixXd s = smoothPadded(xg, w, order, pad);
+    const Eigen::Index inner = xg.rows() - 2 * margin;
+    return (xg.middleRows(margin, inner) - s.middleRows(pad + margin, inner)).squaredNorm() /
+           static_cast<double>(inner * xg.cols());
+  }
+
+  // The generalised cross-validation score at cutoff w: mean square residual /
+  // (1 - tr(S) / L)^2, tr(S) from the filter's gain |H|^2 at the L DFT frequencies of the
+  // record (the circulant approximation of the smoother S).
+  double gcvScore(double w) const {
+    const Eigen::Index n = xg.rows();
+    const double tc = std::tan(M_PI * w);
+    double trace = 0.0;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const double ratio = std::tan(M_PI * static_cast<double>(k) / n) / tc;
+      trace += 1.0 / (1.0 + std::pow(ratio * ratio, order));
+    }
+    const double dof = 1.0 - trace / static_cast<double>(n);
+    return meanSquareResidual(w) / (dof * dof);
+  }
+};
 
 // Winter's residual analysis: the residual's RMS R(w) is a straight line where it holds
 // only noise (fitted over 0.2 .. 0.4 of the sampling rate); its intercept a at w = 0
 // estimates the noise, and the cutoff is where R(w) = a (bisection on log w).
-double residualCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
+double residualCutoff(const CutoffSearch& search) {
   const int fits = 9;
   double sw = 0, sr = 0, sww = 0, swr = 0;
   for (int j = 0; j < fits; ++j) {
     const double w = 0.2 + 0.025 * j;
-    const double r = std::sqrt(meanSquareResidual(xg, w, order, pad));
+    const double r = std::sqrt(search.meanSquareResidual(w));
     sw += w, sr += r, sww += w * w, swr += w * r;
   }
   const double slope = (fits * swr - sw * sr) / (fits * sww - sw * sw);
   const double a = (sr - slope * sw) / fits;
-  const auto above = [&](double w) { return meanSquareResidual(xg, w, order, pad) > a * a; };
-  double lo = std::log(w_lo), hi = std::log(0.2);
-  if (!above(w_lo)) return w_lo;
+  const auto above = [&](double w) { return search.meanSquareResidual(w) > a * a; };
+  double lo = std::log(search.w_lo), hi = std::log(0.2);
+  if (!above(search.w_lo)) return search.w_lo;
   for (int i = 0; i < 40; ++i) {
     const double mid = 0.5 * (lo + hi);
     (above(std::exp(mid)) ? lo : hi) = mid;
@@ -204,26 +224,11 @@ double residualCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad
   return std::exp(hi);
 }
 
-// The generalised cross-validation score of the smoother at cutoff w: mean square
-// residual / (1 - tr(S) / L)^2, tr(S) from the filter's gain |H|^2 at the L DFT
-// frequencies of the record (the circulant approximation of the smoother S).
-double gcvScore(const Eigen::MatrixXd& xg, double w, int order, int pad) {
-  const Eigen::Index n = xg.rows();
-  const double tc = std::tan(M_PI * w);
-  double trace = 0.0;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double ratio = std::tan(M_PI * static_cast<double>(k) / n) / tc;
-    trace += 1.0 / (1.0 + std::pow(ratio * ratio, order));
-  }
-  const double dof = 1.0 - trace / static_cast<double>(n);
-  return meanSquareResidual(xg, w, order, pad) / (dof * dof);
-}
-
 // The GCV minimum over w_lo .. 0.4: a scan at ratio 1.1, then a golden section between the
 // best scanned point's neighbours (on log w).
-double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
-  const auto score = [&](double log_w) { return gcvScore(xg, std::exp(log_w), order, pad); };
-  const double step = std::log(1.1), lo = std::log(w_lo);
+double gcvCutoff(const CutoffSearch& search) {
+  const auto score = [&](double log_w) { return search.gcvScore(std::exp(log_w)); };
+  const double step = std::log(1.1), lo = std::log(search.w_lo);
   const int steps = std::max(1, static_cast<int>(std::ceil((std::log(0.4) - lo) / step)));
   int best = 0;
   double best_score = score(lo);
@@ -235,7 +240,7 @@ double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
   double a = lo + std::max(0, best - 1) * step, b = lo + std::min(steps, best + 1) * step;
   double c = b - g * (b - a), d = a + g * (b - a);
   double fc = score(c), fd = score(d);
-  for (int i = 0; i < 30; ++i) {
+  for (int i = 0; i < 40; ++i) {
     if (fc < fd) {
       b = d, d = c, fd = fc, c = b - g * (b - a), fc = score(c);
     } else {
@@ -245,15 +250,17 @@ double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
   return std::exp(0.5 * (a + b));
 }
 
-// The cutoff [Hz] of the rule, for channels xg on the grid.
+// The cutoff [Hz] of the rule, for channels xg on the grid. The lowest cutoff searched
+// is a thousandth of the rate or one period over the record; the residual leaves out
+// two periods of that cutoff at each end, at most a quarter of the record.
 double cutoffOf(const Grid& grid, const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
   if (config.rule == CutoffRule::kFixed) return config.cutoff;
-  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
-  // The lowest cutoff searched: a thousandth of the rate, or a period over the record.
   const double w_lo = std::max(1e-3, 1.0 / grid.m);
-  const double w = config.rule == CutoffRule::kResidual
-                       ? residualCutoff(xg, w_lo, config.order, pad)
-                       : gcvCutoff(xg, w_lo, config.order, pad);
+  const CutoffSearch search{
+      xg, config.order, paddingOf(config.padding, config.order, static_cast<int>(xg.rows())), w_lo,
+      std::min<Eigen::Index>(static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4)};
+  const double w =
+      config.rule == CutoffRule::kResidual ? residualCutoff(search) : gcvCutoff(search);
   return w / grid.h;
 }
 
@@ -288,8 +295,10 @@ void evaluateAt(const Grid& grid, const std::vector<double>& t, ZeroPhaseResult&
     const double h00 = (2 * s - 3) * s * s + 1, h10 = ((s - 2) * s + 1) * s;
     const double h01 = (3 - 2 * s) * s * s, h11 = (s - 1) * s * s;
     const auto row = static_cast<Eigen::Index>(i);
-    r.value.row(row) = h00 * v.row(k) + h10 * h * d.row(k) + h01 * v.row(k + 1) + h11 * h * d.row(k + 1);
-    r.rate.row(row) = h00 * d.row(k) + h10 * h * a.row(k) + h01 * d.row(k + 1) + h11 * h * a.row(k + 1);
+    r.value.row(row) =
+        h00 * v.row(k) + h10 * h * d.row(k) + h01 * v.row(k + 1) + h11 * h * d.row(k + 1);
+    r.rate.row(row) =
+        h00 * d.row(k) + h10 * h * a.row(k) + h01 * d.row(k + 1) + h11 * h * a.row(k + 1);
     r.accel.row(row) = (1.0 - s) * a.row(k) + s * a.row(k + 1);
   }
 }
