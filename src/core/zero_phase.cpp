@@ -158,6 +158,21 @@ Eigen::MatrixXd smoothPadded(const Eigen::MatrixXd& xg, double w, int order, int
   return out;
 }
 
+// The padded smoothed grid channels back at the stamps t: the grid's own samples when t is
+// uniform, else linearly interpolated (the filter's value without derivatives).
+Eigen::MatrixXd atStamps(const Grid& grid, const std::vector<double>& t,
+                         const Eigen::MatrixXd& padded, int pad) {
+  if (grid.uniform) return padded.middleRows(pad, grid.m + 1);
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(t.size()), padded.cols());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    double f = 0.0;
+    const int k = intervalOf(grid, t[i], f);
+    out.row(static_cast<Eigen::Index>(i)) =
+        (1.0 - f) * padded.row(pad + k) + f * padded.row(pad + k + 1);
+  }
+  return out;
+}
+
 // The cutoff as a fraction of the grid's sampling rate, checked against the Nyquist rate.
 double relativeCutoff(const Grid& grid, double cutoff) {
   const double w = cutoff * grid.h;
@@ -168,21 +183,32 @@ double relativeCutoff(const Grid& grid, double cutoff) {
   return w;
 }
 
-// The channels on the grid that a cutoff is chosen for, and the search's constants.
+// The channels that a cutoff is chosen for: x at the stamps t, xg on the grid; and the
+// search's constants.
 struct CutoffSearch {
+  const Grid& grid;
+  const std::vector<double>& t;
+  const Eigen::MatrixXd& x;
   const Eigen::MatrixXd& xg;
   int order, pad;
-  double w_lo;          // the lowest cutoff searched [1/sample]
-  Eigen::Index margin;  // samples left out of the residual at each end
+  double w_lo;        // the lowest cutoff searched [1/sample]
+  double margin = 0;  // [s] left out of the residual at each end
 
-  // Mean square of x - smooth(x) over every channel at cutoff w [1/sample], away from
-  // the ends: there the padding's transient (odd reflection bends the curvature) would
-  // dominate the residual at low cutoffs.
+  // Mean square of x - smooth(x) over every channel at cutoff w [1/sample], at the input
+  // stamps (the measurements themselves, not their resampling, whose interpolation
+  // colours the noise), away from the ends: there the padding's transient (odd
+  // reflection bends the curvature) would dominate the residual at low cutoffs.
   double meanSquareResidual(double w) const {
-    const Eigen::MatrixXd s = smoothPadded(xg, w, order, pad);
-    const Eigen::Index inner = xg.rows() - 2 * margin;
-    return (xg.middleRows(margin, inner) - s.middleRows(pad + margin, inner)).squaredNorm() /
-           static_cast<double>(inner * xg.cols());
+    const Eigen::MatrixXd s = atStamps(grid, t, smoothPadded(xg, w, order, pad), pad);
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t[i] - t.front() < margin || t.back() - t[i] < margin) continue;
+      const auto row = static_cast<Eigen::Index>(i);
+      sum += (x.row(row) - s.row(row)).squaredNorm();
+      ++count;
+    }
+    return sum / static_cast<double>(count * x.cols());
   }
 
   // The generalised cross-validation score at cutoff w: mean square residual /
@@ -250,15 +276,18 @@ double gcvCutoff(const CutoffSearch& search) {
   return std::exp(0.5 * (a + b));
 }
 
-// The cutoff [Hz] of the rule, for channels xg on the grid. The lowest cutoff searched
-// is a thousandth of the rate or one period over the record; the residual leaves out
-// two periods of that cutoff at each end, at most a quarter of the record.
-double cutoffOf(const Grid& grid, const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
+// The cutoff [Hz] of the rule for the channels x at the stamps t (xg on the grid). The
+// lowest cutoff searched is a thousandth of the rate or one period over the record; the
+// residual leaves out two periods of that cutoff at each end, at most a quarter of the
+// record.
+double cutoffOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
+                const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
   if (config.rule == CutoffRule::kFixed) return config.cutoff;
   const double w_lo = std::max(1e-3, 1.0 / grid.m);
-  const CutoffSearch search{
-      xg, config.order, paddingOf(config.padding, config.order, static_cast<int>(xg.rows())), w_lo,
-      std::min<Eigen::Index>(static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4)};
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  CutoffSearch search{grid, t, x, xg, config.order, pad, w_lo};
+  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
+                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
   const double w =
       config.rule == CutoffRule::kResidual ? residualCutoff(search) : gcvCutoff(search);
   return w / grid.h;
@@ -322,7 +351,7 @@ double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
   validate(config);
   checkInput(t, x);
   const Grid grid = gridOf(t);
-  return cutoffOf(grid, grid.uniform ? x : resample(grid, t, x), config);
+  return cutoffOf(grid, t, x, grid.uniform ? x : resample(grid, t, x), config);
 }
 
 ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
@@ -332,7 +361,7 @@ ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::Matri
   const Grid grid = gridOf(t);
   const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
   ZeroPhaseResult r;
-  r.cutoff = cutoffOf(grid, xg, config);
+  r.cutoff = cutoffOf(grid, t, x, xg, config);
   const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
   const Eigen::MatrixXd padded =
       smoothPadded(xg, relativeCutoff(grid, r.cutoff), config.order, pad);
@@ -354,16 +383,7 @@ Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::Matr
   const Grid grid = gridOf(t);
   const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
   const int pad = paddingOf(padding, order, static_cast<int>(xg.rows()));
-  const Eigen::MatrixXd s = smoothPadded(xg, relativeCutoff(grid, cutoff), order, pad);
-  if (grid.uniform) return s.middleRows(pad, xg.rows());
-  // Back at the stamps: linearly (no derivatives to build a Hermite interpolant from).
-  Eigen::MatrixXd out(x.rows(), x.cols());
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    double f = 0.0;
-    const int k = intervalOf(grid, t[i], f);
-    out.row(static_cast<Eigen::Index>(i)) = (1.0 - f) * s.row(pad + k) + f * s.row(pad + k + 1);
-  }
-  return out;
+  return atStamps(grid, t, smoothPadded(xg, relativeCutoff(grid, cutoff), order, pad), pad);
 }
 
 }  // namespace jle

@@ -95,8 +95,8 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    q is differentiated (docs/zero_phase.md); the cutoff [Hz] given,
                    or chosen from the q columns by --cutoff-rule (default: auto).
                    The cutoff used is printed on standard error.
-  --cutoff-rule R  residual (Winter's residual analysis, default) or gcv
-                   (generalised cross-validation); with --cutoff auto
+  --cutoff-rule R  gcv (generalised cross-validation, default) or residual
+                   (Winter's residual analysis); with --cutoff auto
   --filter-order N Butterworth order of each pass, 1..8 (default 4)
   --write-kinematics PATH
                    positions only: also write the smoothed inputs as a joint-state
