@@ -28,7 +28,7 @@ struct Scene {
 // A scene's readings and its truth at the reading instants.
 struct Trial {
   std::vector<double> t;
-  Eigen::MatrixXd q, wrench;             // samples x nq, samples x 6
+  Eigen::MatrixXd q, wrench;              // samples x nq, samples x 6
   Eigen::MatrixXd true_effort, true_qdd;  // samples x moving joints, samples x nq
 };
 
