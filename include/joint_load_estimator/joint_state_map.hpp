@@ -20,8 +20,8 @@ class JointStateMap {
 
   /// Takes a message's names and positions (same size, checked by the caller) and its
   /// efforts (empty, or the same size; a non-finite one is taken as none: NaN). Mimic
-  /// joints are ignored (a mimic follows its leader). Returns the index in `names` of the first joint the model does not have,
-  /// or -1 if there is none (the others are still taken).
+  /// joints are ignored (a mimic follows its leader). Returns the index in `names` of the first
+  /// joint the model does not have, or -1 if there is none (the others are still taken).
   int update(const std::vector<std::string>& names, const std::vector<double>& position,
              const std::vector<double>& effort);
 

@@ -292,8 +292,8 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   const std::string& missing = missingJoint();
   if (!missing.empty())
     return fail(kind, Outcome::kWaiting,
-                settings_.joint_states_topic + ": no position received yet for joint '" +
-                    missing + "': not publishing");
+                settings_.joint_states_topic + ": no position received yet for joint '" + missing +
+                    "': not publishing");
   BasePose base;
   if (model().floating_base && !basePose(stamp, base)) return count(kind, Outcome::kNoBasePose);
   return sample(stamp, t, !effort.empty(), &base);
@@ -345,7 +345,8 @@ std::string Pipeline::stoppingInputs() const {
     if (estimator_.stale(static_cast<int>(k)) && c.wrenches[k].stale_policy == StalePolicy::kStop)
       stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
   for (std::size_t k = 0; k < plates_.size(); ++k)
-    if (estimator_.plateStale(static_cast<int>(k)) && c.plates[k].stale_policy == StalePolicy::kStop)
+    if (estimator_.plateStale(static_cast<int>(k)) &&
+        c.plates[k].stale_policy == StalePolicy::kStop)
       stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
   return stale;
 }

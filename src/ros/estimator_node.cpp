@@ -98,9 +98,9 @@ void EstimatorNode::subscribe() {
       continue;
     }
     wrench_topics_[k].subscriber = nh_.subscribe<const WrenchEvent&>(
-        topic, 100,
-        boost::function<void(const WrenchEvent&)>(
-            [this, k](const WrenchEvent& event) { onWrench(k, event); }),
+        topic, 100, boost::function<void(const WrenchEvent&)>([this, k](const WrenchEvent& event) {
+          onWrench(k, event);
+        }),
         ros::VoidConstPtr(), hints);
   }
   for (std::size_t k = 0; k < plate_topics_.size(); ++k) {

@@ -156,8 +156,14 @@ TEST(Config, TopLevel) {
              {"diagnostic_period", [](Settings& s) { s.diagnostic_period = kInf; }},
              {"joint_states_topic", [](Settings& s) { s.joint_states_topic.clear(); }},
              {"robot_description", [](Settings& s) { s.robot_description.clear(); }},
-             {"joints[1]", [](Settings& s) { s.estimator.joints = {"a", "a"}; }},
-             {"keep_fixed_joints[2]", [](Settings& s) { s.keep_fixed_joints = {"a", "b", "b"}; }}},
+             {"joints[1]",
+              [](Settings& s) {
+                s.estimator.joints = {"a", "a"};
+              }},
+             {"keep_fixed_joints[2]",
+              [](Settings& s) {
+                s.keep_fixed_joints = {"a", "b", "b"};
+              }}},
             false);
 }
 
