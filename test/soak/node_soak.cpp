@@ -185,6 +185,9 @@ class Driver {
   bool run();
 
  private:
+  // Sample i of the schedule: a jump back when due, the good sample, its wrench, a bad
+  // message when due.
+  bool step(long i, long& next_jump);
   void onLoads(const joint_load_estimator::JointLoads::ConstPtr& msg) {
     const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
     const std::size_t r = received_.size();
@@ -380,6 +383,36 @@ class Driver {
   long injected_[kKinds] = {};
 };
 
+bool Driver::step(long i, long& next_jump) {
+  if (next_jump <= o_.jumps && i == next_jump * o_.samples / (o_.jumps + 1)) {
+    // A looping bag: back to the first stamp (or further, so that the jump is
+    // at least twice the node's time_jump_threshold), once every input of the
+    // old timeline has been handled.
+    ++next_jump;
+    if (!barrier(0)) return false;
+    next_ns_ = std::min(kEpochNs, last_good_ns_ - jump_back_ns_);
+    segment_.clear();
+    segment_count_ = 0;
+    wrench_in_segment_ = false;
+    ++injected_[kTimeJump];
+  }
+  const Bad kind = static_cast<Bad>((i / kBadPeriod) % kTimeJump);
+  const bool bad_here = i % kBadPeriod == kBadPeriod / 5;
+  const bool ghost = bad_here && kind == kUnknownJoint;
+  const bool nan_effort = bad_here && kind == kNanEffort;
+  if (ghost) ++injected_[kUnknownJoint];
+  if (nan_effort) ++injected_[kNanEffort];
+  if (!sendGood(ghost, nan_effort)) return false;
+  if (i % kWrenchPeriod == 0) {
+    sendWrench(last_good_ns_, 10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
+               wrench_link_);
+    last_wrench_ns_ = last_good_ns_;
+    wrench_in_segment_ = true;
+  }
+  if (bad_here && !ghost && !nan_effort && sendBad(kind)) ++injected_[kind];
+  return ros::ok();
+}
+
 bool Driver::run() {
   std::printf(
       "node_soak: %zu joints, wrench on '%s', warm-up %d samples (%d "
@@ -403,34 +436,7 @@ bool Driver::run() {
   const long diag_at_start = diag_count_;
   for (long i = 0; i < o_.samples; ++i) {
     if (i == o_.samples / 10) rss_10 = vmRssKb(o_.pid);
-    if (next_jump <= o_.jumps && i == next_jump * o_.samples / (o_.jumps + 1)) {
-      // A looping bag: back to the first stamp (or further, so that the jump is
-      // at least twice the node's time_jump_threshold), once every input of the
-      // old timeline has been handled.
-      ++next_jump;
-      if (!barrier(0)) return false;
-      next_ns_ = std::min(kEpochNs, last_good_ns_ - jump_back_ns_);
-      segment_.clear();
-      segment_count_ = 0;
-      wrench_in_segment_ = false;
-      ++injected_[kTimeJump];
-    }
-    const Bad kind = static_cast<Bad>((i / kBadPeriod) % kTimeJump);
-    const bool bad_here = i % kBadPeriod == kBadPeriod / 5;
-    const bool ghost = bad_here && kind == kUnknownJoint;
-    const bool nan_effort = bad_here && kind == kNanEffort;
-    if (ghost) ++injected_[kUnknownJoint];
-    if (nan_effort) ++injected_[kNanEffort];
-    if (!sendGood(ghost, nan_effort)) return false;
-    if (i % kWrenchPeriod == 0) {
-      sendWrench(last_good_ns_,
-                 10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
-                 wrench_link_);
-      last_wrench_ns_ = last_good_ns_;
-      wrench_in_segment_ = true;
-    }
-    if (bad_here && !ghost && !nan_effort && sendBad(kind)) ++injected_[kind];
-    if (!ros::ok()) return false;
+    if (!step(i, next_jump)) return false;
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
