@@ -469,11 +469,8 @@ bool Driver::run() {
   // period of slack at each end, 10% for a loaded machine's timer).
   const long diag_seen = diag_count_ - diag_at_start;
   const double diag_due = total_seconds / diag_period_;
-  std::printf(
-      "diagnostics: %ld in %.2f s, %.0f due at %.3f s
-      ", diag_seen, total_seconds,
-      diag_due,
-      diag_period_);
+  std::printf("diagnostics: %ld in %.2f s, %.0f due at %.3f s\n", diag_seen, total_seconds,
+              diag_due, diag_period_);
   expect(diag_seen >= 0.9 * diag_due - 2 && diag_seen <= 1.1 * diag_due + 2,
          "diagnostics not at their configured rate");
   std::printf(
