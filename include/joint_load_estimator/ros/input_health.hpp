@@ -28,8 +28,9 @@ class InputHealth {
   explicit InputHealth(std::string topic = "") : topic_(std::move(topic)) {}
 
   /// A message of `publisher` (its caller id) numbered `seq` (header.seq), received at
-  /// `wall_s` [s], with the pipeline's outcome. A publisher that leaves seq at 0 or
-  /// restarts its numbering loses nothing.
+  /// `wall_s` [s], with the pipeline's outcome. roscpp and rospy number every message
+  /// of a topic they send; a message handed over in-process keeps the sender's seq (0,
+  /// often). A publisher that leaves seq at 0 or restarts its numbering loses nothing.
   void take(const std::string& publisher, std::uint32_t seq, Outcome outcome, double wall_s);
 
   /// Whether `outcome` drops the message (the pipeline did not take it): invalid, stamp
