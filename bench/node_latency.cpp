@@ -1,16 +1,19 @@
 // End-to-end latency and throughput of the running node on loopback: publishes joint
 // states of a 7-joint arm and two wrench inputs at increasing rates, receives
 // ~joint_loads, and reports latency (publication of the joint state to reception of
-// its loads: median, p99, max) and losses per rate. Run by bench/node_latency.sh,
-// which starts a master and the node.
+// its loads: median, p99, max) and losses per rate, with the loss the node itself
+// counted (the header.seq gaps of its joint-state input, /diagnostics). Run by
+// bench/node_latency.sh, which starts a master and the node.
 #include <joint_load_estimator/JointLoads.h>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -41,6 +44,22 @@ void onLoads(const joint_load_estimator::JointLoads::ConstPtr& msg) {
   g_sent_at.erase(it);
 }
 
+long g_node_lost = 0;  // the node's count of joint states lost before it (header.seq gaps)
+
+void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+  for (const auto& status : msg->status)
+    for (const auto& kv : status.values)
+      if (kv.key == "input '/joint_states': lost (header.seq gaps)") {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        g_node_lost = std::stol(kv.value);
+      }
+}
+
+long nodeLost() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  return g_node_lost;
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());
@@ -65,6 +84,7 @@ int main(int argc, char** argv) {
   ros::Publisher w2 = nh.advertise<geometry_msgs::WrenchStamped>("handle/wrench", 1000);
   ros::Subscriber sub = nh.subscribe("joint_load_estimator/joint_loads", 10000, onLoads,
                                      ros::TransportHints().tcpNoDelay());
+  ros::Subscriber diag = nh.subscribe("/diagnostics", 100, onDiagnostics);
   ros::AsyncSpinner spinner(1);
   spinner.start();
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
@@ -85,13 +105,15 @@ int main(int argc, char** argv) {
   geometry_msgs::WrenchStamped handle;
   handle.header.frame_id = "panda_link5";
   std::printf(
-      "| input rate [Hz] | sent | loads received | lost | latency median [us] | p99 [us] | max "
-      "[us] |\n");
-  std::printf("|---|---|---|---|---|---|---|\n");
+      "| input rate [Hz] | sent | loads received | lost | lost, counted by the node | latency "
+      "median [us] | p99 [us] | max [us] |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::uint32_t seq = 0;  // every joint state numbered, as rospy and many drivers do
   double t_sim = 0.0;
   for (double rate : rates) {
     Run run;
     run.rate = rate;
+    const long lost_before = nodeLost();
     const ros::WallTime start = ros::WallTime::now();
     const long n = static_cast<long>(rate * seconds);
     for (long k = 0; k < n; ++k) {
@@ -118,6 +140,7 @@ int main(int argc, char** argv) {
         g_sent_at[stamp.toNSec()] = ros::WallTime::now().toSec();
         ++run.sent;
       }
+      state.header.seq = ++seq;
       js.publish(state);
     }
     // Let the last loads arrive.
@@ -136,11 +159,14 @@ int main(int argc, char** argv) {
       g_sent_at.clear();
       latency = run.latency;
     }
-    std::printf("| %.0f | %ld | %ld | %ld | %.0f | %.0f | %.0f |\n", rate, run.sent, run.received,
-                run.sent - run.received, 1e6 * percentile(latency, 0.5),
-                1e6 * percentile(latency, 0.99), 1e6 * percentile(latency, 1.0));
+    // A gap: the node's filters restart, and its diagnostics (diagnostic_period 0.2 s
+    // in node_latency.yaml) report what it lost.
+    ros::WallDuration(1.0).sleep();
+    std::printf("| %.0f | %ld | %ld | %ld | %ld | %.0f | %.0f | %.0f |\n", rate, run.sent,
+                run.received, run.sent - run.received, nodeLost() - lost_before,
+                1e6 * percentile(latency, 0.5), 1e6 * percentile(latency, 0.99),
+                1e6 * percentile(latency, 1.0));
     std::fflush(stdout);
-    ros::WallDuration(1.0).sleep();  // a gap: the node's filters restart
   }
   return 0;
 }

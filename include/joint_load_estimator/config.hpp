@@ -211,9 +211,8 @@ struct Settings {
   /// YAML file of the sensor biases: loaded at start if it exists, written by
   /// ~calibrate_bias. Empty: not loaded, and calibrate_bias writes none.
   std::string bias_file;
-  /// [s] > 0: period of the node's diagnostics timer (/diagnostics). diagnostic_updater
-  /// reads the same key from the node's private namespace; it is kept here so that it is
-  /// validated, documented and defaulted with the others.
+  /// [s] > 0: period of the node's diagnostics timer (/diagnostics), a wall-clock timer:
+  /// its rate holds through sim-time jumps and while no input arrives.
   double diagnostic_period = 1.0;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;

@@ -19,11 +19,19 @@ class JointStateMap {
   JointStateMap(const Model<double>& model, const std::vector<int>& published_segments);
 
   /// Takes a message's names and positions (same size, checked by the caller) and its
-  /// efforts (empty, or the same size). Mimic joints are ignored (a mimic follows its
-  /// leader). Returns the index in `names` of the first joint the model does not have,
-  /// or -1 if there is none (the others are still taken).
+  /// efforts (empty, or the same size; a non-finite one is taken as none: NaN). Mimic
+  /// joints are ignored (a mimic follows its leader). Returns the index in `names` of the first
+  /// joint the model does not have, or -1 if there is none (the others are still taken).
   int update(const std::vector<std::string>& names, const std::vector<double>& position,
              const std::vector<double>& effort);
+
+  /// The index in `names` of the first name that an earlier entry of `names` has too,
+  /// or -1 if every name is there once. Binds the layout (no cost for the same layout
+  /// as the last message's).
+  int duplicate(const std::vector<std::string>& names);
+  /// Per entry of the last layout bound (update(), duplicate()): the coordinate it
+  /// sets (model.coordinate_names index), or -1 (a mimic, a fixed or unknown joint).
+  const std::vector<int>& coordinates() const { return coordinate_of_; }
 
   /// The positions, model.coordinate_names order (size nq).
   const std::vector<double>& q() const { return q_; }
@@ -48,6 +56,7 @@ class JointStateMap {
   std::vector<std::string> layout_;
   std::vector<int> coordinate_of_, published_of_;
   std::vector<char> known_;
+  int duplicate_ = -1;  // of the cached layout
 };
 
 }  // namespace jle

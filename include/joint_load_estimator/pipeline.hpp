@@ -29,13 +29,16 @@ using Stamp = std::int64_t;
 enum class Outcome : std::uint8_t {
   kUsed,        ///< taken (a joint state entered the filters; no loads for it yet)
   kPublished,   ///< a joint state: loads computed, record() holds them
-  kInvalid,     ///< sizes disagree, or a non-finite value
+  kInvalid,     ///< sizes disagree, a name twice, or a non-finite position or velocity
   kOrder,       ///< same or older stamp than the input's previous one
   kFrame,       ///< frame neither rigid to the link in the URDF nor known to the FrameSource
   kNoBasePose,  ///< floating base: no pose of the base at the stamp
   kWaiting,     ///< a coordinate the computed loads need has had no position yet
   kStale,       ///< an input with stale_policy stop is stale: no loads
   kUnchanged,   ///< same filtered inputs as the last loads and republish_unchanged off
+  /// a joint state that sets no coordinate the computed loads need (empty, or only a
+  /// gripper's joints): its positions are kept, but it is not a sample
+  kNoJoint,
   kCount
 };
 
@@ -56,6 +59,9 @@ struct PipelineCounters {
       outcomes{};
   long unknown_joints = 0;  ///< joint states naming a joint the model does not have
   long resets = 0;          ///< backward time jumps (the filters were reset)
+  /// joint states with a non-finite effort (that joint's measured effort is none; the
+  /// loads are computed)
+  long nonfinite_efforts = 0;
 
   long received(InputKind kind) const;
   long count(InputKind kind, Outcome outcome) const {
@@ -110,8 +116,9 @@ class Pipeline {
   /// std::invalid_argument naming the key, link or joint.
   Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames);
 
-  /// A joint state: names, positions (same size), velocities and efforts (empty or the
-  /// same size). `stamp` 0 is replaced by `clock`, the front end's clock when the
+  /// A joint state: names (each once), positions (same size), velocities and efforts
+  /// (empty or the same size; a non-finite effort only drops that joint's measured
+  /// effort). `stamp` 0 is replaced by `clock`, the front end's clock when the
   /// message arrived (the node: ros::Time::now(); a bag: the message's bag time), which
   /// also tells a backward jump of time (a looping bag).
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
@@ -139,6 +146,13 @@ class Pipeline {
   /// The first joint of the last joint state that the model does not have (ignored,
   /// the others used), or empty.
   const std::string& unknownJoint() const { return unknown_joint_; }
+  /// The first joint of the last joint state whose effort was not finite, or empty.
+  const std::string& nonFiniteEffort() const { return nonfinite_effort_; }
+  /// The first coordinate the computed loads need that has had no position yet, or empty.
+  const std::string& missingJoint() const;
+  /// The topics of the inputs with stale_policy stop that were stale at the last joint
+  /// sample (no loads while there is one), ", " between them; empty if none.
+  std::string stoppingInputs() const;
   /// Whether the last message reset the filters (time jumped back), and from when to
   /// when [ns].
   bool jumped() const { return jumped_; }
@@ -189,6 +203,7 @@ class Pipeline {
   Outcome count(InputKind kind, Outcome outcome);
   Outcome fail(InputKind kind, Outcome outcome, const std::string& why);
   void checkTimeJump(Stamp stamp, Stamp clock);
+  bool movesNeeded() const;
   bool checkJointState(const std::vector<std::string>& names, const std::vector<double>& position,
                        const std::vector<double>& velocity, const std::vector<double>& effort);
   void mapJointState(const std::vector<std::string>& names, const std::vector<double>& position,
@@ -220,7 +235,8 @@ class Pipeline {
   // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
   std::vector<Sample> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;
-  std::string problem_, unknown_joint_;
+  std::string problem_, unknown_joint_, nonfinite_effort_;
+  bool any_needed_ = false;  // the loads need at least one coordinate
   bool jumped_ = false;
   Stamp jump_from_ = 0, jump_to_ = 0;
 };

@@ -39,6 +39,15 @@ std::string element(const char* list, std::size_t k, const char* key) {
   return std::string(list) + "[" + std::to_string(k) + "]/" + key;
 }
 
+// Each entry of the list `key` once: "parameter 'joints[2]' is 'elbow', as is 'joints[0]'".
+void unique(const char* key, const std::vector<std::string>& list) {
+  for (std::size_t i = 0; i < list.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (list[i] == list[j])
+        fail(std::string(key) + "[" + std::to_string(i) + "]",
+             "is '" + list[i] + "', as is '" + key + "[" + std::to_string(j) + "]'");
+}
+
 void validateSavings(const Savings& s) {
   nonNegative("savings/static_velocity", s.static_velocity);
   nonNegative("savings/static_acceleration", s.static_acceleration);
@@ -114,6 +123,7 @@ void validate(const EstimatorConfig& config) {
   if (config.decimation < 1)
     fail("decimation", "must be >= 1, it is " + std::to_string(config.decimation));
   if (!config.gravity_world.allFinite()) fail("gravity", "must be finite");
+  unique("joints", config.joints);
   validateSavings(config.savings);
   validateUncertainty(config.uncertainty);
   for (std::size_t k = 0; k < config.wrenches.size(); ++k) validateWrench(config.wrenches[k], k);
@@ -122,6 +132,9 @@ void validate(const EstimatorConfig& config) {
 
 void validate(const Settings& settings) {
   validate(settings.estimator);
+  required("robot_description", settings.robot_description);
+  required("joint_states_topic", settings.joint_states_topic);
+  unique("keep_fixed_joints", settings.keep_fixed_joints);
   positive("time_jump_threshold", settings.time_jump_threshold);
   positive("base_residual_threshold", settings.base_residual_threshold);
   positive("still_velocity", settings.still_velocity);

@@ -79,8 +79,13 @@ void Estimator::setUpWrenchInputs() {
     input.channel = wrench_channel_ + 6 * static_cast<int>(inputs_.size());
     const int sensor_segment = sensors_.add(model_, c, input.channel);  // throws naming the input
     // A sensor's link is its joint's child link (sensors_ checked a non-empty one).
-    input.frame =
-        model_.frameIndex(sensor_segment >= 0 ? model_.link_name[sensor_segment] : c.link);
+    const std::string& link = sensor_segment >= 0 ? model_.link_name[sensor_segment] : c.link;
+    try {
+      input.frame = model_.frameIndex(link);
+    } catch (const std::invalid_argument&) {
+      throw SettingsError("parameter 'wrenches[" + std::to_string(inputs_.size()) + "]/link': '" +
+                          link + "' is not a link of the model");
+    }
     input.sign = c.sign;
     input.samples = InputBuffer(c.timeout, c.stale_policy);
     inputs_.push_back(input);
@@ -133,7 +138,7 @@ void Estimator::setUpPlanar() {
   // savings.planar: detected over the segments computed (a joint pruned away does not
   // matter); gravity is in the root frame, which is the world for a fixed base.
   if (config_.savings.planar == PlanarMode::kOff) {
-    planar_reason_ = "savings.planar is off";
+    planar_reason_ = "savings/planar is off";
   } else if (config_.precision == Precision::kFloat) {
     planar_reason_ = "precision float keeps the 6x6 path";
   } else if (config_.uncertainty.enabled) {
@@ -150,7 +155,7 @@ void Estimator::setUpPlanar() {
     planar_reason_ = check.reason;
     if (!planar_ && config_.savings.planar == PlanarMode::kOn) {
       if (model_.floating_base || check.normal.isZero())
-        throw std::invalid_argument("savings.planar is on but " + check.reason);
+        throw std::invalid_argument("parameter 'savings/planar' is on but " + check.reason);
       planar_ = true;  // the user's assertion: out-of-plane parts are dropped
     }
     if (planar_) {

@@ -1,5 +1,6 @@
 #include <joint_load_estimator/joint_state_map.hpp>
 
+#include <cmath>
 #include <limits>
 
 namespace jle {
@@ -21,7 +22,10 @@ void JointStateMap::bind(const std::vector<std::string>& names) {
   coordinate_of_.assign(n, -1);
   published_of_.assign(n, -1);
   known_.assign(n, 0);
+  duplicate_ = -1;
   for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < i && duplicate_ < 0; ++j)
+      if (names[j] == names[i]) duplicate_ = static_cast<int>(i);
     for (std::size_t k = 0; k < coordinate_names_.size(); ++k)
       if (coordinate_names_[k] == names[i]) coordinate_of_[i] = static_cast<int>(k);
     for (std::size_t j = 0; j < published_joint_names_.size(); ++j)
@@ -47,9 +51,16 @@ int JointStateMap::update(const std::vector<std::string>& names,
       received_[static_cast<std::size_t>(k)] = 1;
     }
     const int j = published_of_[i];
-    if (j >= 0 && !effort.empty()) effort_[static_cast<std::size_t>(j)] = effort[i];
+    if (j >= 0 && !effort.empty())
+      effort_[static_cast<std::size_t>(j)] =
+          std::isfinite(effort[i]) ? effort[i] : std::numeric_limits<double>::quiet_NaN();
   }
   return unknown;
+}
+
+int JointStateMap::duplicate(const std::vector<std::string>& names) {
+  if (names != layout_) bind(names);
+  return duplicate_;
 }
 
 int JointStateMap::firstMissing() const {

@@ -2,6 +2,7 @@
 #include <joint_load_estimator/pipeline.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -43,16 +44,23 @@ const char* toString(Outcome outcome) {
     case Outcome::kWaiting: return "waiting for a joint";
     case Outcome::kStale: return "stale input";
     case Outcome::kUnchanged: return "unchanged";
+    case Outcome::kNoJoint: return "no needed joint";
     case Outcome::kCount: break;
   }
   return "?";
 }
 
 std::size_t problemKey(const std::string& problem) {
-  // Digits (stamps, values, counts) do not make another problem; names do.
+  // Numbers (stamps, values, counts) do not make another problem; names do, with their
+  // digits: '/ft2' is not '/ft'. A digit belongs to a name when it follows a letter,
+  // '_' or a digit of that name.
   std::size_t h = 1469598103934665603ull;
-  for (char c : problem)
-    if (c < '0' || c > '9') h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  bool in_name = false;
+  for (char c : problem) {
+    const bool digit = c >= '0' && c <= '9';
+    in_name = std::isalpha(static_cast<unsigned char>(c)) || c == '_' || (digit && in_name);
+    if (!digit || in_name) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  }
   return h;
 }
 
@@ -151,6 +159,7 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     record_.effort_per_kg.assign(n, 0.0);
   }
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
+  for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
 }
 
 double Pipeline::relative(Stamp stamp) {
@@ -223,19 +232,37 @@ bool Pipeline::checkJointState(const std::vector<std::string>& names,
     }
   }
   std::size_t bad = 0;
-  for (const Field& field : fields)
-    if (!allFinite(field.values, bad)) {
+  for (const Field& field : fields)  // a non-finite effort only drops its comparison
+    if (&field.values != &effort && !allFinite(field.values, bad)) {
       problem_ = topic + ": " + field.name + " of joint '" + names[bad] + "' is " +
                  std::to_string(field.values[bad]) + ": message dropped";
       return false;
     }
+  const int twice = joints_.duplicate(names);
+  if (twice >= 0) {
+    problem_ = topic + ": joint '" + names[static_cast<std::size_t>(twice)] +
+               "' is named twice: message dropped";
+    return false;
+  }
   return true;
+}
+
+bool Pipeline::movesNeeded() const {
+  if (!any_needed_) return true;  // a floating base alone: every message is a sample
+  for (int k : joints_.coordinates())
+    if (k >= 0 && estimator_.coordinateNeeded(k)) return true;
+  return false;
 }
 
 void Pipeline::mapJointState(const std::vector<std::string>& names,
                              const std::vector<double>& position,
                              const std::vector<double>& effort) {
   const int unknown = joints_.update(names, position, effort);
+  std::size_t bad = 0;
+  if (!allFinite(effort, bad)) {
+    nonfinite_effort_ = names[bad];
+    ++counters_.nonfinite_efforts;
+  }
   if (unknown < 0) {
     unknown_joint_.clear();
     return;
@@ -251,16 +278,22 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   constexpr InputKind kind = InputKind::kJointState;
   problem_.clear();
   unknown_joint_.clear();
+  nonfinite_effort_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
+  mapJointState(names, position, effort);
+  // Neither a sample nor a time: its stamp and clock are not the stream's.
+  if (!movesNeeded())
+    return fail(kind, Outcome::kNoJoint,
+                settings_.joint_states_topic +
+                    ": a message with none of the joints the loads need: not a sample");
   if (stamp == 0) stamp = clock;
   checkTimeJump(stamp, clock);
-  mapJointState(names, position, effort);
   const double t = relative(stamp);
-  for (int i = 0; i < model().nq; ++i)
-    if (!joints_.received(i) && estimator_.coordinateNeeded(i))
-      return fail(kind, Outcome::kWaiting,
-                  settings_.joint_states_topic + ": no position received yet for joint '" +
-                      model().coordinate_names[static_cast<std::size_t>(i)] + "': not publishing");
+  const std::string& missing = missingJoint();
+  if (!missing.empty())
+    return fail(kind, Outcome::kWaiting,
+                settings_.joint_states_topic + ": no position received yet for joint '" + missing +
+                    "': not publishing");
   BasePose base;
   if (model().floating_base && !basePose(stamp, base)) return count(kind, Outcome::kNoBasePose);
   return sample(stamp, t, !effort.empty(), &base);
@@ -303,16 +336,32 @@ Outcome Pipeline::sample(Stamp stamp, double t, bool has_effort, const BasePose*
   return count(kind, Outcome::kPublished);
 }
 
-Outcome Pipeline::staleProblem() {
+std::string Pipeline::stoppingInputs() const {
+  // Only the inputs with the stop policy stop the loads; a stale hold or zero input
+  // does not.
   std::string stale;
+  const EstimatorConfig& c = settings_.estimator;
   for (std::size_t k = 0; k < wrenches_.size(); ++k)
-    if (estimator_.stale(static_cast<int>(k)))
+    if (estimator_.stale(static_cast<int>(k)) && c.wrenches[k].stale_policy == StalePolicy::kStop)
       stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
   for (std::size_t k = 0; k < plates_.size(); ++k)
-    if (estimator_.plateStale(static_cast<int>(k)))
+    if (estimator_.plateStale(static_cast<int>(k)) &&
+        c.plates[k].stale_policy == StalePolicy::kStop)
       stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
+  return stale;
+}
+
+const std::string& Pipeline::missingJoint() const {
+  static const std::string kNoJointMissing;
+  for (int i = 0; i < model().nq; ++i)
+    if (!joints_.received(i) && estimator_.coordinateNeeded(i))
+      return model().coordinate_names[static_cast<std::size_t>(i)];
+  return kNoJointMissing;
+}
+
+Outcome Pipeline::staleProblem() {
   return fail(InputKind::kJointState, Outcome::kStale,
-              "stale inputs (stale_policy stop): " + stale + ": not publishing");
+              "stale inputs (stale_policy stop): " + stoppingInputs() + ": not publishing");
 }
 
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {

@@ -20,6 +20,22 @@ Outcome feedWrenchStamped(Pipeline& pipeline, WrenchInput input, int k,
 
 }  // namespace
 
+// What tf2 could not do, in the user's terms (its own texts name its functions and
+// arguments).
+std::string Tf2FrameSource::lookupError(const tf2::TransformException& e, const std::string& target,
+                                        const std::string& frame, Stamp stamp) const {
+  if (dynamic_cast<const tf2::LookupException*>(&e)) {
+    const std::string& unknown = buffer_._frameExists(frame) ? target : frame;
+    return "tf2 has no frame '" + unknown + "' (nothing has published it)";
+  }
+  if (dynamic_cast<const tf2::ConnectivityException*>(&e))
+    return "tf2 has no chain of transforms between '" + frame + "' and '" + target + "'";
+  if (dynamic_cast<const tf2::ExtrapolationException*>(&e))
+    return "tf2 has no transform between '" + frame + "' and '" + target + "' at " +
+           std::to_string(toRosTime(stamp).toSec()) + " s (before or after what it holds)";
+  return "tf2 cannot give '" + frame + "' in '" + target + "'";
+}
+
 bool Tf2FrameSource::lookup(const std::string& target, const std::string& frame, Stamp stamp,
                             Eigen::Isometry3d& X_target_frame, std::string& error) {
   try {
@@ -27,7 +43,7 @@ bool Tf2FrameSource::lookup(const std::string& target, const std::string& frame,
         tf2::transformToEigen(buffer_.lookupTransform(target, frame, toRosTime(stamp)));
     return true;
   } catch (const tf2::TransformException& e) {
-    error = e.what();
+    error = lookupError(e, target, frame, stamp);
     return false;
   }
 }

@@ -4,10 +4,14 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <cstdio>
+
 namespace jle {
 namespace {
 
 constexpr double kThrottle = 2.0;  // [s] between repeats of one kind of message
+// [s] without a joint state: the loads have stopped (an ERROR in the diagnostics).
+constexpr double kSilence = 1.0;
 
 }  // namespace
 
@@ -32,6 +36,8 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   updater_.add("joint loads", this, &EstimatorNode::diagnose);
   if (!sensor_topics_.empty() || model.floating_base)
     updater_.add("consistency", this, &EstimatorNode::diagnoseConsistency);
+  diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(settings_.diagnostic_period),
+                                           &EstimatorNode::onDiagnosticsTimer, this);
   ROS_INFO(
       "joint_load_estimator: %d segments, %d coordinates, %zu joints published, %zu wrench "
       "inputs%s",
@@ -82,19 +88,23 @@ void EstimatorNode::advertise() {
 void EstimatorNode::subscribe() {
   const Estimator& estimator = pipeline_->estimator();
   const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
+  joint_health_ = InputHealth(nh_.resolveName(settings_.joint_states_topic));
   for (std::size_t k = 0; k < wrench_topics_.size(); ++k) {
     const std::string& topic = settings_.wrenches[k].topic;
+    wrench_topics_[k].health = InputHealth(topic);
     if (!estimator.inputNeeded(static_cast<int>(k))) {  // nothing to subscribe to
       ROS_INFO("wrench '%s' on link '%s' affects none of the published joints: not subscribed",
                topic.c_str(), settings_.estimator.wrenches[k].link.c_str());
       continue;
     }
-    wrench_topics_[k].subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
-        topic, 100,
-        [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onWrench(k, msg); },
+    wrench_topics_[k].subscriber = nh_.subscribe<const WrenchEvent&>(
+        topic, 100, boost::function<void(const WrenchEvent&)>([this, k](const WrenchEvent& event) {
+          onWrench(k, event);
+        }),
         ros::VoidConstPtr(), hints);
   }
   for (std::size_t k = 0; k < plate_topics_.size(); ++k) {
+    plate_topics_[k].health = InputHealth(settings_.force_plates[k].topic);
     if (!estimator.plateNeeded(static_cast<int>(k))) {
       ROS_INFO(
           "force plate '%s' under link '%s' affects none of the published joints: not "
@@ -103,9 +113,10 @@ void EstimatorNode::subscribe() {
           settings_.estimator.plates[k].plate.link.c_str());
       continue;
     }
-    plate_topics_[k].subscriber = nh_.subscribe<geometry_msgs::WrenchStamped>(
+    plate_topics_[k].subscriber = nh_.subscribe<const WrenchEvent&>(
         settings_.force_plates[k].topic, 100,
-        [this, k](const geometry_msgs::WrenchStamped::ConstPtr& msg) { onPlate(k, msg); },
+        boost::function<void(const WrenchEvent&)>(
+            [this, k](const WrenchEvent& event) { onPlate(k, event); }),
         ros::VoidConstPtr(), hints);
   }
   joint_sub_ =
@@ -119,6 +130,14 @@ void EstimatorNode::report(Outcome outcome) {
   if (!pipeline_->unknownJoint().empty())
     ROS_WARN_THROTTLE(kThrottle, "%s: joint '%s' is not in the model: ignored",
                       settings_.joint_states_topic.c_str(), pipeline_->unknownJoint().c_str());
+  if (!pipeline_->nonFiniteEffort().empty())
+    ROS_WARN_THROTTLE(kThrottle, "%s: effort of joint '%s' is not finite: not compared",
+                      settings_.joint_states_topic.c_str(), pipeline_->nonFiniteEffort().c_str());
+  // A gripper's own joint states are normal: said once, counted in the diagnostics.
+  if (outcome == Outcome::kNoJoint) {
+    ROS_INFO_ONCE("%s (counted under 'not used: no needed joint')", pipeline_->problem().c_str());
+    return;
+  }
   if (pipeline_->problem().empty()) return;
   if (last_log_.size() > 1024) last_log_.clear();  // bounded: names come from the inputs
   double& last = last_log_[problemKey(pipeline_->problem())];
@@ -132,11 +151,15 @@ void EstimatorNode::report(Outcome outcome) {
     ROS_WARN("%s", pipeline_->problem().c_str());
 }
 
-void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
+void EstimatorNode::onJointState(const JointStateEvent& event) {
   const ros::Time received = ros::Time::now();
+  const sensor_msgs::JointState& msg = *event.getConstMessage();
   try {
     applyPendingBias();
-    const Outcome outcome = feed(*pipeline_, *msg, received);
+    const Outcome outcome = feed(*pipeline_, msg, received);
+    last_joint_outcome_ = outcome;
+    joint_health_.take(event.getPublisherName(), msg.header.seq, outcome,
+                       ros::WallTime::now().toSec());
     report(outcome);
     if (outcome == Outcome::kPublished) publish(received);
   } catch (const std::exception& e) {
@@ -146,19 +169,27 @@ void EstimatorNode::onJointState(const sensor_msgs::JointState::ConstPtr& msg) {
   }
 }
 
-void EstimatorNode::onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+void EstimatorNode::onWrench(std::size_t k, const WrenchEvent& event) {
+  const geometry_msgs::WrenchStamped& msg = *event.getConstMessage();
   try {
     applyPendingBias();
-    report(feedWrench(*pipeline_, static_cast<int>(k), *msg, ros::Time::now()));
+    const Outcome outcome = feedWrench(*pipeline_, static_cast<int>(k), msg, ros::Time::now());
+    wrench_topics_[k].health.take(event.getPublisherName(), msg.header.seq, outcome,
+                                  ros::WallTime::now().toSec());
+    report(outcome);
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "wrench input %zu: %s", k, e.what());
   }
 }
 
-void EstimatorNode::onPlate(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+void EstimatorNode::onPlate(std::size_t k, const WrenchEvent& event) {
+  const geometry_msgs::WrenchStamped& msg = *event.getConstMessage();
   try {
-    report(feedPlate(*pipeline_, static_cast<int>(k), *msg, ros::Time::now()));
+    const Outcome outcome = feedPlate(*pipeline_, static_cast<int>(k), msg, ros::Time::now());
+    plate_topics_[k].health.take(event.getPublisherName(), msg.header.seq, outcome,
+                                 ros::WallTime::now().toSec());
+    report(outcome);
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "force plate input %zu: %s", k, e.what());
@@ -189,7 +220,6 @@ void EstimatorNode::publish(const ros::Time& received) {
   latency_sum_ += latency;
   latency_max_ = std::max(latency_max_, latency);
   ++latency_count_;
-  updater_.update();
 }
 
 void EstimatorNode::publishPlates(const ros::Time& stamp) {
@@ -202,6 +232,15 @@ void EstimatorNode::publishPlates(const ros::Time& stamp) {
     cop_msg_.point.y = r.cop_plate.y();
     cop_msg_.point.z = r.cop_plate.z();
     plate_topics_[k].cop_pub.publish(cop_msg_);
+  }
+}
+
+void EstimatorNode::onDiagnosticsTimer(const ros::WallTimerEvent&) {
+  try {
+    updater_.force_update();
+  } catch (const std::exception& e) {
+    ++exceptions_;
+    ROS_ERROR_THROTTLE(kThrottle, "diagnostics: %s", e.what());
   }
 }
 
@@ -224,31 +263,81 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   for (std::size_t k = 0; k < settings_.force_plates.size(); ++k)
     if (estimator.plateStale(static_cast<int>(k)))
       stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
-  if (published == 0)
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no loads published yet");
+  const std::string inputs = diagnoseInputs(status);
+  if (!inputs.empty())
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, inputs);
   else if (!stale.empty())
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale wrench inputs: " + stale);
   else
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "publishing");
+  diagnoseLevel(status, published);  // what stops the loads comes first
   status.add("mean latency [s]", latency_count_ ? latency_sum_ / latency_count_ : 0.0);
   status.add("max latency [s]", latency_max_);
   status.add("joint states received", received);
   status.add("wrenches received", c.received(InputKind::kWrench));
   status.add("loads published", published);
-  status.add("dropped: invalid", c.count(Outcome::kInvalid) + exceptions_);
-  status.add("dropped: stamp order", c.count(Outcome::kOrder));
-  status.add("dropped: unresolved frame", c.count(Outcome::kFrame) + c.count(Outcome::kNoBasePose));
-  status.add("dropped: no base pose", c.count(Outcome::kNoBasePose));
-  status.add("not published: waiting for a joint", c.count(Outcome::kWaiting));
-  status.add("not published: unchanged", c.count(Outcome::kUnchanged));
-  status.add("messages with unknown joints", c.unknown_joints);
-  status.add("not published: stale input", c.count(Outcome::kStale));
-  status.add("time jumps back", c.resets);
-  status.add("force plate samples received", c.received(InputKind::kPlate));
+  diagnoseCounts(status);
   status.add("stale inputs", stale);
   latency_sum_ = 0.0;
   latency_max_ = 0.0;
   latency_count_ = 0;
+}
+
+void EstimatorNode::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& status,
+                                  long published) {
+  using diagnostic_msgs::DiagnosticStatus;
+  const double last = joint_health_.lastReceived();
+  const double silent = ros::WallTime::now().toSec() - (last > 0.0 ? last : started_.toSec());
+  char text[64];
+  std::snprintf(text, sizeof text, "no joint states for %.1f s", silent);
+  if (silent > kSilence)
+    status.summary(DiagnosticStatus::ERROR, text);
+  else if (!pipeline_->missingJoint().empty())
+    status.summary(DiagnosticStatus::ERROR,
+                   "waiting for joint '" + pipeline_->missingJoint() + "'");
+  else if (last_joint_outcome_ == Outcome::kStale)
+    status.summary(DiagnosticStatus::ERROR,
+                   "not publishing: input '" + pipeline_->stoppingInputs() + "' stale");
+  else if (published == 0)
+    status.summary(DiagnosticStatus::WARN, "no loads published yet");
+}
+
+std::string EstimatorNode::diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  // The first input whose every reading of the period was dropped, or that lost
+  // messages: a WARN.
+  std::string warning;
+  auto one = [&](InputHealth& h) {
+    const InputHealth::Period p = h.since();
+    status.add("input '" + h.topic() + "': received", h.received());
+    status.add("input '" + h.topic() + "': lost (header.seq gaps)", h.lost());
+    if (!warning.empty()) return;
+    if (p.received > 0 && p.used == 0)
+      warning = "input '" + h.topic() + "': every reading dropped (" + toString(p.last_drop) + ")";
+    else if (p.lost > 0)
+      warning = "input '" + h.topic() + "': " + std::to_string(p.lost) + " messages lost";
+  };
+  one(joint_health_);
+  for (WrenchTopic& w : wrench_topics_)
+    if (w.subscriber) one(w.health);
+  for (PlateTopic& p : plate_topics_)
+    if (p.subscriber) one(p.health);
+  return warning;
+}
+
+void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const PipelineCounters& c = pipeline_->counters();
+  status.add("dropped: invalid", c.count(Outcome::kInvalid) + exceptions_);
+  status.add("dropped: stamp order", c.count(Outcome::kOrder));
+  status.add("dropped: unresolved frame", c.count(Outcome::kFrame) + c.count(Outcome::kNoBasePose));
+  status.add("dropped: no base pose", c.count(Outcome::kNoBasePose));
+  status.add("not used: no needed joint", c.count(Outcome::kNoJoint));
+  status.add("not published: waiting for a joint", c.count(Outcome::kWaiting));
+  status.add("not published: unchanged", c.count(Outcome::kUnchanged));
+  status.add("messages with unknown joints", c.unknown_joints);
+  status.add("efforts not compared: non-finite", c.nonfinite_efforts);
+  status.add("not published: stale input", c.count(Outcome::kStale));
+  status.add("time jumps back", c.resets);
+  status.add("force plate samples received", c.received(InputKind::kPlate));
 }
 
 }  // namespace jle

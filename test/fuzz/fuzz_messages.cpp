@@ -1,6 +1,7 @@
 // libFuzzer target: the node's message path, jle::Pipeline, the code the node and
 // process_bag run. The fuzz bytes decode into a stream of JointState-like messages
 // (names from a small alphabet with unknown and repeated ones, NaN / inf / huge values,
+// messages that set none of the needed joints,
 // empty and mismatched arrays, stamp 0, duplicate, backward and jumping stamps over the
 // whole range a ROS stamp holds), wrench messages (frames known and unknown) and jumps
 // of the clock. Checks the documented outcome of every message against a shadow of
@@ -185,8 +186,18 @@ struct Shadow {
 struct JointMessage {
   std::vector<std::string> names;
   std::vector<double> position, velocity, effort;
-  bool valid = true;  // sizes agree and every value is finite
+  bool valid = true;  // sizes agree, names are unique, positions and velocities finite
 };
+
+// Whether the message sets a coordinate the loads need (else kNoJoint: no sample, no time).
+bool moves(const jle::Pipeline& p, const JointMessage& js) {
+  for (const std::string& name : js.names)
+    for (int k = 0; k < p.model().nq; ++k)
+      if (name == p.model().coordinate_names[static_cast<std::size_t>(k)] &&
+          p.estimator().coordinateNeeded(k))
+        return true;
+  return false;
+}
 
 void decodeJointState(Bytes& in, JointMessage& js) {
   const std::size_t n = in.byte() % 9;
@@ -204,8 +215,11 @@ void decodeJointState(Bytes& in, JointMessage& js) {
   for (double& v : js.velocity) v = in.value();
   for (double& v : js.effort) v = in.value();
   js.valid = np == n && (ne == 0 || ne == n) && (nv == 0 || nv == n);
-  for (const auto* field : {&js.position, &js.velocity, &js.effort})
+  // A non-finite effort only drops its comparison.
+  for (const auto* field : {&js.position, &js.velocity})
     for (double v : *field) js.valid = js.valid && std::isfinite(v);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < i; ++j) js.valid = js.valid && js.names[i] != js.names[j];
 }
 
 void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stamp stamp,
@@ -216,7 +230,8 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
     return;
   }
   JLE_FUZZ_CHECK(outcome != Outcome::kInvalid && outcome != Outcome::kFrame);
-  if (outcome == Outcome::kWaiting) return;
+  JLE_FUZZ_CHECK((outcome == Outcome::kNoJoint) == !moves(p, js));
+  if (outcome == Outcome::kNoJoint || outcome == Outcome::kWaiting) return;
   if (outcome == Outcome::kOrder) {
     JLE_FUZZ_CHECK(shadow.last != 0 && stamp <= shadow.last);
     return;
@@ -265,7 +280,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     decodeJointState(in, js);
     const jle::Outcome outcome =
         p.onJointState(stamp, clock, js.names, js.position, js.velocity, js.effort);
-    if (js.valid) shadow.clockSeen(effective, clock);
+    if (js.valid && moves(p, js)) shadow.clockSeen(effective, clock);
     checkJointOutcome(p, js, effective, outcome, shadow);
   }
   const jle::PipelineCounters& c = p.counters();

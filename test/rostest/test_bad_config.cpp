@@ -130,6 +130,14 @@ TEST(BadConfig, ValueOutOfRangeInEachKeyFamily) {
   expectRefused("/ko_savings", {"parameter 'savings/static_velocity'"});
 }
 
+// Hostile parameters (issue 14): refused at start with the key path as the user wrote it.
+TEST(BadConfig, EmptyTopicDuplicateJointsAndUnknownLinkNameTheirKeys) {
+  expectRefused("/empty_topic", {"parameter 'joint_states_topic' is required"});
+  expectRefused("/duplicate_joints", {"parameter 'joints[2]' is 'elbow_joint', as is 'joints[0]'"});
+  expectRefused("/unknown_wrench_link",
+                {"parameter 'wrenches[1]/link': 'tool9' is not a link of the model"});
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

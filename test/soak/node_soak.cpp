@@ -17,7 +17,8 @@
 //  3. the node's VmRSS is flat: at 100% of the samples it exceeds the value at
 //  10% (the
 //     buffers have grown to size by then) by at most --rss-limit kB;
-//  4. the node is alive at the end.
+//  4. the node is alive at the end;
+//  5. /diagnostics came at the node's diagnostic_period (wall clock) throughout.
 // Prints a summary; exits 1 on a failed check, 2 on a usage error.
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/command_line.hpp>
@@ -115,13 +116,16 @@ enum Bad {
   kNanWrench,
   kBackwardWrench,
   kUnresolvedFrame,
-  kTimeJump,  // not in the periodic cycle: --jumps times
+  kDuplicateName,  // a joint named twice
+  kEmpty,          // a joint state with no joint: not a sample
+  kNanEffort,      // a good sample with a NaN effort: its loads are published
+  kTimeJump,       // not in the periodic cycle: --jumps times
   kKinds
 };
-const char* const kBadName[kKinds] = {"nan_position",     "inf_position",  "position_length",
-                                      "velocity_length",  "unknown_joint", "duplicate_stamp",
-                                      "backward_stamp",   "nan_wrench",    "backward_wrench",
-                                      "unresolved_frame", "time_jump_back"};
+const char* const kBadName[kKinds] = {
+    "nan_position",    "inf_position",   "position_length", "velocity_length", "unknown_joint",
+    "duplicate_stamp", "backward_stamp", "nan_wrench",      "backward_wrench", "unresolved_frame",
+    "duplicate_name",  "empty",          "nan_effort",      "time_jump_back"};
 const char* const kBadKey[kKinds] = {"dropped: invalid",
                                      "dropped: invalid",
                                      "dropped: invalid",
@@ -132,6 +136,9 @@ const char* const kBadKey[kKinds] = {"dropped: invalid",
                                      "dropped: invalid",
                                      "dropped: stamp order",
                                      "dropped: unresolved frame",
+                                     "dropped: invalid",
+                                     "not used: no needed joint",
+                                     "efforts not compared: non-finite",
                                      "time jumps back"};
 constexpr long kBadPeriod = 50;          // one bad message per 50 good samples
 constexpr long kWrenchPeriod = 10;       // one wrench per 10 joint samples (100 Hz)
@@ -157,6 +164,7 @@ class Driver {
     delay_ = bank.config().delay;
     jump_back_ns_ = static_cast<std::int64_t>(2e9 * settings.time_jump_threshold);
     wrench_link_ = settings.estimator.wrenches[0].link;
+    diag_period_ = settings.diagnostic_period;
 
     std::string urdf;
     if (!nh_.getParam(settings.robot_description, urdf))
@@ -177,6 +185,9 @@ class Driver {
   bool run();
 
  private:
+  // Sample i of the schedule: a jump back when due, the good sample, its wrench, a bad
+  // message when due.
+  bool step(long i, long& next_jump);
   void onLoads(const joint_load_estimator::JointLoads::ConstPtr& msg) {
     const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
     const std::size_t r = received_.size();
@@ -259,7 +270,7 @@ class Driver {
 
   // The next good sample (positions: slow sines), the loads it must produce
   // recorded.
-  bool sendGood(bool ghost) {
+  bool sendGood(bool ghost, bool nan_effort = false) {
     const std::int64_t stamp = next_ns_;
     next_ns_ += kDtNs;
     const double t = 1e-9 * static_cast<double>(stamp - kEpochNs);
@@ -271,6 +282,11 @@ class Driver {
     if (ghost) {
       good_msg_.name.push_back("ghost_joint");
       good_msg_.position.push_back(1.0);
+    }
+    good_msg_.effort.clear();
+    if (nan_effort) {
+      good_msg_.effort.assign(names_.size(), 1.0);
+      good_msg_.effort[0] = std::nan("");
     }
     // The filter publishes from the warmup()-th sample after a (re)start on,
     // each time the estimate for the sample `delay` samples back.
@@ -330,6 +346,14 @@ class Driver {
       case kUnresolvedFrame:
         sendWrench(last_good_ns_ + kDtNs / 4, 1.0, "no_such_frame");
         return true;
+      case kDuplicateName:
+        m.name.push_back(names_[0]);
+        m.position.push_back(m.position[0] + 0.5);
+        break;
+      case kEmpty:
+        m.name.clear();
+        m.position.clear();
+        break;
       default: return false;
     }
     return sendJoint(m);
@@ -355,8 +379,39 @@ class Driver {
   std::vector<long> trigger_;  // index of the joint-state message that publishes expected_[r]
   std::map<std::string, long> last_diag_;
   long diag_count_ = 0;
+  double diag_period_ = 1.0;  // [s] the node's diagnostic_period (wall clock)
   long injected_[kKinds] = {};
 };
+
+bool Driver::step(long i, long& next_jump) {
+  if (next_jump <= o_.jumps && i == next_jump * o_.samples / (o_.jumps + 1)) {
+    // A looping bag: back to the first stamp (or further, so that the jump is
+    // at least twice the node's time_jump_threshold), once every input of the
+    // old timeline has been handled.
+    ++next_jump;
+    if (!barrier(0)) return false;
+    next_ns_ = std::min(kEpochNs, last_good_ns_ - jump_back_ns_);
+    segment_.clear();
+    segment_count_ = 0;
+    wrench_in_segment_ = false;
+    ++injected_[kTimeJump];
+  }
+  const Bad kind = static_cast<Bad>((i / kBadPeriod) % kTimeJump);
+  const bool bad_here = i % kBadPeriod == kBadPeriod / 5;
+  const bool ghost = bad_here && kind == kUnknownJoint;
+  const bool nan_effort = bad_here && kind == kNanEffort;
+  if (ghost) ++injected_[kUnknownJoint];
+  if (nan_effort) ++injected_[kNanEffort];
+  if (!sendGood(ghost, nan_effort)) return false;
+  if (i % kWrenchPeriod == 0) {
+    sendWrench(last_good_ns_, 10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
+               wrench_link_);
+    last_wrench_ns_ = last_good_ns_;
+    wrench_in_segment_ = true;
+  }
+  if (bad_here && !ghost && !nan_effort && sendBad(kind)) ++injected_[kind];
+  return ros::ok();
+}
 
 bool Driver::run() {
   std::printf(
@@ -378,34 +433,10 @@ bool Driver::run() {
   long next_jump = 1;
   long rss_10 = -1;
   const auto start = std::chrono::steady_clock::now();
+  const long diag_at_start = diag_count_;
   for (long i = 0; i < o_.samples; ++i) {
     if (i == o_.samples / 10) rss_10 = vmRssKb(o_.pid);
-    if (next_jump <= o_.jumps && i == next_jump * o_.samples / (o_.jumps + 1)) {
-      // A looping bag: back to the first stamp (or further, so that the jump is
-      // at least twice the node's time_jump_threshold), once every input of the
-      // old timeline has been handled.
-      ++next_jump;
-      if (!barrier(0)) return false;
-      next_ns_ = std::min(kEpochNs, last_good_ns_ - jump_back_ns_);
-      segment_.clear();
-      segment_count_ = 0;
-      wrench_in_segment_ = false;
-      ++injected_[kTimeJump];
-    }
-    const Bad kind = static_cast<Bad>((i / kBadPeriod) % kTimeJump);
-    const bool bad_here = i % kBadPeriod == kBadPeriod / 5;
-    const bool ghost = bad_here && kind == kUnknownJoint;
-    if (ghost) ++injected_[kUnknownJoint];
-    if (!sendGood(ghost)) return false;
-    if (i % kWrenchPeriod == 0) {
-      sendWrench(last_good_ns_,
-                 10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
-                 wrench_link_);
-      last_wrench_ns_ = last_good_ns_;
-      wrench_in_segment_ = true;
-    }
-    if (bad_here && !ghost && sendBad(kind)) ++injected_[kind];
-    if (!ros::ok()) return false;
+    if (!step(i, next_jump)) return false;
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -434,6 +465,14 @@ bool Driver::run() {
     }
   const double total_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // /diagnostics on the node's wall-clock timer: its rate whatever the inputs do (one
+  // period of slack at each end, 10% for a loaded machine's timer).
+  const long diag_seen = diag_count_ - diag_at_start;
+  const double diag_due = total_seconds / diag_period_;
+  std::printf("diagnostics: %ld in %.2f s, %.0f due at %.3f s\n", diag_seen, total_seconds,
+              diag_due, diag_period_);
+  expect(diag_seen >= 0.9 * diag_due - 2 && diag_seen <= 1.1 * diag_due + 2,
+         "diagnostics not at their configured rate");
   std::printf(
       "good samples %ld (%ld scheduled + %ld while waiting for "
       "diagnostics at the %ld "

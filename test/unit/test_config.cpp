@@ -125,6 +125,17 @@ TEST(Config, SettingsErrorIsAnInvalidArgument) {
   } catch (const jle::SettingsError& e) {
     EXPECT_EQ(std::string(e.what()), "parameter 'wrenches[0]/sign' must be +1 or -1, it is 0");
   }
+  // A link the model does not have: the key path as the user wrote it.
+  c.wrenches[0].sign = 1.0;
+  c.wrenches.push_back(c.wrenches[0]);
+  c.wrenches[1].link = "no_such_link";
+  try {
+    jle::Estimator estimator(ur5, c);
+    ADD_FAILURE() << "an unknown link was accepted";
+  } catch (const jle::SettingsError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "parameter 'wrenches[1]/link': 'no_such_link' is not a link of the model");
+  }
 }
 
 TEST(Config, TopLevel) {
@@ -142,7 +153,17 @@ TEST(Config, TopLevel) {
              {"base_residual_threshold", [](Settings& s) { s.base_residual_threshold = -0.1; }},
              {"still_velocity", [](Settings& s) { s.still_velocity = kNaN; }},
              {"diagnostic_period", [](Settings& s) { s.diagnostic_period = 0.0; }},
-             {"diagnostic_period", [](Settings& s) { s.diagnostic_period = kInf; }}},
+             {"diagnostic_period", [](Settings& s) { s.diagnostic_period = kInf; }},
+             {"joint_states_topic", [](Settings& s) { s.joint_states_topic.clear(); }},
+             {"robot_description", [](Settings& s) { s.robot_description.clear(); }},
+             {"joints[1]",
+              [](Settings& s) {
+                s.estimator.joints = {"a", "a"};
+              }},
+             {"keep_fixed_joints[2]",
+              [](Settings& s) {
+                s.keep_fixed_joints = {"a", "b", "b"};
+              }}},
             false);
 }
 

@@ -320,3 +320,96 @@ TEST(Pipeline, MalformedMessagesAreCountedAndNamed) {
 }
 
 }  // namespace
+
+namespace {
+
+// Issue 14, item 1: every hostile joint state is used or counted under its reason, and
+// the loads of the good messages are exactly those of the good messages alone.
+TEST(Pipeline, HostileJointStatesAreCountedAndChangeNoLoads) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  jle::Pipeline clean(model, settings, nullptr), hostile(model, settings, nullptr);
+  const std::vector<std::string>& names = model.coordinate_names;
+  std::vector<std::string> twice = names;
+  twice.push_back(names[1]);  // shoulder_lift twice, the second 0.5 rad off
+  const std::vector<std::string> gripper = {"gripper_finger_joint"};
+  std::vector<double> p(6), pe(6, 1.0), p_twice, one = {0.3};
+  int compared = 0;
+  for (int k = 0; k < 60; ++k) {
+    const Stamp stamp = kStart + k * kMs;
+    const double t = k * 1e-3;
+    for (int i = 0; i < 6; ++i) p[i] = q(i, t);
+    // Before the good message of this stamp: a duplicate, an empty one, a gripper's.
+    p_twice = p;
+    p_twice.push_back(p[1] + 0.5);
+    EXPECT_EQ(hostile.onJointState(stamp, stamp, twice, p_twice, kNone, kNone), Outcome::kInvalid);
+    EXPECT_NE(hostile.problem().find("'" + names[1] + "' is named twice"), std::string::npos)
+        << hostile.problem();
+    EXPECT_EQ(hostile.onJointState(stamp - kMs / 2, stamp, {}, kNone, kNone, kNone),
+              Outcome::kNoJoint);
+    EXPECT_EQ(hostile.onJointState(stamp - kMs / 3, stamp, gripper, one, kNone, one),
+              Outcome::kNoJoint);
+    // The good one; every 7th with a NaN effort on joint 2 (the loads still computed).
+    std::vector<double> effort = pe;
+    if (k % 7 == 3) effort[2] = std::nan("");
+    const Outcome a = clean.onJointState(stamp, stamp, names, p, kNone, pe);
+    const Outcome b = hostile.onJointState(stamp, stamp, names, p, kNone, effort);
+    ASSERT_EQ(a, b) << k;
+    EXPECT_EQ(hostile.nonFiniteEffort(), k % 7 == 3 ? names[2] : "");
+    if (b != Outcome::kPublished) continue;
+    const jle::LoadsRecord &rc = clean.record(), &rh = hostile.record();
+    ASSERT_EQ(rc.stamp, rh.stamp);
+    for (std::size_t i = 0; i < rc.segment.size(); ++i) {
+      // The same samples in the same order: bit-identical.
+      EXPECT_EQ(rc.force[i], rh.force[i]);
+      EXPECT_EQ(rc.moment[i], rh.moment[i]);
+      EXPECT_EQ(rc.effort[i], rh.effort[i]);
+    }
+    // The record describes the middle sample (finite differences, window 3): the NaN
+    // effort drops that sample's comparison for joint 2 only.
+    const bool nan_sample = (rh.stamp - kStart) / kMs % 7 == 3;
+    EXPECT_EQ(std::isnan(rh.measured_effort[2]), nan_sample);
+    EXPECT_EQ(rh.measured_effort[1], 1.0);
+    compared += nan_sample;
+  }
+  EXPECT_GT(compared, 0);
+  const jle::PipelineCounters& c = hostile.counters();
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kInvalid), 60);
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kNoJoint), 120);
+  EXPECT_EQ(c.nonfinite_efforts, 9);  // k = 3, 10, ..., 59
+  EXPECT_EQ(c.resets, 0);
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kPublished),
+            clean.counters().count(InputKind::kJointState, Outcome::kPublished));
+}
+
+TEST(Pipeline, ProblemKeysKeepTheDigitsOfNames) {
+  // Numbers do not make another problem; a name's digits do ('/ft2' is not '/ft').
+  EXPECT_EQ(jle::problemKey("stamp 1700000000.123 (previous 1700000000.124)"),
+            jle::problemKey("stamp 1700000001.5 (previous 1700000001.6)"));
+  EXPECT_NE(jle::problemKey("stale inputs (stale_policy stop): /ft2: not publishing"),
+            jle::problemKey("stale inputs (stale_policy stop): /ft: not publishing"));
+  EXPECT_NE(jle::problemKey("joint 'wrist_1_joint'"), jle::problemKey("joint 'wrist_2_joint'"));
+}
+
+TEST(Pipeline, StaleStopNamesTheStoppingInputOnly) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  addWrenchInput(settings, "tool0");
+  settings.wrenches[0].topic = "/ft";
+  settings.wrenches[1].topic = "/ft2";
+  settings.estimator.wrenches[1].stale_policy = jle::StalePolicy::kStop;
+  jle::Pipeline pipeline(model, settings, nullptr);
+  EXPECT_EQ(pipeline.missingJoint(), model.coordinate_names[0]);
+  const std::vector<double> p(6, 0.1);
+  Outcome last = Outcome::kUsed;
+  for (int k = 0; k < 5; ++k)  // neither input has spoken: both stale, only /ft2 stops
+    last = pipeline.onJointState(kStart + k * kMs, 0, model.coordinate_names, p, kNone, kNone);
+  EXPECT_EQ(last, Outcome::kStale);
+  EXPECT_EQ(pipeline.missingJoint(), "");
+  EXPECT_EQ(pipeline.stoppingInputs(), "/ft2");
+  EXPECT_NE(pipeline.problem().find(": /ft2: not publishing"), std::string::npos)
+      << pipeline.problem();
+}
+
+}  // namespace

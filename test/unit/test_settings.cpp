@@ -337,6 +337,11 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
                 "'force_plates[0]/orientation' must be a quaternion");
   expectRefused("savings: [prune]", "parameter 'savings' must be a map");
   expectRefused("diagnostics_period: 1", "unknown parameter 'diagnostics_period'");
+  // Issue 14: an empty topic and a joint listed twice are refused at start, key named.
+  expectRefused("joint_states_topic: ''", "parameter 'joint_states_topic' is required");
+  expectRefused("wrenches: [{topic: '', link: l}]", "parameter 'wrenches[0]/topic' is required");
+  expectRefused("joints: [a, b, a]", "parameter 'joints[2]' is 'a', as is 'joints[0]'");
+  expectRefused("keep_fixed_joints: [f, f]", "parameter 'keep_fixed_joints[1]' is 'f'");
 }
 
 // ---------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@
 #include <ros/time.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2/buffer_core.h>
+#include <tf2/exceptions.h>
 
 #include <string>
 
@@ -30,6 +31,9 @@ class Tf2FrameSource : public FrameSource {
               Eigen::Isometry3d& X_target_frame, std::string& error) override;
 
  private:
+  std::string lookupError(const tf2::TransformException& e, const std::string& target,
+                          const std::string& frame, Stamp stamp) const;
+
   const tf2::BufferCore& buffer_;
 };
 

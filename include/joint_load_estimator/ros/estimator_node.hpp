@@ -7,6 +7,7 @@
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
+#include <joint_load_estimator/ros/input_health.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
 
@@ -44,6 +45,7 @@ class EstimatorNode {
  private:
   struct WrenchTopic {
     ros::Subscriber subscriber;
+    InputHealth health;
     // Sensor inputs (sensor_joint): the residual of the last published sample in the
     // reading's frame, its output ~consistency/<sensor_joint> and its extremes.
     Wrench<double> residual;
@@ -63,6 +65,7 @@ class EstimatorNode {
 
   struct PlateTopic {
     ros::Subscriber subscriber;
+    InputHealth health;
     ros::Publisher cop_pub;
   };
 
@@ -70,14 +73,24 @@ class EstimatorNode {
   void advertise();
   void subscribe();
   void setUpConsistency();
-  void onJointState(const sensor_msgs::JointState::ConstPtr& msg);
-  void onWrench(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
-  void onPlate(std::size_t k, const geometry_msgs::WrenchStamped::ConstPtr& msg);
+  using JointStateEvent = ros::MessageEvent<const sensor_msgs::JointState>;
+  using WrenchEvent = ros::MessageEvent<const geometry_msgs::WrenchStamped>;
+  void onJointState(const JointStateEvent& event);
+  void onWrench(std::size_t k, const WrenchEvent& event);
+  void onPlate(std::size_t k, const WrenchEvent& event);
   // Logs what the pipeline said of the last message, each problem throttled on its own.
   void report(Outcome outcome);
   void publish(const ros::Time& received);
   void publishPlates(const ros::Time& stamp);
+  // /diagnostics on a wall-clock timer (diagnostic_period): it keeps its rate whatever
+  // the inputs and the (sim) clock do.
+  void onDiagnosticsTimer(const ros::WallTimerEvent& event);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  // The first of the reasons why the loads are not flowing, or empty (diagnose()).
+  void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& status, long published);
+  // Per input: received, used, lost; an input whose readings are all dropped is WARN.
+  std::string diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& status);
   // Predicted against measured (sensor residuals, floating-base residual).
   void publishConsistency(const ros::Time& stamp);
   void publishResidual(std::size_t k, const ros::Time& stamp);
@@ -105,6 +118,10 @@ class EstimatorNode {
   geometry_msgs::WrenchStamped wrench_msg_;
   geometry_msgs::PointStamped cop_msg_;
   diagnostic_updater::Updater updater_;
+  ros::WallTimer diagnostics_timer_;
+  InputHealth joint_health_;
+  Outcome last_joint_outcome_ = Outcome::kUsed;  // of the last joint state
+  ros::WallTime started_ = ros::WallTime::now();
   // When each problem (problemKey) was last logged [wall s], and callbacks that threw.
   std::unordered_map<std::size_t, double> last_log_;
   long exceptions_ = 0;
