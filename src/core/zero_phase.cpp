@@ -1,0 +1,360 @@
+// Zero-phase Butterworth smoothing of a whole record (docs/zero_phase.md).
+#include <joint_load_estimator/zero_phase.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+#include <string>
+
+namespace jle {
+namespace {
+
+// One second-order section in direct form II transposed (as scipy.signal.sosfilt):
+// y = b0 x + z1, z1' = b1 x - a1 y + z2, z2' = b2 x - a2 y.
+struct Section {
+  double b0, b1, b2, a1, a2;
+};
+
+// Butterworth low-pass of `order`, cutoff w as a fraction of the sampling rate
+// (0 < w < 0.5), by the bilinear transform with prewarping (as scipy.signal.butter);
+// every section has a DC gain of 1.
+std::vector<Section> butterworth(double w, int order) {
+  const double warped = 2.0 * std::tan(M_PI * w);  // the analog cutoff [rad/sample]
+  std::vector<Section> sections;
+  for (int k = 0; k < order / 2; ++k) {
+    // The pole in the upper left quadrant; its conjugate is the section's other pole.
+    const std::complex<double> p =
+        warped * std::polar(1.0, M_PI * (2.0 * k + order + 1) / (2.0 * order));
+    const std::complex<double> z = (2.0 + p) / (2.0 - p);
+    const double a1 = -2.0 * z.real(), a2 = std::norm(z);
+    const double g = (1.0 + a1 + a2) / 4.0;  // numerator g (1 + z^-1)^2
+    sections.push_back({g, 2.0 * g, g, a1, a2});
+  }
+  if (order % 2 == 1) {
+    const double a1 = -(2.0 - warped) / (2.0 + warped);  // the real pole p = -warped
+    const double g = (1.0 + a1) / 2.0;
+    sections.push_back({g, g, 0.0, a1, 0.0});
+  }
+  return sections;
+}
+
+// Filters y[0 .. n-1] in place through the sections, each started in the steady state of
+// a constant input y[0] (scipy.signal.sosfilt_zi times y[0]; every DC gain is 1).
+void runSections(const std::vector<Section>& sections, double* y, int n) {
+  const double x0 = y[0];
+  for (const Section& c : sections) {
+    double z2 = (c.b2 - c.a2) * x0;
+    double z1 = (c.b1 - c.a1) * x0 + z2;
+    for (int i = 0; i < n; ++i) {
+      const double x = y[i];
+      const double out = c.b0 * x + z1;
+      z1 = c.b1 * x - c.a1 * out + z2;
+      z2 = c.b2 * x - c.a2 * out;
+      y[i] = out;
+    }
+  }
+}
+
+// The forward-backward filter of one channel x (n samples), padded by `pad` samples at
+// each end: the line through the two end samples is taken out, the rest extended by odd
+// reflection about its ends, filtered forward and backward, and the line put back (so
+// that a constant and a ramp pass exactly). Returns the n + 2 pad samples, the input's
+// at pad .. pad + n - 1.
+Eigen::VectorXd filtfiltPadded(const std::vector<Section>& sections, const double* x, int n,
+                               int pad) {
+  const double slope = (x[n - 1] - x[0]) / (n - 1);
+  const auto line = [&](int i) { return x[0] + slope * i; };
+  Eigen::VectorXd y(n + 2 * pad);
+  for (int i = 0; i < n; ++i) y[pad + i] = x[i] - line(i);
+  for (int k = 1; k <= pad; ++k) {
+    y[pad - k] = -y[pad + k];
+    y[pad + n - 1 + k] = -y[pad + n - 1 - k];
+  }
+  runSections(sections, y.data(), static_cast<int>(y.size()));
+  y.reverseInPlace();
+  runSections(sections, y.data(), static_cast<int>(y.size()));
+  y.reverseInPlace();
+  for (int i = 0; i < y.size(); ++i) y[i] += line(i - pad);
+  return y;
+}
+
+// The uniform time axis that the filter runs on: t0 + k h, k = 0 .. m. `uniform`: the
+// input stamps are on it (within 1e-4 h) and are used as they are.
+struct Grid {
+  double t0 = 0.0, h = 0.0;
+  int m = 0;
+  bool uniform = true;
+  double at(int k) const { return t0 + k * h; }
+};
+
+// The median period of t, and the grid spanning t at (about) that period.
+Grid gridOf(const std::vector<double>& t) {
+  std::vector<double> dt(t.size() - 1);
+  for (std::size_t i = 0; i + 1 < t.size(); ++i) dt[i] = t[i + 1] - t[i];
+  const std::size_t mid = dt.size() / 2;
+  std::nth_element(dt.begin(), dt.begin() + mid, dt.end());
+  double median = dt[mid];
+  if (dt.size() % 2 == 0) median = 0.5 * (median + *std::max_element(dt.begin(), dt.begin() + mid));
+  Grid grid;
+  grid.t0 = t.front();
+  grid.m = std::max(2, static_cast<int>(std::lround((t.back() - t.front()) / median)));
+  grid.h = (t.back() - t.front()) / grid.m;
+  grid.uniform = grid.m + 1 == static_cast<int>(t.size());
+  for (std::size_t i = 0; grid.uniform && i < t.size(); ++i)
+    grid.uniform = std::abs(t[i] - grid.at(static_cast<int>(i))) <= 1e-4 * grid.h;
+  return grid;
+}
+
+// The interval [k, k + 1] of the grid that holds time s, and the fraction of it.
+int intervalOf(const Grid& grid, double s, double& fraction) {
+  const int k = std::min(grid.m - 1, std::max(0, static_cast<int>((s - grid.t0) / grid.h)));
+  fraction = (s - grid.at(k)) / grid.h;
+  return k;
+}
+
+// x (at the stamps t) linearly interpolated onto the grid.
+Eigen::MatrixXd resample(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x) {
+  Eigen::MatrixXd out(grid.m + 1, x.cols());
+  std::size_t i = 0;
+  for (int k = 0; k <= grid.m; ++k) {
+    const double s = k == grid.m ? t.back() : grid.at(k);
+    while (i + 2 < t.size() && t[i + 1] <= s) ++i;
+    const double f = (s - t[i]) / (t[i + 1] - t[i]);
+    out.row(k) = (1.0 - f) * x.row(i) + f * x.row(i + 1);
+  }
+  return out;
+}
+
+void checkInput(const std::vector<double>& t, const Eigen::MatrixXd& x) {
+  if (static_cast<Eigen::Index>(t.size()) != x.rows())
+    throw std::invalid_argument("zero_phase: " + std::to_string(t.size()) + " stamps for " +
+                                std::to_string(x.rows()) + " samples");
+  if (t.size() < 3)
+    throw std::invalid_argument("zero_phase: " + std::to_string(t.size()) +
+                                " samples; at least 3 are needed");
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!std::isfinite(t[i]) || (i > 0 && !(t[i] > t[i - 1])))
+      throw std::invalid_argument("zero_phase: stamp " + std::to_string(i) +
+                                  " is not finite or does not increase");
+  }
+  if (!x.allFinite()) throw std::invalid_argument("zero_phase: a sample is not finite");
+}
+
+// The samples added at each end: `padding` (0: 3 (order + 1)), at least the 2 that the
+// derivatives' stencil needs, at most samples - 1 (the odd reflection's reach).
+int paddingOf(int padding, int order, int samples) {
+  return std::min(std::max(2, padding > 0 ? padding : 3 * (order + 1)), samples - 1);
+}
+
+// Every channel of xg (on the grid, L samples) smoothed: the padded outputs, (L + 2 pad)
+// x channels.
+Eigen::MatrixXd smoothPadded(const Eigen::MatrixXd& xg, double w, int order, int pad) {
+  const std::vector<Section> sections = butterworth(w, order);
+  const int n = static_cast<int>(xg.rows());
+  Eigen::MatrixXd out(n + 2 * pad, xg.cols());
+  for (Eigen::Index c = 0; c < xg.cols(); ++c)
+    out.col(c) = filtfiltPadded(sections, xg.col(c).data(), n, pad);
+  return out;
+}
+
+// The cutoff as a fraction of the grid's sampling rate, checked against the Nyquist rate.
+double relativeCutoff(const Grid& grid, double cutoff) {
+  const double w = cutoff * grid.h;
+  if (!(w < 0.5))
+    throw std::invalid_argument("zero_phase cutoff " + std::to_string(cutoff) +
+                                " Hz must be below half the sampling rate (" +
+                                std::to_string(0.5 / grid.h) + " Hz)");
+  return w;
+}
+
+// Mean square of x - smooth(x) over every channel, cutoff w [1/sample], away from the
+// ends: the padding's transient (odd reflection bends the curvature) would otherwise
+// dominate the residual at low cutoffs. The margin is 2 / w samples (two periods of the
+// cutoff) at each end, at most a quarter of the record.
+double meanSquareResidual(const Eigen::MatrixXd& xg, double w, int order, int pad) {
+  const Eigen::MatrixXd s = smoothPadded(xg, w, order, pad);
+  const Eigen::Index n = xg.rows();
+  const Eigen::Index margin = std::min<Eigen::Index>(static_cast<Eigen::Index>(std::ceil(2.0 / w)), n / 4);
+  const Eigen::Index inner = n - 2 * margin;
+  return (xg.middleRows(margin, inner) - s.middleRows(pad + margin, inner)).squaredNorm() /
+         static_cast<double>(inner * xg.cols());
+}
+
+// Winter's residual analysis: the residual's RMS R(w) is a straight line where it holds
+// only noise (fitted over 0.2 .. 0.4 of the sampling rate); its intercept a at w = 0
+// estimates the noise, and the cutoff is where R(w) = a (bisection on log w).
+double residualCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
+  const int fits = 9;
+  double sw = 0, sr = 0, sww = 0, swr = 0;
+  for (int j = 0; j < fits; ++j) {
+    const double w = 0.2 + 0.025 * j;
+    const double r = std::sqrt(meanSquareResidual(xg, w, order, pad));
+    sw += w, sr += r, sww += w * w, swr += w * r;
+  }
+  const double slope = (fits * swr - sw * sr) / (fits * sww - sw * sw);
+  const double a = (sr - slope * sw) / fits;
+  const auto above = [&](double w) { return meanSquareResidual(xg, w, order, pad) > a * a; };
+  double lo = std::log(w_lo), hi = std::log(0.2);
+  if (!above(w_lo)) return w_lo;
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (above(std::exp(mid)) ? lo : hi) = mid;
+  }
+  return std::exp(hi);
+}
+
+// The generalised cross-validation score of the smoother at cutoff w: mean square
+// residual / (1 - tr(S) / L)^2, tr(S) from the filter's gain |H|^2 at the L DFT
+// frequencies of the record (the circulant approximation of the smoother S).
+double gcvScore(const Eigen::MatrixXd& xg, double w, int order, int pad) {
+  const Eigen::Index n = xg.rows();
+  const double tc = std::tan(M_PI * w);
+  double trace = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double ratio = std::tan(M_PI * static_cast<double>(k) / n) / tc;
+    trace += 1.0 / (1.0 + std::pow(ratio * ratio, order));
+  }
+  const double dof = 1.0 - trace / static_cast<double>(n);
+  return meanSquareResidual(xg, w, order, pad) / (dof * dof);
+}
+
+// The GCV minimum over w_lo .. 0.4: a scan at ratio 1.1, then a golden section between the
+// best scanned point's neighbours (on log w).
+double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
+  const auto score = [&](double log_w) { return gcvScore(xg, std::exp(log_w), order, pad); };
+  const double step = std::log(1.1), lo = std::log(w_lo);
+  const int steps = std::max(1, static_cast<int>(std::ceil((std::log(0.4) - lo) / step)));
+  int best = 0;
+  double best_score = score(lo);
+  for (int j = 1; j <= steps; ++j) {
+    const double s = score(lo + j * step);
+    if (s < best_score) best_score = s, best = j;
+  }
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = lo + std::max(0, best - 1) * step, b = lo + std::min(steps, best + 1) * step;
+  double c = b - g * (b - a), d = a + g * (b - a);
+  double fc = score(c), fd = score(d);
+  for (int i = 0; i < 30; ++i) {
+    if (fc < fd) {
+      b = d, d = c, fd = fc, c = b - g * (b - a), fc = score(c);
+    } else {
+      a = c, c = d, fc = fd, d = a + g * (b - a), fd = score(d);
+    }
+  }
+  return std::exp(0.5 * (a + b));
+}
+
+// The cutoff [Hz] of the rule, for channels xg on the grid.
+double cutoffOf(const Grid& grid, const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
+  if (config.rule == CutoffRule::kFixed) return config.cutoff;
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  // The lowest cutoff searched: a thousandth of the rate, or a period over the record.
+  const double w_lo = std::max(1e-3, 1.0 / grid.m);
+  const double w = config.rule == CutoffRule::kResidual
+                       ? residualCutoff(xg, w_lo, config.order, pad)
+                       : gcvCutoff(xg, w_lo, config.order, pad);
+  return w / grid.h;
+}
+
+// Rate and acceleration of the padded smoothed channels at the grid's samples, by 5-point
+// central differences (error O(h^4)); the padding supplies the neighbours at the ends.
+void differentiate(const Eigen::MatrixXd& padded, int pad, double h, Eigen::MatrixXd& rate,
+                   Eigen::MatrixXd& accel) {
+  const Eigen::Index n = padded.rows() - 2 * pad;
+  const auto y = [&](Eigen::Index k, int d) { return padded.row(pad + k + d); };
+  rate.resize(n, padded.cols());
+  accel.resize(n, padded.cols());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    rate.row(k) = (y(k, -2) - 8.0 * y(k, -1) + 8.0 * y(k, 1) - y(k, 2)) / (12.0 * h);
+    accel.row(k) =
+        (-y(k, -2) + 16.0 * y(k, -1) - 30.0 * y(k, 0) + 16.0 * y(k, 1) - y(k, 2)) / (12.0 * h * h);
+  }
+}
+
+// The grid's smoothed value, rate and acceleration evaluated at the stamps t: value by the
+// cubic Hermite interpolant of (value, rate), rate by that of (rate, accel), acceleration
+// linearly.
+void evaluateAt(const Grid& grid, const std::vector<double>& t, ZeroPhaseResult& r) {
+  const Eigen::MatrixXd v = r.value, d = r.rate, a = r.accel;
+  const double h = grid.h;
+  const auto rows = static_cast<Eigen::Index>(t.size());
+  r.value.resize(rows, v.cols());
+  r.rate.resize(rows, v.cols());
+  r.accel.resize(rows, v.cols());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    double s = 0.0;
+    const int k = intervalOf(grid, t[i], s);
+    const double h00 = (2 * s - 3) * s * s + 1, h10 = ((s - 2) * s + 1) * s;
+    const double h01 = (3 - 2 * s) * s * s, h11 = (s - 1) * s * s;
+    const auto row = static_cast<Eigen::Index>(i);
+    r.value.row(row) = h00 * v.row(k) + h10 * h * d.row(k) + h01 * v.row(k + 1) + h11 * h * d.row(k + 1);
+    r.rate.row(row) = h00 * d.row(k) + h10 * h * a.row(k) + h01 * d.row(k + 1) + h11 * h * a.row(k + 1);
+    r.accel.row(row) = (1.0 - s) * a.row(k) + s * a.row(k + 1);
+  }
+}
+
+}  // namespace
+
+void validate(const ZeroPhaseConfig& config) {
+  if (config.rule == CutoffRule::kFixed && !(config.cutoff > 0.0 && std::isfinite(config.cutoff)))
+    throw std::invalid_argument("zero_phase cutoff must be finite and > 0 [Hz] (got " +
+                                std::to_string(config.cutoff) + ")");
+  if (config.order < 1 || config.order > 8)
+    throw std::invalid_argument("zero_phase order must be 1..8 (got " +
+                                std::to_string(config.order) + ")");
+  if (config.padding < 0)
+    throw std::invalid_argument("zero_phase padding must be >= 0 (got " +
+                                std::to_string(config.padding) + ")");
+}
+
+double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                    const ZeroPhaseConfig& config) {
+  validate(config);
+  checkInput(t, x);
+  const Grid grid = gridOf(t);
+  return cutoffOf(grid, grid.uniform ? x : resample(grid, t, x), config);
+}
+
+ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                                const ZeroPhaseConfig& config) {
+  validate(config);
+  checkInput(t, x);
+  const Grid grid = gridOf(t);
+  const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
+  ZeroPhaseResult r;
+  r.cutoff = cutoffOf(grid, xg, config);
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  const Eigen::MatrixXd padded =
+      smoothPadded(xg, relativeCutoff(grid, r.cutoff), config.order, pad);
+  r.value = padded.middleRows(pad, xg.rows());
+  differentiate(padded, pad, grid.h, r.rate, r.accel);
+  if (!grid.uniform) evaluateAt(grid, t, r);
+  return r;
+}
+
+Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                                 double cutoff, int order, int padding) {
+  ZeroPhaseConfig config;
+  config.rule = CutoffRule::kFixed;
+  config.cutoff = cutoff;
+  config.order = order;
+  config.padding = padding;
+  validate(config);
+  checkInput(t, x);
+  const Grid grid = gridOf(t);
+  const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
+  const int pad = paddingOf(padding, order, static_cast<int>(xg.rows()));
+  const Eigen::MatrixXd s = smoothPadded(xg, relativeCutoff(grid, cutoff), order, pad);
+  if (grid.uniform) return s.middleRows(pad, xg.rows());
+  // Back at the stamps: linearly (no derivatives to build a Hermite interpolant from).
+  Eigen::MatrixXd out(x.rows(), x.cols());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    double f = 0.0;
+    const int k = intervalOf(grid, t[i], f);
+    out.row(static_cast<Eigen::Index>(i)) = (1.0 - f) * s.row(pad + k) + f * s.row(pad + k + 1);
+  }
+  return out;
+}
+
+}  // namespace jle
