@@ -809,8 +809,9 @@ struct Score {
   double rms_effort = 0, max_effort = 0, rms_force = 0, max_force = 0, rms_moment = 0,
          max_moment = 0;
   double rms_true_effort = 0, rms_true_force = 0, rms_true_moment = 0;
-  /// How far the effort estimate leaves the truth's range over the after-impact windows
-  /// (the whole record without impacts), over that range; ALL: the worst joint's.
+  /// How far the effort estimate leaves the truth's range in an after-impact window (the
+  /// whole record without impacts), over that range: the worst window's; ALL: the worst
+  /// joint's.
   double overshoot = 0;
 };
 
@@ -888,7 +889,7 @@ double phaseLag(const Scene& scene, const std::vector<double>& times, const Eige
   return (best + std::max(-0.5, std::min(0.5, offset))) * h;
 }
 
-// The envelope of one joint's estimated and true effort over the overshoot windows.
+// The envelope of one joint's estimated and true effort over one overshoot window.
 struct Envelope {
   double est_max = -std::numeric_limits<double>::infinity();
   double est_min = std::numeric_limits<double>::infinity();
@@ -909,11 +910,13 @@ struct Envelope {
   }
 };
 
-bool inWindow(const Scene& scene, double t) {
-  if (scene.windows.empty()) return true;
-  for (const auto& w : scene.windows)
-    if (t >= w.first && t < w.second) return true;
-  return false;
+// The overshoot window holding the true instant t, or -1 (none): 0 for the whole record
+// without impacts.
+int windowOf(const Scene& scene, double t) {
+  if (scene.windows.empty()) return 0;
+  for (std::size_t i = 0; i < scene.windows.size(); ++i)
+    if (t >= scene.windows[i].first && t < scene.windows[i].second) return static_cast<int>(i);
+  return -1;
 }
 
 // One estimate of joint j against the truth at reading k, into its score and ALL's.
@@ -938,9 +941,10 @@ void accumulate(const Scene& scene, int row, long k, const double* o, Score& joi
   }
 }
 
-// The sums into RMS values, the joints named, the overshoots (ALL: the worst joint's).
+// The sums into RMS values, the joints named, the overshoots (per joint the worst
+// window's, ALL the worst joint's). envelopes: per joint, per window.
 void finish(const jle::Model<double>& model, const std::vector<int>& segments,
-            const std::vector<Envelope>& envelopes, std::vector<Score>& scores) {
+            const std::vector<std::vector<Envelope>>& envelopes, std::vector<Score>& scores) {
   const std::size_t nseg = segments.size();
   for (std::size_t j = 0; j <= nseg; ++j) {
     Score& s = scores[j];
@@ -949,10 +953,9 @@ void finish(const jle::Model<double>& model, const std::vector<int>& segments,
     for (double* x : {&s.rms_effort, &s.rms_force, &s.rms_moment, &s.rms_true_effort,
                       &s.rms_true_force, &s.rms_true_moment})
       *x = std::sqrt(*x / count);
-    if (j < nseg) {
-      s.overshoot = envelopes[j].overshoot();
-      scores.back().overshoot = std::max(scores.back().overshoot, s.overshoot);
-    }
+    if (j >= nseg) continue;
+    for (const Envelope& e : envelopes[j]) s.overshoot = std::max(s.overshoot, e.overshoot());
+    scores.back().overshoot = std::max(scores.back().overshoot, s.overshoot);
   }
 }
 
@@ -967,7 +970,9 @@ RunResult score(const Scene& scene, const Outputs& out, const std::vector<int>& 
   for (int s : segments)
     rows.push_back(static_cast<int>(std::find(moving.begin(), moving.end(), s) - moving.begin()));
   std::vector<Score> scores(static_cast<std::size_t>(nseg) + 1);
-  std::vector<Envelope> envelopes(static_cast<std::size_t>(nseg));
+  std::vector<std::vector<Envelope>> envelopes(
+      static_cast<std::size_t>(nseg),
+      std::vector<Envelope>(std::max<std::size_t>(1, scene.windows.size())));
   double lag_sum = 0.0;
   std::vector<double> scored_times;
   std::vector<Eigen::Index> scored_columns;
@@ -978,12 +983,14 @@ RunResult score(const Scene& scene, const Outputs& out, const std::vector<int>& 
     if (t < scene.settle) continue;
     scored_times.push_back(t);
     scored_columns.push_back(static_cast<Eigen::Index>(p));
-    const bool window = inWindow(scene, t);
+    const int window = windowOf(scene, t);
     const double* o = &out.loads[p * 7 * static_cast<std::size_t>(nseg)];
     for (int j = 0; j < nseg; ++j, o += 7) {
       const int row = rows[static_cast<std::size_t>(j)];
       accumulate(scene, row, k, o, scores[static_cast<std::size_t>(j)], scores.back());
-      if (window) envelopes[static_cast<std::size_t>(j)].add(o[0], scene.true_effort(row, k));
+      if (window >= 0)
+        envelopes[static_cast<std::size_t>(j)][static_cast<std::size_t>(window)].add(
+            o[0], scene.true_effort(row, k));
     }
   }
   finish(model, segments, envelopes, scores);
