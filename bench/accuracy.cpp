@@ -1,8 +1,9 @@
-// accuracy: error against run time and delay of the online estimator (jle::Estimator,
-// the code the node runs), over its differentiators, precisions and savings, on
-// scenes whose exact joint loads are known (ground_truth.hpp). Writes one CSV row per
-// configuration and joint plus an overall row per configuration; bench/plot_accuracy.py
-// turns it into docs/accuracy.md and the figures. tools/accuracy.sh runs both.
+// accuracy: error against run time and delay of the online estimator (jle::Pipeline,
+// the message path the node runs), over its differentiators, precisions and savings, and
+// of the offline zero-phase smoother (zero_phase.hpp), on scenes whose exact joint loads
+// are known (ground_truth.hpp). Writes one CSV row per configuration and joint plus an
+// overall row per configuration; bench/plot_accuracy.py turns it into docs/accuracy.md
+// and the figures. tools/accuracy.sh runs both.
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
@@ -33,14 +34,15 @@ namespace {
 const char* const kUsage =
     R"(usage: accuracy --csv OUT.csv [--quick] [--repeat N] [--scene NAME] [--data DIR]
 
-Runs every scene's sensor readings through jle::Estimator for each configuration and
-compares the loads with the exact ones at the estimate's stamp (a sample stamp).
+Runs every scene's sensor readings through jle::Pipeline (the node's message path) for
+each configuration, and through the offline zero-phase smoother, and compares the loads
+with the exact ones at the true instant of the sample each estimate describes.
 
   --csv PATH    where the results go (CSV, one row per configuration x joint, plus
                 a row per configuration with joint = ALL; scene_description on the
                 scene's first row only)
-  --quick       a tiny input (0.3 s per scene, a few configurations): checks that the
-                study still runs, in a second
+  --quick       a tiny input (0.3 s per scene, 2 s for the impact scenes, a few
+                configurations): checks that the study still runs, in a second
   --repeat N    timed runs per configuration of the main scene and of the savings
                 sweeps on TALOS and the planar chain (the fastest counts; default 5;
                 other scenes 1)

@@ -434,7 +434,8 @@ def main():
       "single drops, the stated noise before 2^17-count quantisation. "
       "Other scenes: encoder: 2^17 counts per revolution (4.8e-5 rad per count) after 5e-6 rad of "
       "Gaussian noise. Kalman filters get measurement_noise = sqrt(noise^2 + count^2 / 12) "
-      "= 1.5e-5 rad (1e-6 rad for exact inputs). Trajectories, wrenches and sensors: "
+      "= 1.5e-5 rad (1e-6 rad for exact inputs; the scene's noise in the `arm_*` scenes), but "
+      "those labelled r=1e-04 and `default`, which keep their own. Trajectories, wrenches and sensors: "
       "test/support/jle_testing/ground_truth.hpp.\n\n")
 
     w(f"## Main scene: `{MAIN}`, default savings\n\n")
