@@ -290,7 +290,7 @@ struct Scene {
   Eigen::MatrixXd true_qdd_grid;    // nq x G, at (g - grid_offset) * grid_step
   int grid_offset = 0;              // grid samples before t = 0
   double measurement_noise = 1e-6;  // for the Kalman filters [rad]
-  double settle = 0.5;              // [s] stamps before this are not scored
+  double settle = 0.5;  // [s] true instants this close to either end of the record are not scored
 };
 
 std::string readFile(const std::string& path) {
@@ -982,7 +982,8 @@ RunResult score(const Scene& scene, const Outputs& out, const std::vector<int>& 
     const long k = out.index[p];
     const double t = scene.times[static_cast<std::size_t>(k)];
     lag_sum += out.newest[p] - scene.stamps[static_cast<std::size_t>(k)];
-    if (t < scene.settle) continue;
+    // The online filters' start-up and the offline smoother's two record ends.
+    if (t < scene.settle || t > scene.spec.duration - scene.settle) continue;
     scored_times.push_back(t);
     scored_columns.push_back(static_cast<Eigen::Index>(p));
     const int window = windowOf(scene, t);
