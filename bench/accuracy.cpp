@@ -748,6 +748,24 @@ void recordLoads(const jle::Data<double>& d, const std::vector<int>& segments, O
   }
 }
 
+// The reading a published stamp [ns] describes: the one of that stamp, or else (a
+// pipeline that publishes its estimate of the sample instant) the one whose true instant
+// is nearest, within half a period.
+long readingOf(const Scene& scene, jle::Stamp stamp) {
+  const auto it = std::lower_bound(scene.stamp_ns.begin(), scene.stamp_ns.end(), stamp);
+  if (it != scene.stamp_ns.end() && *it == stamp) return it - scene.stamp_ns.begin();
+  const double t = 1e-9 * static_cast<double>(stamp - kEpoch);
+  const auto next = std::lower_bound(scene.times.begin(), scene.times.end(), t);
+  long k = next - scene.times.begin();
+  if (next == scene.times.end() ||
+      (k > 0 && t - scene.times[static_cast<std::size_t>(k - 1)] < *next - t))
+    --k;
+  if (k < 0 ||
+      std::abs(scene.times[static_cast<std::size_t>(k)] - t) > 0.5 / scene.spec.sensor.rate)
+    throw std::logic_error("an estimate's stamp is neither a sample's stamp nor its instant");
+  return k;
+}
+
 // One run through jle::Pipeline, the node's message path: joint states (positions only,
 // named as the URDF's joints) and wrench messages in their stamp order, each with its
 // stamp as the message would carry it and the same as the arrival clock.
@@ -782,11 +800,7 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
     if (pipeline.onJointState(scene.stamp_ns[k], scene.stamp_ns[k], model.coordinate_names,
                               position, none, none) != jle::Outcome::kPublished)
       continue;
-    const auto it =
-        std::lower_bound(scene.stamp_ns.begin(), scene.stamp_ns.end(), pipeline.record().stamp);
-    if (it == scene.stamp_ns.end() || *it != pipeline.record().stamp)
-      throw std::logic_error("an estimate's stamp is not a sample stamp");
-    out.index.push_back(it - scene.stamp_ns.begin());
+    out.index.push_back(readingOf(scene, pipeline.record().stamp));
     out.newest.push_back(j.stamp);
     recordLoads(pipeline.estimator().data(), segments, out);
     out.qdd.col(published++) = pipeline.estimator().qdd();
