@@ -13,6 +13,7 @@ packages=(
   liborocos-kdl-dev libkdl-parser-dev liburdf-dev
   ros-robot-state-publisher rosbash
   python3-matplotlib
+  python3-scipy             # test/scripts/zero_phase_reference.py (the independent reference)
   clang libclang-rt-14-dev  # libFuzzer for test/fuzz/build_and_run.sh
   clang-format              # tools/format.sh (the style is tuned on Debian's 14)
 )

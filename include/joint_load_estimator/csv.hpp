@@ -147,6 +147,9 @@ struct StateColumns {
   /// JOINT.q, JOINT.qd, JOINT.qdd.
   std::vector<int> q, qd, qdd;
   std::vector<WrenchColumns> wrenches;  ///< in the order of their first column
+  /// ExtraStateInputs::positions_only and the header has no JOINT.qd or JOINT.qdd
+  /// column: qd and qdd are all -1 (the caller estimates them).
+  bool positions_only = false;
 };
 
 /// What a joint-state CSV may hold beyond the joints and the wrenches.
@@ -157,6 +160,9 @@ struct ExtraStateInputs {
   /// Force plates: for each NAME, plate@NAME.fx ... .mz are required; a plate@ column
   /// of another name is refused.
   std::vector<std::string> plates;
+  /// A header with JOINT.q of every joint and no JOINT.qd or JOINT.qdd at all is
+  /// accepted (StateColumns::positions_only); one that has some of them must have all.
+  bool positions_only = false;
 };
 
 /// Maps a joint-state CSV header onto `model`. Throws CsvError at line 1 naming the

@@ -517,8 +517,14 @@ class StateHeader {
   void checkJoints() {
     std::vector<std::string> missing;
     if (out_.t < 0) missing.push_back("t");
+    // Positions only: no JOINT.qd or JOINT.qdd column at all, when the caller allows it.
+    out_.positions_only =
+        extra_.positions_only && model_.nq > 0 &&
+        std::all_of(out_.qd.begin(), out_.qd.end(), [](int c) { return c < 0; }) &&
+        std::all_of(out_.qdd.begin(), out_.qdd.end(), [](int c) { return c < 0; });
+    const int kinds = out_.positions_only ? 1 : 3;
     for (int k = 0; k < model_.nq; ++k)
-      for (int kind = 0; kind < 3; ++kind)
+      for (int kind = 0; kind < kinds; ++kind)
         if (coordinateColumns(kind)[k] < 0)
           missing.push_back(model_.coordinate_names[k] + "." + kStateSuffixes[kind]);
     if (!missing.empty()) problems_.add("missing " + columnList(missing));

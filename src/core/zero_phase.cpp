@@ -158,6 +158,21 @@ Eigen::MatrixXd smoothPadded(const Eigen::MatrixXd& xg, double w, int order, int
   return out;
 }
 
+// The padded smoothed grid channels back at the stamps t: the grid's own samples when t is
+// uniform, else linearly interpolated (the filter's value without derivatives).
+Eigen::MatrixXd atStamps(const Grid& grid, const std::vector<double>& t,
+                         const Eigen::MatrixXd& padded, int pad) {
+  if (grid.uniform) return padded.middleRows(pad, grid.m + 1);
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(t.size()), padded.cols());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    double f = 0.0;
+    const int k = intervalOf(grid, t[i], f);
+    out.row(static_cast<Eigen::Index>(i)) =
+        (1.0 - f) * padded.row(pad + k) + f * padded.row(pad + k + 1);
+  }
+  return out;
+}
+
 // The cutoff as a fraction of the grid's sampling rate, checked against the Nyquist rate.
 double relativeCutoff(const Grid& grid, double cutoff) {
   const double w = cutoff * grid.h;
@@ -168,35 +183,66 @@ double relativeCutoff(const Grid& grid, double cutoff) {
   return w;
 }
 
-// Mean square of x - smooth(x) over every channel, cutoff w [1/sample], away from the
-// ends: the padding's transient (odd reflection bends the curvature) would otherwise
-// dominate the residual at low cutoffs. The margin is 2 / w samples (two periods of the
-// cutoff) at each end, at most a quarter of the record.
-double meanSquareResidual(const Eigen::MatrixXd& xg, double w, int order, int pad) {
-  const Eigen::MatrixXd s = smoothPadded(xg, w, order, pad);
-  const Eigen::Index n = xg.rows();
-  const Eigen::Index margin = std::min<Eigen::Index>(static_cast<Eigen::Index>(std::ceil(2.0 / w)), n / 4);
-  const Eigen::Index inner = n - 2 * margin;
-  return (xg.middleRows(margin, inner) - s.middleRows(pad + margin, inner)).squaredNorm() /
-         static_cast<double>(inner * xg.cols());
-}
+// The channels that a cutoff is chosen for: x at the stamps t, xg on the grid; and the
+// search's constants.
+struct CutoffSearch {
+  const Grid& grid;
+  const std::vector<double>& t;
+  const Eigen::MatrixXd& x;
+  const Eigen::MatrixXd& xg;
+  int order, pad;
+  double w_lo;        // the lowest cutoff searched [1/sample]
+  double margin = 0;  // [s] left out of the residual at each end
+
+  // Mean square of x - smooth(x) over every channel at cutoff w [1/sample], at the input
+  // stamps (the measurements themselves, not their resampling, whose interpolation
+  // colours the noise), away from the ends: there the padding's transient (odd
+  // reflection bends the curvature) would dominate the residual at low cutoffs.
+  double meanSquareResidual(double w) const {
+    const Eigen::MatrixXd s = atStamps(grid, t, smoothPadded(xg, w, order, pad), pad);
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t[i] - t.front() < margin || t.back() - t[i] < margin) continue;
+      const auto row = static_cast<Eigen::Index>(i);
+      sum += (x.row(row) - s.row(row)).squaredNorm();
+      ++count;
+    }
+    return sum / static_cast<double>(count * x.cols());
+  }
+
+  // The generalised cross-validation score at cutoff w: mean square residual /
+  // (1 - tr(S) / L)^2, tr(S) from the filter's gain |H|^2 at the L DFT frequencies of the
+  // record (the circulant approximation of the smoother S).
+  double gcvScore(double w) const {
+    const Eigen::Index n = xg.rows();
+    const double tc = std::tan(M_PI * w);
+    double trace = 0.0;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      const double ratio = std::tan(M_PI * static_cast<double>(k) / n) / tc;
+      trace += 1.0 / (1.0 + std::pow(ratio * ratio, order));
+    }
+    const double dof = 1.0 - trace / static_cast<double>(n);
+    return meanSquareResidual(w) / (dof * dof);
+  }
+};
 
 // Winter's residual analysis: the residual's RMS R(w) is a straight line where it holds
 // only noise (fitted over 0.2 .. 0.4 of the sampling rate); its intercept a at w = 0
 // estimates the noise, and the cutoff is where R(w) = a (bisection on log w).
-double residualCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
+double residualCutoff(const CutoffSearch& search) {
   const int fits = 9;
   double sw = 0, sr = 0, sww = 0, swr = 0;
   for (int j = 0; j < fits; ++j) {
     const double w = 0.2 + 0.025 * j;
-    const double r = std::sqrt(meanSquareResidual(xg, w, order, pad));
+    const double r = std::sqrt(search.meanSquareResidual(w));
     sw += w, sr += r, sww += w * w, swr += w * r;
   }
   const double slope = (fits * swr - sw * sr) / (fits * sww - sw * sw);
   const double a = (sr - slope * sw) / fits;
-  const auto above = [&](double w) { return meanSquareResidual(xg, w, order, pad) > a * a; };
-  double lo = std::log(w_lo), hi = std::log(0.2);
-  if (!above(w_lo)) return w_lo;
+  const auto above = [&](double w) { return search.meanSquareResidual(w) > a * a; };
+  double lo = std::log(search.w_lo), hi = std::log(0.2);
+  if (!above(search.w_lo)) return search.w_lo;
   for (int i = 0; i < 40; ++i) {
     const double mid = 0.5 * (lo + hi);
     (above(std::exp(mid)) ? lo : hi) = mid;
@@ -204,26 +250,11 @@ double residualCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad
   return std::exp(hi);
 }
 
-// The generalised cross-validation score of the smoother at cutoff w: mean square
-// residual / (1 - tr(S) / L)^2, tr(S) from the filter's gain |H|^2 at the L DFT
-// frequencies of the record (the circulant approximation of the smoother S).
-double gcvScore(const Eigen::MatrixXd& xg, double w, int order, int pad) {
-  const Eigen::Index n = xg.rows();
-  const double tc = std::tan(M_PI * w);
-  double trace = 0.0;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double ratio = std::tan(M_PI * static_cast<double>(k) / n) / tc;
-    trace += 1.0 / (1.0 + std::pow(ratio * ratio, order));
-  }
-  const double dof = 1.0 - trace / static_cast<double>(n);
-  return meanSquareResidual(xg, w, order, pad) / (dof * dof);
-}
-
 // The GCV minimum over w_lo .. 0.4: a scan at ratio 1.1, then a golden section between the
 // best scanned point's neighbours (on log w).
-double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
-  const auto score = [&](double log_w) { return gcvScore(xg, std::exp(log_w), order, pad); };
-  const double step = std::log(1.1), lo = std::log(w_lo);
+double gcvCutoff(const CutoffSearch& search) {
+  const auto score = [&](double log_w) { return search.gcvScore(std::exp(log_w)); };
+  const double step = std::log(1.1), lo = std::log(search.w_lo);
   const int steps = std::max(1, static_cast<int>(std::ceil((std::log(0.4) - lo) / step)));
   int best = 0;
   double best_score = score(lo);
@@ -235,7 +266,7 @@ double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
   double a = lo + std::max(0, best - 1) * step, b = lo + std::min(steps, best + 1) * step;
   double c = b - g * (b - a), d = a + g * (b - a);
   double fc = score(c), fd = score(d);
-  for (int i = 0; i < 30; ++i) {
+  for (int i = 0; i < 40; ++i) {
     if (fc < fd) {
       b = d, d = c, fd = fc, c = b - g * (b - a), fc = score(c);
     } else {
@@ -245,15 +276,20 @@ double gcvCutoff(const Eigen::MatrixXd& xg, double w_lo, int order, int pad) {
   return std::exp(0.5 * (a + b));
 }
 
-// The cutoff [Hz] of the rule, for channels xg on the grid.
-double cutoffOf(const Grid& grid, const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
+// The cutoff [Hz] of the rule for the channels x at the stamps t (xg on the grid). The
+// lowest cutoff searched is a thousandth of the rate or one period over the record; the
+// residual leaves out two periods of that cutoff at each end, at most a quarter of the
+// record.
+double cutoffOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
+                const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
   if (config.rule == CutoffRule::kFixed) return config.cutoff;
-  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
-  // The lowest cutoff searched: a thousandth of the rate, or a period over the record.
   const double w_lo = std::max(1e-3, 1.0 / grid.m);
-  const double w = config.rule == CutoffRule::kResidual
-                       ? residualCutoff(xg, w_lo, config.order, pad)
-                       : gcvCutoff(xg, w_lo, config.order, pad);
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  CutoffSearch search{grid, t, x, xg, config.order, pad, w_lo};
+  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
+                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
+  const double w =
+      config.rule == CutoffRule::kResidual ? residualCutoff(search) : gcvCutoff(search);
   return w / grid.h;
 }
 
@@ -288,8 +324,10 @@ void evaluateAt(const Grid& grid, const std::vector<double>& t, ZeroPhaseResult&
     const double h00 = (2 * s - 3) * s * s + 1, h10 = ((s - 2) * s + 1) * s;
     const double h01 = (3 - 2 * s) * s * s, h11 = (s - 1) * s * s;
     const auto row = static_cast<Eigen::Index>(i);
-    r.value.row(row) = h00 * v.row(k) + h10 * h * d.row(k) + h01 * v.row(k + 1) + h11 * h * d.row(k + 1);
-    r.rate.row(row) = h00 * d.row(k) + h10 * h * a.row(k) + h01 * d.row(k + 1) + h11 * h * a.row(k + 1);
+    r.value.row(row) =
+        h00 * v.row(k) + h10 * h * d.row(k) + h01 * v.row(k + 1) + h11 * h * d.row(k + 1);
+    r.rate.row(row) =
+        h00 * d.row(k) + h10 * h * a.row(k) + h01 * d.row(k + 1) + h11 * h * a.row(k + 1);
     r.accel.row(row) = (1.0 - s) * a.row(k) + s * a.row(k + 1);
   }
 }
@@ -313,7 +351,7 @@ double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
   validate(config);
   checkInput(t, x);
   const Grid grid = gridOf(t);
-  return cutoffOf(grid, grid.uniform ? x : resample(grid, t, x), config);
+  return cutoffOf(grid, t, x, grid.uniform ? x : resample(grid, t, x), config);
 }
 
 ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
@@ -323,7 +361,7 @@ ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::Matri
   const Grid grid = gridOf(t);
   const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
   ZeroPhaseResult r;
-  r.cutoff = cutoffOf(grid, xg, config);
+  r.cutoff = cutoffOf(grid, t, x, xg, config);
   const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
   const Eigen::MatrixXd padded =
       smoothPadded(xg, relativeCutoff(grid, r.cutoff), config.order, pad);
@@ -345,16 +383,7 @@ Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::Matr
   const Grid grid = gridOf(t);
   const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
   const int pad = paddingOf(padding, order, static_cast<int>(xg.rows()));
-  const Eigen::MatrixXd s = smoothPadded(xg, relativeCutoff(grid, cutoff), order, pad);
-  if (grid.uniform) return s.middleRows(pad, xg.rows());
-  // Back at the stamps: linearly (no derivatives to build a Hermite interpolant from).
-  Eigen::MatrixXd out(x.rows(), x.cols());
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    double f = 0.0;
-    const int k = intervalOf(grid, t[i], f);
-    out.row(static_cast<Eigen::Index>(i)) = (1.0 - f) * s.row(pad + k) + f * s.row(pad + k + 1);
-  }
-  return out;
+  return atStamps(grid, t, smoothPadded(xg, relativeCutoff(grid, cutoff), order, pad), pad);
 }
 
 }  // namespace jle

@@ -8,6 +8,7 @@
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/zero_phase.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -33,6 +34,8 @@ const char* const kUsage =
                    [--floating-base] [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
                    [--contact-threshold N] [--per-kg [--body-mass KG]]
                    [--format csv|sto]
+                   [--cutoff HZ|auto] [--cutoff-rule residual|gcv]
+                   [--filter-order N] [--write-kinematics STATES.csv]
 
 Joint loads by per-segment inverse dynamics: for every sample of STATES.csv, the
 wrench that each moving joint's parent exerts on its child (moment about the joint
@@ -46,7 +49,9 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                                                for every revolute, continuous and
                                                prismatic joint [rad or m, /s, /s^2];
                                                mimic joints may be left out (ignored
-                                               if present: a mimic follows its leader)
+                                               if present: a mimic follows its leader);
+                                               or JOINT.q alone for every joint
+                                               (positions only: see --cutoff)
                      wrench@LINK.fx,.fy,.fz,.mx,.my,.mz
                                                optional: a wrench applied TO the robot
                                                at the origin of URDF link LINK, in
@@ -84,6 +89,18 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
   --per-kg         also JOINT.effort_per_kg = effort / body mass [N m/kg, N/kg]
   --body-mass KG   the body mass for --per-kg (default: the URDF's total mass)
   --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
+  --cutoff HZ|auto positions only (no JOINT.qd, JOINT.qdd column): q, and with the
+                   same filter every wrench@ and plate@ column, are smoothed by a
+                   Butterworth low-pass run forward and backward (zero phase), and
+                   q is differentiated (docs/zero_phase.md); the cutoff [Hz] given,
+                   or chosen from the q columns by --cutoff-rule (default: auto).
+                   The cutoff used is printed on standard error.
+  --cutoff-rule R  gcv (generalised cross-validation, default) or residual
+                   (Winter's residual analysis); with --cutoff auto
+  --filter-order N Butterworth order of each pass, 1..8 (default 4)
+  --write-kinematics PATH
+                   positions only: also write the smoothed inputs as a joint-state
+                   CSV (t, JOINT.q, .qd, .qdd, the wrench@ and plate@ columns), %.17g
   --help           this text
 
 Output: t; with a floating base base.fx,.fy,.fz,.mx,.my,.mz (what the world must
@@ -111,6 +128,11 @@ struct Options {
   bool per_kg = false;
   double body_mass = 0.0;  // 0: the model's total mass
   bool sto = false;
+  // Positions-only CSVs: the zero-phase filter; `smoothing_given`: an option of it was
+  // given (refused for a CSV with JOINT.qd, JOINT.qdd).
+  jle::ZeroPhaseConfig smoothing;
+  bool smoothing_given = false;
+  std::string kinematics;  // --write-kinematics
 };
 
 Eigen::Vector3d parseGravity(const std::string& text) {
@@ -187,6 +209,28 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
   return plates;
 }
 
+// --cutoff, --cutoff-rule, --filter-order, --write-kinematics.
+void parseSmoothing(std::map<std::string, std::string>& v, Options& options) {
+  jle::ZeroPhaseConfig& z = options.smoothing;
+  const std::string cutoff = v.count("--cutoff") ? v["--cutoff"] : "auto";
+  if (cutoff != "auto") {
+    z.rule = jle::CutoffRule::kFixed;
+    z.cutoff = parseNumber("--cutoff", cutoff, Sign::kPositive);
+  }
+  if (v.count("--cutoff-rule")) {
+    if (cutoff != "auto") throw UsageError("--cutoff-rule is only used with --cutoff auto");
+    const std::string& rule = v["--cutoff-rule"];
+    if (rule != "residual" && rule != "gcv")
+      throw UsageError("--cutoff-rule: '" + rule + "' is not residual or gcv");
+    z.rule = rule == "gcv" ? jle::CutoffRule::kGcv : jle::CutoffRule::kResidual;
+  }
+  if (v.count("--filter-order"))
+    z.order = static_cast<int>(parseInteger("--filter-order", v["--filter-order"], 1, 8));
+  if (v.count("--write-kinematics")) options.kinematics = v["--write-kinematics"];
+  for (const char* key : {"--cutoff", "--cutoff-rule", "--filter-order", "--write-kinematics"})
+    options.smoothing_given = options.smoothing_given || v.count(key) > 0;
+}
+
 Options parseOptions(int argc, char** argv) {
   std::vector<std::string> plates;
   std::vector<char*> rest;
@@ -194,7 +238,8 @@ Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v =
       optionValues(static_cast<int>(rest.size()), rest.data(),
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
-                    "--body-mass", "--format"},
+                    "--body-mass", "--format", "--cutoff", "--cutoff-rule", "--filter-order",
+                    "--write-kinematics"},
                    {"--floating-base", "--per-kg"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
@@ -215,6 +260,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--format") && v["--format"] != "csv" && v["--format"] != "sto")
     throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
   options.sto = v.count("--format") && v["--format"] == "sto";
+  parseSmoothing(v, options);
   return options;
 }
 
@@ -324,6 +370,13 @@ class Processor {
       reader.failAt(columns_.t, "time does not increase (the previous row's is " +
                                     shortest(slot(n - 1).cells[columns_.t]) +
                                     "): the base motion is estimated from the times");
+  }
+
+  // Takes `cells` (the record of `line`, as smoothPositions completed it) as row n.
+  void take(const std::vector<double>& cells, long line, long n) {
+    Row& row = slot(n);
+    std::copy(cells.begin(), cells.end(), row.cells.begin());
+    row.line = line;
   }
 
   // Emits what row n, just read, completes.
@@ -483,13 +536,150 @@ jle::Model<double> loadModel(const Options& options) {
   return model;
 }
 
+// A whole positions-only record, every row's cells; smoothPositions appends JOINT.qd and
+// JOINT.qdd of every coordinate to them.
+struct Record {
+  std::vector<std::vector<double>> cells;
+  std::vector<long> lines;
+  std::vector<double> t;  // [s]
+};
+
+Record readRecord(jle::CsvReader& reader, const jle::StateColumns& columns,
+                  const std::string& input) {
+  Record r;
+  while (reader.next()) {
+    std::vector<double> cells(static_cast<std::size_t>(reader.columns()));
+    reader.numbers(cells.data());
+    const double t = cells[columns.t];
+    if (!r.t.empty() && !(t > r.t.back()))
+      reader.failAt(columns.t, "time does not increase (the previous row's is " +
+                                   shortest(r.t.back()) +
+                                   "): positions only are smoothed over the times");
+    r.t.push_back(t);
+    r.cells.push_back(std::move(cells));
+    r.lines.push_back(reader.line());
+  }
+  if (r.t.size() < 3)
+    throw std::runtime_error(input + ": " + std::to_string(r.t.size()) +
+                             " rows; smoothing and differentiating positions needs at least 3");
+  return r;
+}
+
+// The columns of the record (indices into the cells) as samples x channels, and back.
+Eigen::MatrixXd gather(const Record& r, const std::vector<int>& columns) {
+  Eigen::MatrixXd x(r.cells.size(), columns.size());
+  for (std::size_t i = 0; i < r.cells.size(); ++i)
+    for (std::size_t c = 0; c < columns.size(); ++c) x(i, c) = r.cells[i][columns[c]];
+  return x;
+}
+
+void scatter(const Eigen::MatrixXd& x, const std::vector<int>& columns, Record& r) {
+  for (std::size_t i = 0; i < r.cells.size(); ++i)
+    for (std::size_t c = 0; c < columns.size(); ++c) r.cells[i][columns[c]] = x(i, c);
+}
+
+// Every wrench@ and plate@ column: the forces, filtered like the kinematics.
+std::vector<int> forceColumns(const jle::StateColumns& columns) {
+  std::vector<int> forces;
+  for (const jle::StateColumns::WrenchColumns& w : columns.wrenches)
+    forces.insert(forces.end(), w.column.begin(), w.column.end());
+  for (const std::array<int, 6>& plate : columns.plates)
+    forces.insert(forces.end(), plate.begin(), plate.end());
+  return forces;
+}
+
+// q and the forces smoothed alike, q's rate and acceleration appended to every row and
+// `columns` pointed at them. Returns the cutoff [Hz].
+double smoothPositions(const Options& options, jle::StateColumns& columns, Record& r) {
+  const jle::ZeroPhaseConfig& z = options.smoothing;
+  const std::size_t width = r.cells.front().size(), nq = columns.q.size();
+  try {
+    const jle::ZeroPhaseResult k = jle::smoothZeroPhase(r.t, gather(r, columns.q), z);
+    for (std::size_t j = 0; j < nq; ++j) {
+      columns.qd[j] = static_cast<int>(width + j);
+      columns.qdd[j] = static_cast<int>(width + nq + j);
+    }
+    for (std::vector<double>& cells : r.cells) cells.resize(width + 2 * nq);
+    scatter(k.value, columns.q, r);
+    scatter(k.rate, columns.qd, r);
+    scatter(k.accel, columns.qdd, r);
+    const std::vector<int> forces = forceColumns(columns);
+    if (!forces.empty())
+      scatter(jle::lowPassZeroPhase(r.t, gather(r, forces), k.cutoff, z.order, z.padding), forces,
+              r);
+    return k.cutoff;
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(options.input + ": smoothing the positions (--cutoff): " + e.what());
+  }
+}
+
+// --write-kinematics: the smoothed record as a joint-state CSV (stateColumnNames' order).
+void writeKinematics(const Options& options, const jle::Model<double>& model,
+                     const jle::StateColumns& columns, const Record& r) {
+  std::vector<std::string> links;
+  std::vector<int> order{columns.t};
+  for (int k = 0; k < model.nq; ++k)
+    order.insert(order.end(), {columns.q[k], columns.qd[k], columns.qdd[k]});
+  for (const jle::StateColumns::WrenchColumns& w : columns.wrenches) links.push_back(w.link);
+  const std::vector<int> forces = forceColumns(columns);
+  order.insert(order.end(), forces.begin(), forces.end());
+  jle::ExtraStateInputs extra;
+  for (const jle::ForcePlateConfig& plate : options.plates) extra.plates.push_back(plate.name);
+  jle::CsvWriter out(options.kinematics);
+  out.writeHeader(jle::stateColumnNames(model, links, extra));
+  std::vector<double> row(order.size());
+  for (const std::vector<double>& cells : r.cells) {
+    for (std::size_t i = 0; i < order.size(); ++i) row[i] = cells[order[i]];
+    out.writeRow(row.data(), row.size());
+  }
+  out.commit();
+}
+
+const char* ruleName(jle::CutoffRule rule) {
+  switch (rule) {
+    case jle::CutoffRule::kFixed: return "given";
+    case jle::CutoffRule::kResidual: return "residual analysis";
+    case jle::CutoffRule::kGcv: return "generalised cross-validation";
+  }
+  return "";
+}
+
+// A CSV of positions only: the whole record read, smoothed and differentiated, then the
+// loads of every row as for a CSV with JOINT.qd, JOINT.qdd.
+void runPositionsOnly(const Options& options, const jle::Model<double>& model,
+                      jle::CsvReader& reader, jle::StateColumns columns) {
+  Record record = readRecord(reader, columns, options.input);
+  const double cutoff = smoothPositions(options, columns, record);
+  std::fprintf(stderr,
+               "joint_loads: positions only: zero-phase Butterworth, order %d per pass, "
+               "cutoff %.17g Hz (%s)\n",
+               options.smoothing.order, cutoff, ruleName(options.smoothing.rule));
+  if (!options.kinematics.empty()) writeKinematics(options, model, columns, record);
+  Processor processor(options, model, columns, record.cells.front().size());
+  Output out(options, model, processor.names());
+  long n = 0;
+  for (; n < static_cast<long>(record.cells.size()); ++n) {
+    processor.take(record.cells[n], record.lines[n], n);
+    processor.emitReady(n, out);
+  }
+  processor.finish(n, out);
+  out.commit();
+}
+
 void run(const Options& options) {
   const jle::Model<double> model = loadModel(options);
   jle::CsvReader reader(options.input);
   jle::ExtraStateInputs extra;
   extra.floating_base = model.floating_base;
+  // Positions only with a fixed base (a floating base's pose is not smoothed).
+  extra.positions_only = !model.floating_base;
   for (const jle::ForcePlateConfig& plate : options.plates) extra.plates.push_back(plate.name);
   const jle::StateColumns columns = jle::bindStateColumns(model, reader, extra);
+  if (columns.positions_only) return runPositionsOnly(options, model, reader, columns);
+  if (options.smoothing_given)
+    throw std::runtime_error(options.input +
+                             ": --cutoff, --cutoff-rule, --filter-order and --write-kinematics "
+                             "are for a CSV of positions only (this one has JOINT.qd, JOINT.qdd)");
 
   // Everything the loop touches is allocated here, once.
   Processor processor(options, model, columns, static_cast<std::size_t>(reader.columns()));

@@ -11,6 +11,7 @@
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/zero_phase.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/serialization.h>
@@ -43,6 +44,7 @@ const char* const kUsage =
     R"(usage: process_bag --bag IN.bag --urdf ROBOT.urdf [--config CONFIG.yaml]
                    [--output OUT.bag | --csv OUT.csv] [--sto OUT.sto]
                    [--topic-prefix /joint_load_estimator]
+                   [--zero-phase HZ|auto [--cutoff-rule gcv|residual]]
 
 Runs the joint_load_estimator node's estimate over a bag, offline and as fast as the
 machine allows: the joint states, the configured wrench and force plate topics and
@@ -71,6 +73,16 @@ bag is played to it, without the timing of a live system.
                        Every output is written beside PATH and renamed onto it on
                        success only. With none, the loads are computed and counted.
   --topic-prefix NS    namespace of the output topic (default /joint_load_estimator)
+  --zero-phase HZ|auto smooth offline first (docs/zero_phase.md): the whole bag's
+                       joint positions, and with the same filter every wrench and
+                       plate message, by a Butterworth low-pass (order 4 per pass)
+                       run forward and backward, cutoff HZ or chosen from the
+                       positions (auto); then the message path runs on the smoothed
+                       messages, its differentiator set to central differences
+                       (finite_difference, order 2, delay 1) of the smoothed
+                       positions. Every joint state must carry the same joints, in
+                       increasing stamps. The cutoff is printed.
+  --cutoff-rule R      with --zero-phase auto: gcv (default) or residual
   --help               this text
 
 Frames: a wrench's frame that is not a URDF link rigid to its link, a floating base's
@@ -90,11 +102,31 @@ culprit); 2 a usage error.
 struct Options {
   std::string bag, urdf, config, output, csv, sto;
   std::string prefix = "/joint_load_estimator";
+  bool smooth = false;  // --zero-phase
+  jle::ZeroPhaseConfig smoothing;
 };
 
+// --zero-phase, --cutoff-rule.
+void parseSmoothing(std::map<std::string, std::string>& v, Options& o) {
+  o.smooth = v.count("--zero-phase") > 0;
+  const std::string cutoff = o.smooth ? v["--zero-phase"] : "";
+  if (o.smooth && cutoff != "auto") {
+    o.smoothing.rule = jle::CutoffRule::kFixed;
+    o.smoothing.cutoff = jle::cli::parseNumber("--zero-phase", cutoff, jle::cli::Sign::kPositive);
+  }
+  if (!v.count("--cutoff-rule")) return;
+  if (cutoff != "auto") throw UsageError("--cutoff-rule is only used with --zero-phase auto");
+  const std::string& rule = v["--cutoff-rule"];
+  if (rule != "gcv" && rule != "residual")
+    throw UsageError("--cutoff-rule: '" + rule + "' is not gcv or residual");
+  o.smoothing.rule = rule == "gcv" ? jle::CutoffRule::kGcv : jle::CutoffRule::kResidual;
+}
+
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v = optionValues(
-      argc, argv, {"--bag", "--urdf", "--config", "--output", "--csv", "--sto", "--topic-prefix"});
+  std::map<std::string, std::string> v =
+      optionValues(argc, argv,
+                   {"--bag", "--urdf", "--config", "--output", "--csv", "--sto", "--topic-prefix",
+                    "--zero-phase", "--cutoff-rule"});
   Options o;
   if (!v.count("--bag")) throw UsageError("--bag IN.bag is required");
   if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
@@ -110,6 +142,7 @@ Options parseOptions(int argc, char** argv) {
   if (o.prefix[0] != '/') o.prefix = "/" + o.prefix;
   while (o.prefix.size() > 1 && o.prefix.back() == '/') o.prefix.pop_back();
   if (o.prefix == "/") o.prefix.clear();
+  parseSmoothing(v, o);
   return o;
 }
 
@@ -235,6 +268,127 @@ std::string Outputs::destination() const {
 }
 
 /// The bag's messages through the pipeline, in the bag's order. Everything the loop
+/// --zero-phase: the bag's joint states and wrench and plate messages, read whole and
+/// smoothed (zero_phase.hpp); the message path then takes them in place of the bag's, in
+/// the same order.
+class SmoothedBag {
+ public:
+  SmoothedBag(const std::string& joint_topic, const std::vector<std::string>& force_topics)
+      : joint_topic_(joint_topic) {
+    for (const std::string& topic : force_topics) forces_[topic];
+  }
+
+  /// Every message of the joint and force topics in `view`.
+  void read(rosbag::View& view, ReuseBuffer& buffer);
+  /// Smooths them; the cutoff [Hz].
+  double smooth(const jle::ZeroPhaseConfig& config);
+  const sensor_msgs::JointState& nextJoint() { return joints_.at(next_joint_++); }
+  const geometry_msgs::WrenchStamped& nextForce(const std::string& topic) {
+    Series& s = forces_.at(topic);
+    return s.messages.at(s.next++);
+  }
+
+ private:
+  struct Series {
+    std::vector<geometry_msgs::WrenchStamped> messages;
+    std::vector<jle::Stamp> stamps;  // header stamps, the bag time where 0
+    std::size_t next = 0;
+  };
+  std::vector<double> times(const std::vector<jle::Stamp>& stamps, const std::string& topic) const;
+  Eigen::MatrixXd positions() const;
+  void filterForces(const std::string& topic, Series& s, double cutoff, int order);
+
+  std::string joint_topic_;
+  std::vector<sensor_msgs::JointState> joints_;
+  std::vector<jle::Stamp> joint_stamps_;
+  std::map<std::string, Series> forces_;
+  std::size_t next_joint_ = 0;
+};
+
+void SmoothedBag::read(rosbag::View& view, ReuseBuffer& buffer) {
+  for (const rosbag::MessageInstance& m : view) {
+    const std::string& topic = m.getTopic();
+    const auto stamp = [&](const std_msgs::Header& h) {
+      return h.stamp.isZero() ? jle::toStamp(m.getTime()) : jle::toStamp(h.stamp);
+    };
+    if (topic == joint_topic_) {
+      joints_.emplace_back();
+      deserialize(m, buffer, joints_.back());
+      joint_stamps_.push_back(stamp(joints_.back().header));
+    } else if (forces_.count(topic)) {
+      Series& s = forces_[topic];
+      s.messages.emplace_back();
+      deserialize(m, buffer, s.messages.back());
+      s.stamps.push_back(stamp(s.messages.back().header));
+    }
+  }
+}
+
+// Seconds since the first joint state's stamp; they must increase.
+std::vector<double> SmoothedBag::times(const std::vector<jle::Stamp>& stamps,
+                                       const std::string& topic) const {
+  std::vector<double> t;
+  for (std::size_t i = 0; i < stamps.size(); ++i) {
+    if (i > 0 && stamps[i] <= stamps[i - 1])
+      throw std::runtime_error("--zero-phase: " + topic + ": message " + std::to_string(i) +
+                               " is not newer than the one before: a record is smoothed over "
+                               "increasing stamps");
+    t.push_back(1e-9 * static_cast<double>(stamps[i] - joint_stamps_.front()));
+  }
+  return t;
+}
+
+// The joint states' positions, samples x joints; every message with the first's joints.
+Eigen::MatrixXd SmoothedBag::positions() const {
+  if (joints_.size() < 3)
+    throw std::runtime_error("--zero-phase: " + joint_topic_ + " has " +
+                             std::to_string(joints_.size()) + " messages; at least 3 are needed");
+  const std::vector<std::string>& names = joints_.front().name;
+  Eigen::MatrixXd q(joints_.size(), names.size());
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    const sensor_msgs::JointState& m = joints_[i];
+    if (m.name != names || m.position.size() != names.size())
+      throw std::runtime_error("--zero-phase: " + joint_topic_ + ": message " + std::to_string(i) +
+                               " does not carry the joints of the first (with a position "
+                               "each): partial joint states are not smoothed");
+    for (std::size_t j = 0; j < names.size(); ++j) q(i, j) = m.position[j];
+  }
+  return q;
+}
+
+void SmoothedBag::filterForces(const std::string& topic, Series& s, double cutoff, int order) {
+  if (s.messages.size() < 3) return;  // too few to filter: the message path counts them
+  Eigen::MatrixXd f(s.messages.size(), 6);
+  for (std::size_t i = 0; i < s.messages.size(); ++i) {
+    const geometry_msgs::Wrench& w = s.messages[i].wrench;
+    f.row(i) << w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z;
+  }
+  f = jle::lowPassZeroPhase(times(s.stamps, topic), f, cutoff, order);
+  for (std::size_t i = 0; i < s.messages.size(); ++i) {
+    geometry_msgs::Wrench& w = s.messages[i].wrench;
+    w.force.x = f(i, 0), w.force.y = f(i, 1), w.force.z = f(i, 2);
+    w.torque.x = f(i, 3), w.torque.y = f(i, 4), w.torque.z = f(i, 5);
+  }
+}
+
+double SmoothedBag::smooth(const jle::ZeroPhaseConfig& config) {
+  const Eigen::MatrixXd q = positions();
+  jle::ZeroPhaseResult r;
+  try {
+    r = jle::smoothZeroPhase(times(joint_stamps_, joint_topic_), q, config);
+    for (auto& [topic, series] : forces_) filterForces(topic, series, r.cutoff, config.order);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("--zero-phase: ") + e.what());
+  }
+  for (std::size_t i = 0; i < joints_.size(); ++i) {
+    sensor_msgs::JointState& m = joints_[i];
+    m.velocity.resize(m.position.size());
+    for (std::size_t j = 0; j < m.position.size(); ++j)
+      m.position[j] = r.value(i, j), m.velocity[j] = r.rate(i, j);
+  }
+  return r.cutoff;
+}
+
 /// touches is allocated in the constructor or by the first messages.
 class BagProcessor {
  public:
@@ -256,6 +410,7 @@ class BagProcessor {
 
  private:
   void checkTopics(const rosbag::Bag& in, rosbag::View& view);
+  void smoothInputs(rosbag::View& view);
   void dispatch(const rosbag::MessageInstance& m);
   void onTf(const rosbag::MessageInstance& m, bool is_static);
   void note(jle::Outcome outcome);
@@ -268,6 +423,7 @@ class BagProcessor {
   jle::Tf2FrameSource frames_;
   jle::Pipeline pipeline_;
   std::unique_ptr<Outputs> outputs_;
+  std::unique_ptr<SmoothedBag> smoothed_;  // --zero-phase
   std::string joint_topic_;
   std::vector<std::string> wrench_topics_, plate_topics_;  // settings order
   bool have_tf_ = false;                                   // the bag has /tf or /tf_static
@@ -293,6 +449,7 @@ void BagProcessor::run() {
   topics.insert(topics.end(), plate_topics_.begin(), plate_topics_.end());
   rosbag::View view(in, rosbag::TopicQuery(topics));
   checkTopics(in, view);
+  if (options_.smooth) smoothInputs(view);
   outputs_ = std::make_unique<Outputs>(options_, pipeline_);
 
   const long total = static_cast<long>(view.size());
@@ -322,7 +479,11 @@ void BagProcessor::dispatch(const rosbag::MessageInstance& m) {
   const std::string& topic = m.getTopic();
   if (topic == "/tf" || topic == "/tf_static") return onTf(m, topic == "/tf_static");
   const bool joints = topic == joint_topic_;
-  if (joints)
+  if (smoothed_ && joints)
+    joint_msg_ = smoothed_->nextJoint();
+  else if (smoothed_)
+    wrench_msg_ = smoothed_->nextForce(topic);
+  else if (joints)
     deserialize(m, buffer_, joint_msg_);
   else
     deserialize(m, buffer_, wrench_msg_);
@@ -342,6 +503,24 @@ void BagProcessor::dispatch(const rosbag::MessageInstance& m) {
     if (topic == plate_topics_[k])
       note(jle::feedPlate(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
   compute_ += Clock::now() - c0;
+}
+
+// --zero-phase: the whole bag's inputs read and smoothed before the message path runs.
+void BagProcessor::smoothInputs(rosbag::View& view) {
+  std::vector<std::string> forces = wrench_topics_;
+  forces.insert(forces.end(), plate_topics_.begin(), plate_topics_.end());
+  smoothed_ = std::make_unique<SmoothedBag>(joint_topic_, forces);
+  smoothed_->read(view, buffer_);
+  const double cutoff = smoothed_->smooth(options_.smoothing);
+  const char* rule = options_.smoothing.rule == jle::CutoffRule::kFixed      ? "given"
+                     : options_.smoothing.rule == jle::CutoffRule::kResidual ? "residual analysis"
+                                                                             : "generalised "
+                                                                               "cross-validation";
+  std::fprintf(stderr,
+               "process_bag: --zero-phase: Butterworth order %d per pass, forward and backward, "
+               "cutoff %.6g Hz (%s); differentiator: central differences of the smoothed "
+               "positions\n",
+               options_.smoothing.order, cutoff, rule);
 }
 
 void BagProcessor::onTf(const rosbag::MessageInstance& m, bool is_static) {
@@ -457,6 +636,15 @@ void run(const Options& options) {
                                                          : jle::loadYaml(options.config));
   } catch (const jle::SettingsError& e) {
     throw std::runtime_error(options.config + ": " + e.what());
+  }
+  if (options.smooth) {
+    // The positions are smoothed already: central differences differentiate them (exact
+    // for the parabola through three samples, any spacing) and pass the forces as they are.
+    jle::DifferentiatorConfig& d = settings.estimator.differentiator;
+    d.type = jle::DifferentiatorType::kFiniteDifference;
+    d.order = 2;
+    d.window = 3;
+    d.delay = 1;
   }
   const jle::Model<double> model =
       jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));

@@ -255,6 +255,56 @@ TEST_F(CliTest, ParentAndWorldFramesAndGravityMatchTheLibrary) {
 
 // ------------------------------------------------------------------ input layout
 
+// Positions only (docs/zero_phase.md; the numbers themselves are checked against scipy by
+// test_zero_phase_reference): the smoothed inputs that --write-kinematics writes are a
+// CSV with the derivatives given, whose loads are the positions-only run's, digit for
+// digit; the smoothing options are refused where they do not apply, naming them.
+TEST_F(CliTest, PositionsOnlyKinematicsReproduceTheirLoads) {
+  const std::string full = trajectory(
+      "full.csv", kPandaChain, {"--duration", "0.5", "--rate", "200", "--wrench", "panda_link7"});
+  const Table table = parseTable(readFile(full));
+  Table positions;
+  std::vector<std::size_t> kept;
+  for (std::size_t c = 0; c < table.header.size(); ++c) {
+    const std::string& name = table.header[c];
+    const auto ends = [&](const std::string& end) {
+      return name.size() > end.size() &&
+             name.compare(name.size() - end.size(), end.size(), end) == 0;
+    };
+    if (ends(".qd") || ends(".qdd")) continue;
+    kept.push_back(c);
+    positions.header.push_back(name);
+  }
+  for (const std::vector<std::string>& row : table.rows) {
+    positions.rows.emplace_back();
+    for (std::size_t c : kept) positions.rows.back().push_back(row[c]);
+  }
+  writeFile(path("q.csv"), formatTable(positions));
+  const std::string kinematics = outDir() + "/kinematics.csv", again = outDir() + "/again.csv";
+  Result r = jointLoads({"--urdf", kPandaChain, "--input", path("q.csv"), "--output", outPath(),
+                         "--cutoff", "8", "--write-kinematics", kinematics});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("order 4 per pass, cutoff 8 Hz (given)"), std::string::npos) << r.err;
+  r = jointLoads({"--urdf", kPandaChain, "--input", kinematics, "--output", again});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(readFile(again), readFile(outPath()));
+  EXPECT_EQ(parseTable(readFile(outPath())).rows.size(), table.rows.size());
+
+  r = jointLoads({"--urdf", kPandaChain, "--input", full, "--cutoff", "8"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("are for a CSV of positions only"), std::string::npos) << r.err;
+  r = jointLoads(
+      {"--urdf", kPandaChain, "--input", path("q.csv"), "--cutoff", "8", "--cutoff-rule", "gcv"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--cutoff-rule is only used with --cutoff auto"), std::string::npos);
+  r = jointLoads({"--urdf", kPandaChain, "--input", path("q.csv"), "--filter-order", "9"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--filter-order"), std::string::npos) << r.err;
+  r = jointLoads({"--urdf", kPandaChain, "--input", path("q.csv"), "--cutoff", "150"});
+  EXPECT_EQ(r.status, 1);  // above half the 200 Hz rate
+  EXPECT_NE(r.err.find("must be below half the sampling rate"), std::string::npos) << r.err;
+}
+
 class CliInputTest : public CliTest {
  protected:
   void SetUp() override {

@@ -107,8 +107,8 @@ TEST(ZeroPhase, GainAtAndAboveTheCutoffIsTheButterworthOneWithoutPhase) {
 TEST(ZeroPhase, IrregularStampsAddOnlyTheInterpolationError) {
   const double fs = 200.0, w = 2.0 * M_PI * 1.5;
   const std::vector<double> t = jitteredTimes(2000, fs);
-  const jle::ZeroPhaseResult r =
-      smoothZeroPhase(t, sampled(t, [](double s) { return std::sin(3.0 * M_PI * s); }), fixed(15.0));
+  const jle::ZeroPhaseResult r = smoothZeroPhase(
+      t, sampled(t, [](double s) { return std::sin(3.0 * M_PI * s); }), fixed(15.0));
   // Linear resampling errs by up to h^2 w^2 / 8 = 4.6e-4 in value at a sine's crest
   // (samples up to 1.3 + 1.3 periods apart at +-30 % jitter: h = 13 ms). That error varies
   // from sample to sample; the filter passes its part below the cutoff wc, whose rate and
