@@ -418,18 +418,19 @@ void pandaScenes(std::vector<SceneSpec>& specs) {
 void robotScenes(const std::string& data, std::vector<SceneSpec>& specs) {
   SceneSpec s = specs[2];
   s.motion = jle::MotionKind::kStopAndGo;
-  s.name = "ur5";
-  s.description = "UR5 chain, stop-and-go, sensors as panda, F/T at tool0";
-  s.urdf = readFile(data + "/urdf/chains/ur5_chain.urdf");
-  s.wrench_links = {"tool0"};
-  s.seed = 3;
-  specs.push_back(s);
-  s.name = "kinova";
-  s.description = "Kinova Jaco 2 chain, stop-and-go, sensors as panda, F/T at the end effector";
-  s.urdf = readFile(data + "/urdf/chains/kinova_chain.urdf");
-  s.wrench_links = {"j2s6s200_end_effector"};
-  s.seed = 4;
-  specs.push_back(s);
+  auto add = [&](const char* name, const char* description, const std::string& urdf,
+                 const char* link, std::uint64_t seed) {
+    s.name = name;
+    s.description = description;
+    s.urdf = readFile(data + urdf);
+    s.wrench_links = {link};
+    s.seed = seed;
+    specs.push_back(s);
+  };
+  add("ur5", "UR5 chain, stop-and-go, sensors as panda, F/T at tool0",
+      "/urdf/chains/ur5_chain.urdf", "tool0", 3);
+  add("kinova", "Kinova Jaco 2 chain, stop-and-go, sensors as panda, F/T at the end effector",
+      "/urdf/chains/kinova_chain.urdf", "j2s6s200_end_effector", 4);
   s.name = "talos";
   s.description =
       "TALOS reduced, pelvis fixed, 32 joints, sums of sines, 5 s, wrenches at "
