@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The accuracy study in one command: builds bench/accuracy, runs every scene through
-# jle::Estimator, and writes docs/accuracy.csv, docs/accuracy.md,
+# jle::Pipeline and the offline zero-phase smoother, and writes docs/accuracy.csv, docs/accuracy.md,
 # docs/accuracy_error_vs_time.png and docs/accuracy_error_vs_delay.png.
-#   tools/accuracy.sh           the full study (about a minute after the build)
+#   tools/accuracy.sh           the full study (about 2 min of CPU after the build)
 #   tools/accuracy.sh --quick   a tiny input, into $JLE_WS/accuracy_quick instead of docs/
 #                               (for CI: it fails if the study or the report no longer run,
 #                               or if exact inputs are not reproduced)

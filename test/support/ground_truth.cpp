@@ -71,75 +71,135 @@ CoordinateState CoordinateMotion::at(double t) const {
     s.qd += step.height * dS / step.duration;
     s.qdd += step.height * ddS / (step.duration * step.duration);
   }
+  for (const AccelPulse& pulse : pulses) {
+    if (t < pulse.start) continue;
+    const double u = std::min(t - pulse.start, pulse.duration);  // time accelerated
+    s.q += pulse.accel * u * (0.5 * u + (t - pulse.start - u));
+    s.qd += pulse.accel * u;
+    if (t - pulse.start < pulse.duration) s.qdd += pulse.accel;
+  }
   return s;
 }
+
+namespace {
+
+// The shared schedule of stop-and-go, (start, duration) of each move: a hold in
+// [hold_lo, hold_hi) at t = 0, then move and hold alternately below the duration.
+std::vector<std::pair<double, double>> stopAndGoSchedule(PortableRandom& rng, double duration,
+                                                         double hold_lo, double hold_hi) {
+  std::vector<std::pair<double, double>> moves;
+  double t = rng.uniform(hold_lo, hold_hi);
+  while (t < duration) {
+    const double T = rng.uniform(0.6, 1.5);
+    moves.emplace_back(t, T);
+    t += T + rng.uniform(hold_lo, hold_hi);
+  }
+  return moves;
+}
+
+// One swing of kImpacts: its acceleration phase and its impact.
+struct Swing {
+  double start = 0.0, accelerate = 0.0, impact_start = 0.0, impact = 0.0;
+};
+
+std::vector<Swing> impactSchedule(PortableRandom& rng, double duration) {
+  std::vector<Swing> swings;
+  double t = rng.uniform(0.2, 0.8);
+  while (t < duration) {
+    Swing s;
+    s.start = t;
+    s.accelerate = rng.uniform(0.2, 0.5);
+    const double coast = rng.uniform(0.1, 0.4);
+    s.impact = rng.uniform(0.01, 0.03);
+    s.impact_start = s.start + s.accelerate + coast;
+    swings.push_back(s);
+    t = s.impact_start + s.impact + rng.uniform(0.3, 1.0);
+  }
+  return swings;
+}
+
+void drawSines(PortableRandom& rng, double scale, CoordinateMotion& m) {
+  const int n = rng.uniform() < 0.5 ? 2 : 3;
+  for (int j = 0; j < n; ++j) {
+    Sine s;
+    s.amplitude = scale * rng.uniform(0.05, 0.3);
+    s.omega = kTwoPi * rng.uniform(0.1, 0.6);
+    s.phase = rng.uniform(0.0, kTwoPi);
+    m.sines.push_back(s);
+  }
+  m.p0 = scale * rng.uniform(-0.5, 0.5);
+}
+
+void drawRamps(PortableRandom& rng, double scale, double duration, CoordinateMotion& m) {
+  m.p0 = scale * rng.uniform(-0.5, 0.5);
+  double at = 0.0;  // offset from p0 reached so far
+  for (double t = 0.0; t < duration;) {
+    SmoothStep s;
+    s.start = t;
+    s.duration = rng.uniform(0.6, 1.5);
+    const double target = scale * rng.uniform(-0.4, 0.4);
+    s.height = target - at;
+    at = target;
+    m.steps.push_back(s);
+    t += s.duration;
+  }
+}
+
+void drawMoves(PortableRandom& rng, double scale,
+               const std::vector<std::pair<double, double>>& moves, CoordinateMotion& m) {
+  m.p0 = scale * rng.uniform(-0.5, 0.5);
+  double at = 0.0;
+  for (const auto& move : moves) {
+    SmoothStep s;
+    s.start = move.first;
+    s.duration = move.second;
+    const double target = scale * rng.uniform(-0.4, 0.4);
+    s.height = target - at;
+    at = target;
+    m.steps.push_back(s);
+  }
+}
+
+void drawImpacts(PortableRandom& rng, double scale, const std::vector<Swing>& swings,
+                 CoordinateMotion& m) {
+  m.p0 = scale * rng.uniform(-0.5, 0.5);
+  double direction = rng.uniform() < 0.5 ? 1.0 : -1.0;
+  for (const Swing& s : swings) {
+    const double speed = direction * scale * rng.uniform(0.2, 0.8);
+    m.pulses.push_back({s.start, s.accelerate, speed / s.accelerate});
+    m.pulses.push_back({s.impact_start, s.impact, -speed / s.impact});
+    direction = -direction;
+  }
+}
+
+}  // namespace
 
 std::vector<CoordinateMotion> randomMotion(const Model<double>& model, MotionKind kind,
                                            double duration, std::uint64_t seed) {
   if (!(duration >= 0.0)) throw std::invalid_argument("randomMotion: negative duration");
   PortableRandom rng(seed);
   const std::vector<bool> prismatic = prismaticCoordinates(model);
-  // The shared schedule of stop-and-go: (start, duration) of each move.
+  // The shared schedules are drawn first.
   std::vector<std::pair<double, double>> moves;
-  if (kind == MotionKind::kStopAndGo) {
-    double t = rng.uniform(0.2, 0.8);
-    while (t < duration) {
-      const double T = rng.uniform(0.6, 1.5);
-      moves.emplace_back(t, T);
-      t += T + rng.uniform(0.2, 0.8);
-    }
-  }
+  if (kind == MotionKind::kStopAndGo) moves = stopAndGoSchedule(rng, duration, 0.2, 0.8);
+  if (kind == MotionKind::kLongHolds) moves = stopAndGoSchedule(rng, duration, 2.0, 5.0);
+  std::vector<Swing> swings;
+  if (kind == MotionKind::kImpacts) swings = impactSchedule(rng, duration);
   std::vector<CoordinateMotion> motion(static_cast<std::size_t>(model.nq));
   for (int c = 0; c < model.nq; ++c) {
     CoordinateMotion& m = motion[static_cast<std::size_t>(c)];
     const double scale = prismatic[static_cast<std::size_t>(c)] ? kPrismaticScale : 1.0;
     switch (kind) {
-      case MotionKind::kSines: {
-        const int n = rng.uniform() < 0.5 ? 2 : 3;
-        for (int j = 0; j < n; ++j) {
-          Sine s;
-          s.amplitude = scale * rng.uniform(0.05, 0.3);
-          s.omega = kTwoPi * rng.uniform(0.1, 0.6);
-          s.phase = rng.uniform(0.0, kTwoPi);
-          m.sines.push_back(s);
-        }
-        m.p0 = scale * rng.uniform(-0.5, 0.5);
-        break;
-      }
-      case MotionKind::kRamps: {
-        m.p0 = scale * rng.uniform(-0.5, 0.5);
-        double at = 0.0;  // offset from p0 reached so far
-        for (double t = 0.0; t < duration;) {
-          SmoothStep s;
-          s.start = t;
-          s.duration = rng.uniform(0.6, 1.5);
-          const double target = scale * rng.uniform(-0.4, 0.4);
-          s.height = target - at;
-          at = target;
-          m.steps.push_back(s);
-          t += s.duration;
-        }
-        break;
-      }
-      case MotionKind::kStopAndGo: {
-        m.p0 = scale * rng.uniform(-0.5, 0.5);
-        double at = 0.0;
-        for (const auto& move : moves) {
-          SmoothStep s;
-          s.start = move.first;
-          s.duration = move.second;
-          const double target = scale * rng.uniform(-0.4, 0.4);
-          s.height = target - at;
-          at = target;
-          m.steps.push_back(s);
-        }
-        break;
-      }
+      case MotionKind::kSines: drawSines(rng, scale, m); break;
+      case MotionKind::kRamps: drawRamps(rng, scale, duration, m); break;
+      case MotionKind::kStopAndGo:
+      case MotionKind::kLongHolds: drawMoves(rng, scale, moves, m); break;
       case MotionKind::kQuadratic:
         m.p0 = scale * rng.uniform(-0.5, 0.5);
         m.p1 = scale * rng.uniform(-0.5, 0.5);
         m.p2 = scale * rng.uniform(-0.5, 0.5);
         break;
+      case MotionKind::kImpacts: drawImpacts(rng, scale, swings, m); break;
     }
   }
   return motion;
@@ -148,6 +208,11 @@ std::vector<CoordinateMotion> randomMotion(const Model<double>& model, MotionKin
 WrenchMotion::Vector6 WrenchMotion::at(double t) const {
   Vector6 w;
   for (int c = 0; c < 6; ++c) w[c] = mean[c] + amplitude[c] * std::sin(omega[c] * t + phase[c]);
+  for (const Stance& stance : stances) {
+    const double s = t - stance.start;
+    if (s < 0.0 || s > stance.duration) continue;
+    w += std::min(1.0, s / stance.rise) * std::sin(kPi * s / stance.duration) * stance.peak;
+  }
   return w;
 }
 
@@ -206,11 +271,42 @@ void GroundTruth::loads(double t, Data<double>& data) const {
   inverseDynamics(model_, data);
 }
 
-SensorReadings GroundTruth::sample(const SensorModel& sensor, double duration,
-                                   std::uint64_t seed) const {
-  if (!(sensor.rate > 0.0)) throw std::invalid_argument("SensorModel: rate must be positive");
-  if (!(duration >= 0.0)) throw std::invalid_argument("GroundTruth::sample: negative duration");
-  SensorReadings out;
+namespace {
+
+// The bursts and gaps of a sensor, drawn per sample from their own stream.
+class SensorDefects {
+ public:
+  SensorDefects(const SensorModel& sensor, std::uint64_t seed)
+      : sensor_(sensor), rng_(deriveSeed(seed, kDefectStream)) {}
+
+  // Sample k's draws: whether it is lost to a gap, whether it is in a burst, and the
+  // burst's gaussian for its stamp error.
+  bool next(bool& in_burst, double& g) {
+    const bool burst_start = rng_.uniform() < sensor_.burst_probability;
+    const bool gap_start = rng_.uniform() < sensor_.gap_probability;
+    const int gap_length = 1 + rng_.index(std::max(1, sensor_.max_gap));
+    g = rng_.gaussian();
+    if (burst_left_ == 0 && burst_start) burst_left_ = sensor_.burst_length;
+    in_burst = burst_left_ > 0;
+    if (burst_left_ > 0) --burst_left_;
+    // A gap starts at a sample after a kept one: two gaps never join.
+    if (gap_left_ == 0 && gap_start && !lost_) gap_left_ = gap_length;
+    lost_ = gap_left_ > 0;
+    if (lost_) --gap_left_;
+    return lost_;
+  }
+
+ private:
+  const SensorModel& sensor_;
+  PortableRandom rng_;
+  int burst_left_ = 0, gap_left_ = 0;
+  bool lost_ = false;  // the previous sample was lost to a gap
+};
+
+}  // namespace
+
+std::vector<JointReading> GroundTruth::sampleJoints(const SensorModel& sensor, double duration,
+                                                    std::uint64_t seed) const {
   const int nq = model_.nq;
   std::vector<double> resolution(static_cast<std::size_t>(nq));
   for (int c = 0; c < nq; ++c)
@@ -218,21 +314,26 @@ SensorReadings GroundTruth::sample(const SensorModel& sensor, double duration,
         prismatic_[static_cast<std::size_t>(c)]
             ? sensor.prismatic_resolution
             : (sensor.counts_per_revolution > 0.0 ? kTwoPi / sensor.counts_per_revolution : 0.0);
-
   PortableRandom rng(deriveSeed(seed, 0));
+  SensorDefects defects(sensor, seed);
   const double jitter_limit = 0.2 / sensor.rate;
   const long samples = static_cast<long>(std::floor(duration * sensor.rate + 1e-9)) + 1;
-  out.joints.reserve(static_cast<std::size_t>(samples));
+  std::vector<JointReading> out;
+  out.reserve(static_cast<std::size_t>(samples));
   VectorX<double> noise_q(nq), noise_qd(nq);
   for (long k = 0; k < samples; ++k) {
     const bool dropped = rng.uniform() < sensor.drop_probability;
     const double dt_sample = clampAbs(sensor.sample_jitter * rng.gaussian(), jitter_limit);
-    const double dt_stamp = clampAbs(sensor.stamp_jitter * rng.gaussian(), jitter_limit);
+    double dt_stamp = clampAbs(sensor.stamp_jitter * rng.gaussian(), jitter_limit);
     for (int c = 0; c < nq; ++c) {
       noise_q[c] = rng.gaussian();
       noise_qd[c] = rng.gaussian();
     }
-    if (dropped) continue;
+    bool in_burst = false;
+    double burst_g = 0.0;
+    const bool in_gap = defects.next(in_burst, burst_g);
+    if (in_burst) dt_stamp = clampAbs(sensor.burst_stamp_jitter * burst_g, jitter_limit);
+    if (dropped || in_gap) continue;
     JointReading r;
     r.time = static_cast<double>(k) / sensor.rate + dt_sample;
     r.stamp = r.time + dt_stamp;
@@ -244,9 +345,14 @@ SensorReadings GroundTruth::sample(const SensorModel& sensor, double duration,
                         resolution[static_cast<std::size_t>(c)]);
       r.qd[c] = s.qd + sensor.velocity_noise * noise_qd[c];
     }
-    out.joints.push_back(std::move(r));
+    out.push_back(std::move(r));
   }
+  return out;
+}
 
+std::vector<WrenchReading> GroundTruth::sampleWrenches(const SensorModel& sensor, double duration,
+                                                       std::uint64_t seed) const {
+  std::vector<WrenchReading> out;
   const double wrench_rate = sensor.wrench_rate > 0.0 ? sensor.wrench_rate : sensor.rate;
   for (std::size_t i = 0; i < wrenches_.size(); ++i) {
     PortableRandom wrng(deriveSeed(seed, i + 1));
@@ -265,13 +371,24 @@ SensorReadings GroundTruth::sample(const SensorModel& sensor, double duration,
         r.force[c] = w[c] + sensor.force_bias[c] + sensor.force_noise * noise[c];
         r.moment[c] = w[c + 3] + sensor.moment_bias[c] + sensor.moment_noise * noise[c + 3];
       }
-      out.wrenches.push_back(r);
+      out.push_back(r);
     }
   }
-  std::stable_sort(out.wrenches.begin(), out.wrenches.end(),
-                   [](const WrenchReading& a, const WrenchReading& b) {
-                     return a.stamp < b.stamp || (a.stamp == b.stamp && a.input < b.input);
-                   });
+  std::stable_sort(out.begin(), out.end(), [](const WrenchReading& a, const WrenchReading& b) {
+    return a.stamp < b.stamp || (a.stamp == b.stamp && a.input < b.input);
+  });
+  return out;
+}
+
+SensorReadings GroundTruth::sample(const SensorModel& sensor, double duration,
+                                   std::uint64_t seed) const {
+  if (!(sensor.rate > 0.0)) throw std::invalid_argument("SensorModel: rate must be positive");
+  if (!(duration >= 0.0)) throw std::invalid_argument("GroundTruth::sample: negative duration");
+  if (sensor.burst_length < 1 || sensor.max_gap < 1)
+    throw std::invalid_argument("SensorModel: burst_length and max_gap must be at least 1");
+  SensorReadings out;
+  out.joints = sampleJoints(sensor, duration, seed);
+  out.wrenches = sampleWrenches(sensor, duration, seed);
   return out;
 }
 
@@ -300,6 +417,34 @@ std::string planarArmUrdf() {
   x << "  <link name=\"tip\"/>\n"
     << "  <joint name=\"tip_joint\" type=\"fixed\"><parent link=\"link3\"/><child link=\"tip\"/>"
     << "<origin xyz=\"0.3 0 0\" rpy=\"0 0 0\"/></joint>\n</robot>\n";
+  return x.str();
+}
+
+std::string planarLegUrdf() {
+  std::ostringstream x;
+  x << std::setprecision(17) << "<?xml version=\"1.0\"?>\n<robot name=\"planar_leg\">\n"
+    << "  <link name=\"pelvis\"/>\n";
+  const char* names[3] = {"thigh", "shank", "foot"};
+  const char* joints[3] = {"hip", "knee", "ankle"};
+  const double length[2] = {0.42, 0.42}, mass[3] = {7.0, 3.2, 1.1};
+  for (int i = 0; i < 3; ++i) {
+    x << "  <link name=\"" << names[i] << "\">\n    <inertial><origin xyz=\"";
+    if (i < 2) {
+      const double I = mass[i] * length[i] * length[i] / 12.0;  // thin rod about its centre
+      x << "0 0 " << -0.43 * length[i] << "\"/><mass value=\"" << mass[i] << "\"/><inertia ixx=\""
+        << I << "\" ixy=\"0\" ixz=\"0\" iyy=\"" << I << "\" iyz=\"0\" izz=\"1e-4\"/>";
+    } else {
+      x << "0.05 0 -0.03\"/><mass value=\"" << mass[i]
+        << "\"/><inertia ixx=\"1e-3\" ixy=\"0\" ixz=\"0\" iyy=\"0.004\" iyz=\"0\" izz=\"0.004\"/>";
+    }
+    x << "</inertial>\n  </link>\n"
+      << "  <joint name=\"" << joints[i] << "\" type=\"revolute\">\n    <parent link=\""
+      << (i == 0 ? "pelvis" : names[i - 1]) << "\"/><child link=\"" << names[i] << "\"/>\n"
+      << "    <origin xyz=\"0 0 " << (i == 0 ? 0.0 : -length[i - 1])
+      << "\" rpy=\"0 0 0\"/><axis xyz=\"0 1 0\"/>\n"
+      << "    <limit effort=\"1000\" velocity=\"100\" lower=\"-10\" upper=\"10\"/>\n  </joint>\n";
+  }
+  x << "</robot>\n";
   return x.str();
 }
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -289,6 +290,143 @@ TEST(GroundTruth, SameSeedSameReadingsAndStreamsAreIndependent) {
   EXPECT_NE(jle::randomTreeUrdf(7, 12), jle::randomTreeUrdf(8, 12));
 }
 
+// Impacts: q'' is piecewise constant, with the steps the pulses state, exactly; q' and q
+// are its exact integrals (central differences agree to the bound of a piecewise-
+// quadratic q); every swing ends at rest, and the robot holds still between swings.
+TEST(GroundTruth, ImpactsStepTheAccelerationExactlyAndEndAtRest) {
+  const jle::Model<double> model = panda();
+  const double duration = 10.0;
+  const std::vector<jle::CoordinateMotion> motion =
+      jle::randomMotion(model, jle::MotionKind::kImpacts, duration, 4);
+  ASSERT_EQ(static_cast<int>(motion.size()), model.nq);
+  const double h = 1e-4;
+  double largest_step = 0.0;
+  for (const jle::CoordinateMotion& m : motion) {
+    ASSERT_GE(m.pulses.size(), 4u);  // at least two swings in 10 s
+    double largest_accel = 0.0;
+    for (const jle::AccelPulse& p : m.pulses)
+      largest_accel = std::max(largest_accel, std::abs(p.accel));
+    for (std::size_t i = 0; i + 1 < m.pulses.size(); i += 2) {
+      const jle::AccelPulse &go = m.pulses[i], &stop = m.pulses[i + 1];
+      // The impact stops the swing: the speed gained is lost, the rate is exactly 0.
+      EXPECT_NEAR(go.accel * go.duration + stop.accel * stop.duration, 0.0, 1e-12);
+      const double end = stop.start + stop.duration;
+      EXPECT_NEAR(m.at(end).qd, 0.0, 1e-12);
+      EXPECT_EQ(m.at(end + 0.2).qdd, 0.0);
+      EXPECT_NEAR(m.at(end + 0.2).q, m.at(end).q, 1e-12);
+      // The step at the impact's start: the acceleration jumps by the pulse's, exactly.
+      EXPECT_EQ(m.at(stop.start).qdd - m.at(stop.start - 1e-9).qdd, stop.accel);
+      EXPECT_GE(stop.duration, 0.01);
+      EXPECT_LT(stop.duration, 0.03);
+      largest_step = std::max(largest_step, std::abs(stop.accel));
+    }
+    for (double t = 0.0; t <= duration; t += 0.00737) {
+      const jle::CoordinateState s = m.at(t), before = m.at(t - h), after = m.at(t + h);
+      // |q'' - a| <= max |a| inside [t - h, t + h]: the central difference's error in q'
+      // is at most max|a| h / 2; rounding of q ~1e-15 over 2h adds 1e-11.
+      EXPECT_LE(std::abs((after.q - before.q) / (2 * h) - s.qd), largest_accel * h / 2 + 1e-10);
+      EXPECT_LE(std::abs((after.qd - before.qd) / (2 * h) - s.qdd), largest_accel + 1e-9);
+    }
+  }
+  // A step in acceleration of at least 0.2 / 0.03 rad/s^2 (the slowest, weakest impact).
+  EXPECT_GT(largest_step, 0.2 / 0.03);
+}
+
+TEST(GroundTruth, LongHoldsHoldStillForAtLeastTwoSeconds) {
+  const jle::Model<double> model = panda();
+  const std::vector<jle::CoordinateMotion> motion =
+      jle::randomMotion(model, jle::MotionKind::kLongHolds, 20.0, 3);
+  double still_since = 0.0, longest = 0.0;
+  bool moving_seen = false;
+  for (double t = 0.0; t < 20.0; t += 0.01) {
+    bool all = true;
+    for (const jle::CoordinateMotion& m : motion) all = all && m.at(t).qd == 0.0;
+    if (!all) {
+      moving_seen = true;
+      still_since = t;
+    }
+    longest = std::max(longest, t - still_since);
+    if (t < 2.0) {
+      EXPECT_TRUE(all) << t;
+    }
+  }
+  EXPECT_TRUE(moving_seen);
+  EXPECT_GE(longest, 2.0 - 0.02);
+}
+
+// Gaps: runs of 1 .. max_gap lost samples, so no two readings are more than max_gap + 1
+// periods apart, and the longest gap is reached; bursts: stamp errors of the burst's
+// deviation in runs, the others' of the sensor's; stamps stay in order.
+TEST(GroundTruth, GapsAndBurstsHaveTheirLengthsAndStatistics) {
+  const jle::GroundTruth truth = pandaTruth(jle::MotionKind::kSines);
+  jle::SensorModel sensor;
+  sensor.rate = 1000.0;
+  sensor.stamp_jitter = 5e-6;  // 0.5 % of the period
+  sensor.burst_probability = 0.01;
+  sensor.burst_length = 20;
+  sensor.burst_stamp_jitter = 5e-5;  // truncated at 2e-4 = 4 sigma
+  sensor.gap_probability = 0.01;
+  sensor.max_gap = 8;
+  const jle::SensorReadings r = truth.sample(sensor, 10.0, 3);
+  long widest = 0, loud = 0;
+  std::vector<double> quiet_errors, loud_errors;
+  for (std::size_t k = 0; k < r.joints.size(); ++k) {
+    const jle::JointReading& j = r.joints[k];
+    const long index = std::lround(j.time * 1000.0);
+    EXPECT_NEAR(j.time, index / 1000.0, 1e-12);  // no sample jitter
+    const double e = j.stamp - j.time;
+    EXPECT_LE(std::abs(e), 2e-4 + 1e-12);
+    (std::abs(e) > 4e-5 ? loud_errors : quiet_errors).push_back(e);  // 8 sigma of the quiet
+    if (k > 0) {
+      EXPECT_GT(j.stamp, r.joints[k - 1].stamp);
+      const long spacing = index - std::lround(r.joints[k - 1].time * 1000.0);
+      EXPECT_LE(spacing, 9);
+      widest = std::max(widest, spacing);
+    }
+  }
+  EXPECT_EQ(widest, 9);
+  // Lost: a gap of mean 4.5 samples starts at ~1% of the samples: 4.3%. About 96 gaps:
+  // their count scatters by 10%, their lengths by 6%; 30% is three times that.
+  const double lost = 1.0 - static_cast<double>(r.joints.size()) / 10001.0;
+  EXPECT_NEAR(lost, 0.045 / 1.045, 0.3 * 0.043);
+  // Bursts cover ~20/120 of the time (a burst of 20, then ~100 samples to the next):
+  // 16.7%; 42% of a burst's errors (|e| > 0.8 sigma) are loud, so ~7%; about 80 bursts
+  // scatter that by 11%: +-3% (absolute) is ample and still fails without bursts.
+  loud = static_cast<long>(loud_errors.size());
+  EXPECT_NEAR(static_cast<double>(loud) / static_cast<double>(r.joints.size()), 0.07, 0.03);
+  // The others have the sensor's deviation: their median |error| would be 0.674 sigma
+  // = 3.4e-6 s alone; the bursts' errors below 4e-5 s (10% of them) move the median of
+  // all |errors| to 0.82 sigma = 4.1e-6 s; +-0.5e-6 s is 10 times the scatter of a
+  // median of 9500 draws.
+  std::vector<double> magnitudes;
+  for (const std::vector<double>* errors : {&quiet_errors, &loud_errors})
+    for (double e : *errors) magnitudes.push_back(std::abs(e));
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
+                   magnitudes.end());
+  EXPECT_NEAR(magnitudes[magnitudes.size() / 2], 4.1e-6, 0.5e-6);
+}
+
+// The defects draw from their own stream: with none configured the readings are those
+// of a sensor without the fields; with gaps, the readings kept are unchanged.
+TEST(GroundTruth, GapsLeaveTheKeptReadingsUnchanged) {
+  const jle::GroundTruth truth = pandaTruth(jle::MotionKind::kStopAndGo);
+  jle::SensorModel sensor;
+  sensor.position_noise = 1e-4;
+  sensor.stamp_jitter = 1e-5;
+  sensor.drop_probability = 0.01;
+  jle::SensorModel gappy = sensor;
+  gappy.gap_probability = 0.02;
+  const jle::SensorReadings a = truth.sample(sensor, 2.0, 5), b = truth.sample(gappy, 2.0, 5);
+  ASSERT_LT(b.joints.size(), a.joints.size());
+  std::size_t i = 0;
+  for (const jle::JointReading& j : b.joints) {
+    while (i < a.joints.size() && a.joints[i].time < j.time) ++i;
+    ASSERT_LT(i, a.joints.size());
+    EXPECT_EQ(a.joints[i].stamp, j.stamp);
+    EXPECT_EQ(a.joints[i].q, j.q);
+  }
+}
+
 // The planar arm, from its stated geometry: link lengths L = 0.5, 0.4, 0.3 m, masses
 // m = 3, 2, 1 kg, thin rods (centre of mass at L/2, inertia m L^2 / 12 about y). A
 // rotation about +y takes x towards -z, so gravity (-z) at a horizontal offset x from a
@@ -352,6 +490,41 @@ TEST(GroundTruth, PlanarArmSwingingAsOneBodyMatchesTheRigidPendulum) {
     // effort = I qdd - (moment of gravity about y) = I qdd - g sum(m d) cos(q).
     EXPECT_NEAR(data.effort[static_cast<std::size_t>(s)],
                 inertia * x.qdd - kG * first_moment * std::cos(x.q), 1e-11);
+  }
+}
+
+TEST(GroundTruth, StanceRisesFastIntoAHalfSine) {
+  jle::WrenchMotion w;
+  w.link = "foot";
+  jle::Stance stance;
+  stance.start = 1.0;
+  stance.rise = 0.01;
+  stance.duration = 0.25;
+  stance.peak << 100.0, 0.0, 1500.0, 0.0, 80.0, 0.0;
+  w.stances.push_back(stance);
+  EXPECT_EQ(w.at(0.999).norm(), 0.0);
+  EXPECT_EQ(w.at(1.26).norm(), 0.0);
+  const double pi = kTwoPi / 2;
+  // Linear in the rise: half of it at half the rise time, times the half sine.
+  EXPECT_NEAR(w.at(1.005)[2], 1500.0 * 0.5 * std::sin(pi * 0.005 / 0.25), 1e-9);
+  EXPECT_NEAR(w.at(1.125)[2], 1500.0, 1e-9);  // the sine's top
+  EXPECT_NEAR(w.at(1.125)[4], 80.0, 1e-12);
+  EXPECT_NEAR(w.at(1.25)[2], 0.0, 1e-9);
+}
+
+// The leg hangs along -z with every joint on the z axis: at rest only the foot's centre of
+// mass, 0.05 m ahead of the ankle, has a lever; every joint holds m_foot g 0.05.
+TEST(GroundTruth, PlanarLegHangingHoldsTheFootsLever) {
+  const jle::Model<double> model = jle::modelFromUrdfString(jle::planarLegUrdf());
+  ASSERT_EQ(model.nq, 3);
+  std::vector<jle::CoordinateMotion> still(3);
+  const jle::GroundTruth truth(model, still, {});
+  jle::Data<double> data(model);
+  truth.loads(0.0, data);
+  for (const char* joint : {"hip", "knee", "ankle"}) {
+    const int s = model.segmentOfJoint(joint);
+    EXPECT_NEAR(std::abs(data.effort[static_cast<std::size_t>(s)]), 1.1 * kG * 0.05, 1e-12)
+        << joint;
   }
 }
 

@@ -50,14 +50,24 @@ struct SmoothStep {
   double height = 0.0;    ///< [rad or m]
 };
 
+/// A box of constant acceleration: q'' = accel on [start, start + duration), 0 elsewhere,
+/// q and q' continuous. Its two edges are steps in acceleration (an impact: the rate
+/// changes by accel * duration within `duration`); q'' is right-continuous at them.
+struct AccelPulse {
+  double start = 0.0;     ///< [s]
+  double duration = 0.0;  ///< [s], > 0
+  double accel = 0.0;     ///< [rad/s^2 or m/s^2]
+};
+
 /// One coordinate's motion, analytic with exact derivatives:
-///   q(t) = p0 + p1 t + p2 t^2 + sum of sines + sum of steps.
+///   q(t) = p0 + p1 t + p2 t^2 + sum of sines + sum of steps + sum of pulses.
 struct CoordinateMotion {
   double p0 = 0.0;  ///< [rad or m]
   double p1 = 0.0;  ///< [rad/s or m/s]
   double p2 = 0.0;  ///< [rad/s^2 or m/s^2]
   std::vector<Sine> sines;
   std::vector<SmoothStep> steps;
+  std::vector<AccelPulse> pulses;
 
   CoordinateState at(double t) const;
 };
@@ -78,6 +88,16 @@ enum class MotionKind : std::uint8_t {
   kStopAndGo,
   /// A quadratic: p0 in [-0.5, 0.5), p1 in [-0.5, 0.5) /s, p2 in [-0.5, 0.5) /s^2.
   kQuadratic,
+  /// Swings that end in an impact, shared by all coordinates (a collision, a heel
+  /// strike): a hold in [0.2, 0.8) s at t = 0, then per cycle an acceleration phase of
+  /// [0.2, 0.5) s, a coast of [0.1, 0.4) s, an impact of [0.01, 0.03) s (the rate falls
+  /// to 0: q'' steps to -speed / impact and back) and a hold of [0.3, 1) s, each drawn
+  /// in that order while the time is below the duration. Per coordinate p0 in
+  /// [-0.5, 0.5), the first direction (+ if uniform < 0.5), then per cycle a speed in
+  /// [0.2, 0.8) rad/s, the direction alternating (AccelPulse: accel = speed / phase).
+  kImpacts,
+  /// As kStopAndGo with long still phases: holds in [2, 5) s (the first at t = 0).
+  kLongHolds,
 };
 
 constexpr double kPrismaticScale = 0.1;  ///< [m/rad] prismatic motion per revolute range
@@ -89,9 +109,20 @@ constexpr double kPrismaticScale = 0.1;  ///< [m/rad] prismatic motion per revol
 std::vector<CoordinateMotion> randomMotion(const Model<double>& model, MotionKind kind,
                                            double duration, std::uint64_t seed);
 
+/// A contact's stance: from `start` the wrench `peak` times
+/// min(1, s / rise) sin(pi s / duration), s = t - start in [0, duration], 0 elsewhere:
+/// a fast linear rise (a heel strike) into a half sine, continuous, its rate stepping.
+struct Stance {
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  double start = 0.0;              ///< [s]
+  double rise = 0.01;              ///< [s], > 0
+  double duration = 0.2;           ///< [s], > rise
+  Vector6 peak = Vector6::Zero();  ///< (force [N], moment [N m]), the link's frame
+};
+
 /// A wrench applied TO the robot at the origin of URDF link `link`, expressed in that
 /// link's frame. Component c of (fx, fy, fz, mx, my, mz) is
-///   mean[c] + amplitude[c] sin(omega[c] t + phase[c])   [N or N m].
+///   mean[c] + amplitude[c] sin(omega[c] t + phase[c]) + the stances'   [N or N m].
 struct WrenchMotion {
   using Vector6 = Eigen::Matrix<double, 6, 1>;
   std::string link;
@@ -99,6 +130,7 @@ struct WrenchMotion {
   Vector6 amplitude = Vector6::Zero();
   Vector6 omega = Vector6::Zero();  ///< [rad/s]
   Vector6 phase = Vector6::Zero();  ///< [rad]
+  std::vector<Stance> stances;
 
   /// (force [N], moment [N m]) at time t [s].
   Vector6 at(double t) const;
@@ -108,6 +140,9 @@ struct WrenchMotion {
 /// and amplitude in [0, 10) N for forces ([-1, 1) and [0, 1) N m for moments), frequency
 /// in [0.1, 1) Hz, phase in [0, 2 pi).
 WrenchMotion randomWrench(const std::string& link, std::uint64_t seed);
+
+/// The stream of GroundTruth::sample's bursts and gaps (beyond any wrench input's).
+constexpr std::uint64_t kDefectStream = 1000;
 
 /// What the sensors of a scene report, and how they err.
 struct SensorModel {
@@ -128,6 +163,18 @@ struct SensorModel {
   /// taken (a stamp taken on receipt). Truncated at +-0.2 / rate, so stamps stay in order.
   double stamp_jitter = 0.0;
   double drop_probability = 0.0;  ///< probability that a joint sample is lost
+  /// Bursts of stamp jitter: at each sample a burst of burst_length samples starts with
+  /// probability burst_probability (unless one is running); within it the stamp error
+  /// has standard deviation burst_stamp_jitter [s] instead of stamp_jitter (same
+  /// truncation).
+  double burst_probability = 0.0;
+  int burst_length = 20;
+  double burst_stamp_jitter = 0.0;
+  /// Gaps: at each sample after a kept one a run of 1 .. max_gap lost samples (uniform)
+  /// starts with probability gap_probability; a gap of n samples spaces the readings
+  /// around it n + 1 periods apart (with drop_probability 0: gaps never join).
+  double gap_probability = 0.0;
+  int max_gap = 9;
 
   /// Force/torque inputs: samples at wrench_offset + j / wrench_rate, stamped exactly.
   double wrench_rate = 0.0;                              ///< [Hz]; 0: the joint rate
@@ -190,10 +237,18 @@ class GroundTruth {
   /// (deriveSeed(seed, 0)): per sample k, the drop draw (uniform), the sample jitter and
   /// the stamp jitter (gaussians), then per coordinate the position and velocity noise
   /// (gaussians); all drawn whether or not used. Wrench input i draws from stream i + 1:
-  /// per sample, the drop draw, then the six noises fx .. mz.
+  /// per sample, the drop draw, then the six noises fx .. mz. Bursts and gaps draw from
+  /// stream kDefectStream, per sample: the burst start (uniform), the gap start
+  /// (uniform), the gap length (index) and the burst's stamp error (gaussian); so a scene
+  /// without them reads as before they existed.
   SensorReadings sample(const SensorModel& sensor, double duration, std::uint64_t seed) const;
 
  private:
+  std::vector<JointReading> sampleJoints(const SensorModel& sensor, double duration,
+                                         std::uint64_t seed) const;
+  std::vector<WrenchReading> sampleWrenches(const SensorModel& sensor, double duration,
+                                            std::uint64_t seed) const;
+
   Model<double> model_;
   std::vector<CoordinateMotion> motion_;
   std::vector<WrenchMotion> wrenches_;
@@ -208,6 +263,13 @@ class GroundTruth {
 /// and loads in the x-z plane (forces in x and z, moments about y) everything stays in
 /// that plane: the joint forces have no y component and the moments only a y component.
 std::string planarArmUrdf();
+
+/// A planar leg hanging from a fixed pelvis: links pelvis, thigh, shank, foot; revolute
+/// joints hip, knee, ankle, all about y; thigh 0.42 m and 7 kg, shank 0.42 m and 3.2 kg
+/// (thin rods along -z, centre of mass at 43% of the length from the proximal joint),
+/// foot 1.1 kg with its centre of mass 0.05 m ahead (+x) of the ankle and
+/// I_yy = 0.004 kg m^2. Loads in the x-z plane keep everything in that plane.
+std::string planarLegUrdf();
 
 /// A random tree of `links` moving links (link1..linkN, under the massive root link0),
 /// seeded: each link's parent is uniform among the links before it (so linkN is a
