@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace jle {
@@ -18,6 +19,11 @@ enum class CutoffRule : std::uint8_t {
   kResidual,  ///< Winter's residual analysis (Biomechanics and Motor Control, ch. 3)
   kGcv,       ///< generalised cross-validation of the Butterworth smoother
 };
+
+/// "given", "residual analysis", "generalised cross-validation".
+const char* toString(CutoffRule rule);
+/// `text` "gcv" or "residual" (the tools' --cutoff-rule) into `rule`; false otherwise.
+bool parseCutoffRule(const std::string& text, CutoffRule& rule);
 
 /// The zero-phase filter. `order` is that of each pass (scipy.signal.butter(order) run by
 /// filtfilt): the amplitude response of the whole is |H|^2, of order 2 * order, and the

@@ -334,6 +334,21 @@ void evaluateAt(const Grid& grid, const std::vector<double>& t, ZeroPhaseResult&
 
 }  // namespace
 
+const char* toString(CutoffRule rule) {
+  switch (rule) {
+    case CutoffRule::kFixed: return "given";
+    case CutoffRule::kResidual: return "residual analysis";
+    case CutoffRule::kGcv: return "generalised cross-validation";
+  }
+  return "";
+}
+
+bool parseCutoffRule(const std::string& text, CutoffRule& rule) {
+  if (text != "gcv" && text != "residual") return false;
+  rule = text == "gcv" ? CutoffRule::kGcv : CutoffRule::kResidual;
+  return true;
+}
+
 void validate(const ZeroPhaseConfig& config) {
   if (config.rule == CutoffRule::kFixed && !(config.cutoff > 0.0 && std::isfinite(config.cutoff)))
     throw std::invalid_argument("zero_phase cutoff must be finite and > 0 [Hz] (got " +

@@ -219,10 +219,8 @@ void parseSmoothing(std::map<std::string, std::string>& v, Options& options) {
   }
   if (v.count("--cutoff-rule")) {
     if (cutoff != "auto") throw UsageError("--cutoff-rule is only used with --cutoff auto");
-    const std::string& rule = v["--cutoff-rule"];
-    if (rule != "residual" && rule != "gcv")
-      throw UsageError("--cutoff-rule: '" + rule + "' is not residual or gcv");
-    z.rule = rule == "gcv" ? jle::CutoffRule::kGcv : jle::CutoffRule::kResidual;
+    if (!jle::parseCutoffRule(v["--cutoff-rule"], z.rule))
+      throw UsageError("--cutoff-rule: '" + v["--cutoff-rule"] + "' is not gcv or residual");
   }
   if (v.count("--filter-order"))
     z.order = static_cast<int>(parseInteger("--filter-order", v["--filter-order"], 1, 8));
@@ -635,15 +633,6 @@ void writeKinematics(const Options& options, const jle::Model<double>& model,
   out.commit();
 }
 
-const char* ruleName(jle::CutoffRule rule) {
-  switch (rule) {
-    case jle::CutoffRule::kFixed: return "given";
-    case jle::CutoffRule::kResidual: return "residual analysis";
-    case jle::CutoffRule::kGcv: return "generalised cross-validation";
-  }
-  return "";
-}
-
 // A CSV of positions only: the whole record read, smoothed and differentiated, then the
 // loads of every row as for a CSV with JOINT.qd, JOINT.qdd.
 void runPositionsOnly(const Options& options, const jle::Model<double>& model,
@@ -653,7 +642,7 @@ void runPositionsOnly(const Options& options, const jle::Model<double>& model,
   std::fprintf(stderr,
                "joint_loads: positions only: zero-phase Butterworth, order %d per pass, "
                "cutoff %.17g Hz (%s)\n",
-               options.smoothing.order, cutoff, ruleName(options.smoothing.rule));
+               options.smoothing.order, cutoff, jle::toString(options.smoothing.rule));
   if (!options.kinematics.empty()) writeKinematics(options, model, columns, record);
   Processor processor(options, model, columns, record.cells.front().size());
   Output out(options, model, processor.names());

@@ -116,10 +116,8 @@ void parseSmoothing(std::map<std::string, std::string>& v, Options& o) {
   }
   if (!v.count("--cutoff-rule")) return;
   if (cutoff != "auto") throw UsageError("--cutoff-rule is only used with --zero-phase auto");
-  const std::string& rule = v["--cutoff-rule"];
-  if (rule != "gcv" && rule != "residual")
-    throw UsageError("--cutoff-rule: '" + rule + "' is not gcv or residual");
-  o.smoothing.rule = rule == "gcv" ? jle::CutoffRule::kGcv : jle::CutoffRule::kResidual;
+  if (!jle::parseCutoffRule(v["--cutoff-rule"], o.smoothing.rule))
+    throw UsageError("--cutoff-rule: '" + v["--cutoff-rule"] + "' is not gcv or residual");
 }
 
 Options parseOptions(int argc, char** argv) {
@@ -512,15 +510,11 @@ void BagProcessor::smoothInputs(rosbag::View& view) {
   smoothed_ = std::make_unique<SmoothedBag>(joint_topic_, forces);
   smoothed_->read(view, buffer_);
   const double cutoff = smoothed_->smooth(options_.smoothing);
-  const char* rule = options_.smoothing.rule == jle::CutoffRule::kFixed      ? "given"
-                     : options_.smoothing.rule == jle::CutoffRule::kResidual ? "residual analysis"
-                                                                             : "generalised "
-                                                                               "cross-validation";
   std::fprintf(stderr,
                "process_bag: --zero-phase: Butterworth order %d per pass, forward and backward, "
                "cutoff %.6g Hz (%s); differentiator: central differences of the smoothed "
                "positions\n",
-               options_.smoothing.order, cutoff, rule);
+               options_.smoothing.order, cutoff, jle::toString(options_.smoothing.rule));
 }
 
 void BagProcessor::onTf(const rosbag::MessageInstance& m, bool is_static) {
