@@ -189,6 +189,16 @@ struct PlateTopicSettings {
   bool pose_configured = false;
 };
 
+/// The friction term of the motor effort (friction.hpp), from the URDF's
+/// <dynamics damping friction> of each joint; off by default.
+struct FrictionConfig {
+  /// JointLoads.motor_effort = effort + damping qd + friction tanh(qd / velocity_scale);
+  /// false: motor_effort is empty.
+  bool enabled = false;
+  /// [rad/s or m/s] > 0: the width of the smooth sign of the Coulomb term.
+  double velocity_scale = 0.01;
+};
+
 /// Every setting of the node and of the offline front ends (process_bag), with the
 /// parameter names of config/default.yaml (README, "Parameters").
 struct Settings {
@@ -217,6 +227,7 @@ struct Settings {
   double diagnostic_period = 1.0;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;
+  FrictionConfig friction;
   /// The estimator's settings; estimator.joints are the joints whose loads are published.
   EstimatorConfig estimator;
   std::vector<WrenchTopicSettings> wrenches;     ///< pairs with estimator.wrenches

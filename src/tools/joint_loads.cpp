@@ -5,6 +5,7 @@
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/force_plate.hpp>
+#include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -32,6 +33,7 @@ const char* const kUsage =
                    [--gravity GX,GY,GZ] [--frame child|parent|world]
                    [--floating-base] [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
                    [--contact-threshold N] [--per-kg [--body-mass KG]]
+                   [--kinematics] [--friction [--velocity-scale V]]
                    [--format csv|sto]
 
 Joint loads by per-segment inverse dynamics: for every sample of STATES.csv, the
@@ -83,6 +85,13 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    plate force [N] below which a foot is not in contact (default 20)
   --per-kg         also JOINT.effort_per_kg = effort / body mass [N m/kg, N/kg]
   --body-mass KG   the body mass for --per-kg (default: the URDF's total mass)
+  --kinematics     also JOINT.q, .qd, .qdd of every joint (what the loads were
+                   computed from; a mimic joint's from its leader's)
+  --friction       also JOINT.motor_effort = effort + damping qd + friction
+                   tanh(qd / V), from each joint's URDF <dynamics damping friction>
+                   (docs/outputs.md)
+  --velocity-scale V
+                   [rad/s or m/s] width of the smooth sign of --friction (default 0.01)
   --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
   --help           this text
 
@@ -91,7 +100,8 @@ apply to the root link: world frame, moment about the root link origin; zero whe
 the measured loads explain the motion); for every moving joint in URDF tree order
 (depth first from the root, children in document order; mimic joints included)
 JOINT.fx,JOINT.fy,JOINT.fz,JOINT.mx,JOINT.my,JOINT.mz,JOINT.effort
-[,JOINT.effort_per_kg]; for every plate plate@NAME.contact (1 or 0) and
+[,JOINT.effort_per_kg]; with --kinematics JOINT.q,.qd,.qdd for every joint; with
+--friction JOINT.motor_effort for every joint; for every plate plate@NAME.contact (1 or 0) and
 plate@NAME.cop_x,.cop_y,.cop_z (centre of pressure in the world [m], 0 without
 contact). Every number with 17 significant digits (%.17g).
 
@@ -111,6 +121,9 @@ struct Options {
   bool per_kg = false;
   double body_mass = 0.0;  // 0: the model's total mass
   bool sto = false;
+  bool kinematics = false;
+  bool friction = false;
+  double velocity_scale = 0.01;  // [rad/s or m/s], jle::FrictionConfig's default
 };
 
 Eigen::Vector3d parseGravity(const std::string& text) {
@@ -187,6 +200,19 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
   return plates;
 }
 
+// --kinematics, --friction, --velocity-scale.
+void parseOutputOptions(std::map<std::string, std::string>& v, Options& options) {
+  options.kinematics = v.count("--kinematics") > 0;
+  options.friction = v.count("--friction") > 0;
+  if (v.count("--velocity-scale")) {
+    if (!options.friction) throw UsageError("--velocity-scale is only used with --friction");
+    options.velocity_scale =
+        parseNumber("--velocity-scale", v["--velocity-scale"], Sign::kPositive);
+  }
+  if (options.sto && (options.kinematics || options.friction))
+    throw UsageError("--kinematics and --friction are columns of the csv format only");
+}
+
 Options parseOptions(int argc, char** argv) {
   std::vector<std::string> plates;
   std::vector<char*> rest;
@@ -194,8 +220,8 @@ Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v =
       optionValues(static_cast<int>(rest.size()), rest.data(),
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
-                    "--body-mass", "--format"},
-                   {"--floating-base", "--per-kg"});
+                    "--body-mass", "--format", "--velocity-scale"},
+                   {"--floating-base", "--per-kg", "--kinematics", "--friction"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   options.input = requiredValue(v, "--input", "STATES.csv");
@@ -215,6 +241,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--format") && v["--format"] != "csv" && v["--format"] != "sto")
     throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
   options.sto = v.count("--format") && v["--format"] == "sto";
+  parseOutputOptions(v, options);
   return options;
 }
 
@@ -304,6 +331,8 @@ class Processor {
     jle::LoadColumnLayout layout;
     layout.base = model.floating_base;
     layout.per_kg = options.per_kg;
+    layout.kinematics = options.kinematics;
+    layout.motor_effort = options.friction;
     for (const jle::ForcePlateConfig& plate : options.plates) {
       plate_frames_.push_back(model.frameIndex(plate.link));
       layout.plates.push_back(plate.name);
@@ -434,6 +463,21 @@ class Processor {
     }
   }
 
+  // The --kinematics and --friction columns of the row, from `o` on.
+  double* putOutputs(double* o) const {
+    if (options_.kinematics)
+      for (int s : model_.moving_segments) {
+        *o++ = data_.q[s];
+        *o++ = data_.qd[s];
+        *o++ = data_.qdd[s];
+      }
+    if (options_.friction)
+      for (int s : model_.moving_segments)
+        *o++ = data_.effort[s] + jle::frictionEffort(model_.damping[s], model_.friction[s],
+                                                      data_.qd[s], options_.velocity_scale);
+    return o;
+  }
+
   // One output row, in the order of names().
   void writeLoads(const std::vector<double>& cells, Output& out) {
     const auto put = [](const jle::Wrench<double>& w, double* o) {
@@ -450,6 +494,7 @@ class Processor {
       *o++ = data_.effort[s];
       if (options_.per_kg) *o++ = data_.effort[s] / mass_;
     }
+    o = putOutputs(o);
     for (double x : cop_) *o++ = x;
     assert(static_cast<std::size_t>(o - loads_.data()) == loads_.size());
     out.row(loads_);
