@@ -474,7 +474,7 @@ class Processor {
     if (options_.friction)
       for (int s : model_.moving_segments)
         *o++ = data_.effort[s] + jle::frictionEffort(model_.damping[s], model_.friction[s],
-                                                      data_.qd[s], options_.velocity_scale);
+                                                     data_.qd[s], options_.velocity_scale);
     return o;
   }
 
