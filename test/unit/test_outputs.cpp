@@ -57,8 +57,7 @@ int run(jle::Pipeline& pipeline, Check check) {
   int published = 0;
   for (int k = 0; k < 500; ++k) {
     const Stamp stamp = kStart + 1000000 * static_cast<Stamp>(k);
-    const Outcome o =
-        pipeline.onJointState(stamp, stamp, {"swing"}, {q(1e-3 * k)}, kNone, kNone);
+    const Outcome o = pipeline.onJointState(stamp, stamp, {"swing"}, {q(1e-3 * k)}, kNone, kNone);
     if (o != Outcome::kPublished) continue;
     ++published;
     check(pipeline.record(), static_cast<double>(pipeline.record().stamp - kStart) * 1e-9);
@@ -124,8 +123,7 @@ TEST(Outputs, CoordinatesOfAnExactlyDifferentiableMotion) {
 TEST(Outputs, FrictionEffortClosedForm) {
   // Odd, zero at rest; tanh(1) = 0.76159415595576489 at one velocity scale.
   EXPECT_EQ(jle::frictionEffort(0.5, 2.0, 0.0, 0.01), 0.0);
-  EXPECT_NEAR(jle::frictionEffort(0.5, 2.0, 0.01, 0.01), 0.005 + 2.0 * 0.76159415595576489,
-              1e-15);
+  EXPECT_NEAR(jle::frictionEffort(0.5, 2.0, 0.01, 0.01), 0.005 + 2.0 * 0.76159415595576489, 1e-15);
   EXPECT_EQ(jle::frictionEffort(0.5, 2.0, -0.3, 0.01), -jle::frictionEffort(0.5, 2.0, 0.3, 0.01));
   // Far from rest: viscous + Coulomb (tanh(30) = 1 in double).
   EXPECT_EQ(jle::frictionEffort(0.5, 2.0, 0.3, 0.01), 0.15 + 2.0);
