@@ -95,11 +95,12 @@ struct UncertaintyConfig {
 /// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
 /// frame, moment about the plate origin; its reaction acts on `plate.link`.
 /// The plate's six components are resampled and filtered at the joint stamps like a
-/// wrench input's. The contact threshold acts on each raw sample before filtering (a
-/// sample below it enters the filter as zero) and again on the raw signal at the
-/// estimate's stamp: the reaction is applied only when the plate is in contact at that
-/// stamp, so the filters' memory of a stance never loads a swinging foot. The applied
-/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot.
+/// wrench input's, every sample as measured. The contact threshold acts on the raw
+/// signal at the estimate's stamp: at or above it the plate is in contact and the applied
+/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot;
+/// below it the raw wrench at the stamp acts, without a COP (so the filters' memory of a
+/// stance never loads a swinging foot, and the reaction has no step at heel strike or
+/// toe-off; README, "Force plates").
 struct PlateInputConfig {
   ForcePlateConfig plate;
   double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale

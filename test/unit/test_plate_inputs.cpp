@@ -1,5 +1,5 @@
 // The force plates' unit (plate_inputs.hpp): a static plate under a known foot, the
-// contact threshold on the raw samples, the contact at the estimate's stamp, the stale
+// contact threshold at the estimate's stamp (filtered above it, raw below it), the stale
 // policies and the refused configurations, against numbers worked by hand.
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/estimator.hpp>  // PlateInputConfig
