@@ -82,7 +82,9 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    about the world z axis; the foot LINK stands on it and receives the
                    reaction at the centre of pressure
   --contact-threshold N
-                   plate force [N] below which a foot is not in contact (default 20)
+                   plate force [N] below which no centre of pressure is decoded and
+                   the plate is not in contact; the reading still acts on the foot
+                   as measured (default 20; 0: every pressing reading in contact)
   --per-kg         also JOINT.effort_per_kg = effort / body mass [N m/kg, N/kg]
   --body-mass KG   the body mass for --per-kg (default: the URDF's total mass)
   --kinematics     also JOINT.q, .qd, .qdd of every joint (what the loads were
