@@ -95,11 +95,12 @@ struct UncertaintyConfig {
 /// One force plate (force_plate.hpp): what the foot applies to the plate, in the plate
 /// frame, moment about the plate origin; its reaction acts on `plate.link`.
 /// The plate's six components are resampled and filtered at the joint stamps like a
-/// wrench input's. The contact threshold acts on each raw sample before filtering (a
-/// sample below it enters the filter as zero) and again on the raw signal at the
-/// estimate's stamp: the reaction is applied only when the plate is in contact at that
-/// stamp, so the filters' memory of a stance never loads a swinging foot. The applied
-/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot.
+/// wrench input's, every sample as measured. The contact threshold acts on the raw
+/// signal at the estimate's stamp: at or above it the plate is in contact and the applied
+/// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot;
+/// below it the raw wrench at the stamp acts, without a COP (so the filters' memory of a
+/// stance never loads a swinging foot, and the reaction has no step at heel strike or
+/// toe-off; README, "Force plates").
 struct PlateInputConfig {
   ForcePlateConfig plate;
   double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale
@@ -189,6 +190,16 @@ struct PlateTopicSettings {
   bool pose_configured = false;
 };
 
+/// The friction term of the motor effort (friction.hpp), from the URDF's
+/// <dynamics damping friction> of each joint; off by default.
+struct FrictionConfig {
+  /// JointLoads.motor_effort = effort + damping qd + friction tanh(qd / velocity_scale);
+  /// false: motor_effort is empty.
+  bool enabled = false;
+  /// [rad/s or m/s] > 0: the width of the smooth sign of the Coulomb term.
+  double velocity_scale = 0.01;
+};
+
 /// Every setting of the node and of the offline front ends (process_bag), with the
 /// parameter names of config/default.yaml (README, "Parameters").
 struct Settings {
@@ -216,6 +227,7 @@ struct Settings {
   double diagnostic_period = 1.0;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;
+  FrictionConfig friction;
   /// The estimator's settings; estimator.joints are the joints whose loads are published.
   EstimatorConfig estimator;
   std::vector<WrenchTopicSettings> wrenches;     ///< pairs with estimator.wrenches

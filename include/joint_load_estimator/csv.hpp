@@ -198,6 +198,11 @@ struct LoadColumnLayout {
   bool per_kg = false;
   /// JOINT.effort_stddev of every joint, after the last joint's columns.
   bool effort_stddev = false;
+  /// JOINT.q, JOINT.qd, JOINT.qdd of every joint (the coordinates the loads were computed
+  /// from), after the effort_stddev columns.
+  bool kinematics = false;
+  /// JOINT.motor_effort of every joint (friction.hpp), after the kinematics columns.
+  bool motor_effort = false;
   /// Force plates: plate@NAME.contact, .cop_x, .cop_y, .cop_z for each NAME, last.
   std::vector<std::string> plates;
 };
@@ -205,7 +210,9 @@ struct LoadColumnLayout {
 /// Header of a joint-load file (joint_loads, process_bag; docs/joint_loads.md), in this
 /// order: t; base.fx ... base.mz (layout.base); for each of `joints` JOINT.fx, .fy, .fz,
 /// .mx, .my, .mz, .effort (and JOINT.effort_per_kg with layout.per_kg); JOINT.effort_stddev
-/// for each of `joints` (layout.effort_stddev); the plates' columns (layout.plates).
+/// for each of `joints` (layout.effort_stddev); JOINT.q, .qd, .qdd for each of `joints`
+/// (layout.kinematics); JOINT.motor_effort for each of `joints` (layout.motor_effort); the
+/// plates' columns (layout.plates).
 std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints,
                                           const LoadColumnLayout& layout = {});
 

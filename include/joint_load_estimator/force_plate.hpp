@@ -30,13 +30,19 @@ struct ForcePlateConfig {
   Eigen::Matrix3d R_world_plate = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_world_plate = Eigen::Vector3d::Zero();  ///< [m]
   double surface_height = 0.0;  ///< [m] z of the contact surface in the plate frame
-  /// [N] below this force pressing into the plate there is no contact: the reading
-  /// (sensor noise, a swinging foot above it) is ignored.
+  /// [N] below this force pressing into the plate the centre of pressure is not
+  /// decoded (a division by a small force: sensor noise would throw it anywhere) and the
+  /// reading is not a contact; the reaction still acts on the foot, as the exact wrench
+  /// the plate measured (force, and moment about the plate origin carried to the foot),
+  /// so heel strike and toe-off have no step (README, "Force plates").
   double contact_threshold = 20.0;
 };
 
 /// One plate sample, decoded.
 struct PlateReading {
+  /// The foot presses into the plate (normal_force > 0, finite): the reaction acts.
+  bool loaded = false;
+  /// Loaded with normal_force >= contact_threshold: the COP and free moment are decoded.
   bool contact = false;
   /// [N] force pressing into the plate (along -z of the plate frame); positive in contact.
   double normal_force = 0.0;
@@ -46,20 +52,25 @@ struct PlateReading {
   /// [N m] free moment of the foot on the plate about the normal through the COP.
   double free_moment = 0.0;
   /// The ground reaction on the foot, plate frame, moment about the plate origin
-  /// [N, N m]; zero without contact.
+  /// [N, N m]; zero unless loaded.
   Eigen::Vector3d force_on_foot_plate = Eigen::Vector3d::Zero();
   Eigen::Vector3d moment_on_foot_plate = Eigen::Vector3d::Zero();
 };
 
 /// Decodes a plate sample: the wrench the foot applies to the plate (plate frame,
-/// moment about the plate origin). Non-finite input gives no contact.
+/// moment about the plate origin). Non-finite input, or a force that does not press into
+/// the plate, is not loaded; below the contact threshold it is loaded without a COP.
 inline PlateReading readForcePlate(const ForcePlateConfig& plate,
                                    const Eigen::Vector3d& force_plate,
                                    const Eigen::Vector3d& moment_plate) {
   PlateReading r;
   if (!force_plate.allFinite() || !moment_plate.allFinite()) return r;
   r.normal_force = -force_plate.z();
-  if (!(r.normal_force >= plate.contact_threshold) || r.normal_force <= 0.0) return r;
+  if (!(r.normal_force > 0.0)) return r;
+  r.loaded = true;
+  r.force_on_foot_plate = -force_plate;
+  r.moment_on_foot_plate = -moment_plate;
+  if (!(r.normal_force >= plate.contact_threshold)) return r;
   r.contact = true;
   // The point p on the surface z = h about which the foot's moment has no component
   // in the plane: moment_plate = p x F + (0, 0, free_moment).
@@ -70,8 +81,6 @@ inline PlateReading readForcePlate(const ForcePlateConfig& plate,
   r.cop_plate.z() = h;
   r.free_moment =
       moment_plate.z() - (r.cop_plate.x() * force_plate.y() - r.cop_plate.y() * force_plate.x());
-  r.force_on_foot_plate = -force_plate;
-  r.moment_on_foot_plate = -moment_plate;
   return r;
 }
 
@@ -81,24 +90,30 @@ inline Eigen::Vector3d copInWorld(const ForcePlateConfig& plate, const PlateRead
 }
 
 /// The ground reaction of a plate reading in the world frame, moment about the world
-/// point `point_world` [m] (e.g. the foot link's origin). Exact: the moment is carried
-/// from the COP, so no large lever arm about a far origin enters.
+/// point `point_world` [m] (e.g. the foot link's origin); zero unless loaded. In contact
+/// the moment is carried from the COP, so no large lever arm about a far origin enters;
+/// below the threshold (a force of at most contact_threshold) from the plate origin.
 inline void plateReactionInWorld(const ForcePlateConfig& plate, const PlateReading& reading,
                                  const Eigen::Vector3d& point_world, Eigen::Vector3d& force_world,
                                  Eigen::Vector3d& moment_world) {
-  if (!reading.contact) {
+  if (!reading.loaded) {
     force_world.setZero();
     moment_world.setZero();
     return;
   }
   force_world.noalias() = plate.R_world_plate * reading.force_on_foot_plate;
+  if (!reading.contact) {
+    moment_world = plate.R_world_plate * reading.moment_on_foot_plate +
+                   (plate.p_world_plate - point_world).cross(force_world);
+    return;
+  }
   const Eigen::Vector3d cop_world = copInWorld(plate, reading);
   // On the foot: the reaction force at the COP plus the opposite free moment about the normal.
   const Eigen::Vector3d free_world = plate.R_world_plate.col(2) * (-reading.free_moment);
   moment_world = (cop_world - point_world).cross(force_world) + free_world;
 }
 
-/// Applies the ground reaction of `reading` (nothing without contact) to the foot standing
+/// Applies the ground reaction of `reading` (nothing unless loaded) to the foot standing
 /// on `plate`: frame `foot_frame` (an index into model.frames, the frame of plate.link),
 /// as a world-frame wrench about its origin. Call after forwardKinematics and before
 /// inverseDynamics. The reaction is worked in double whatever Scalar is.
@@ -106,7 +121,7 @@ template <typename Scalar>
 void applyPlateReaction(const Model<Scalar>& model, Data<Scalar>& data, int foot_frame,
                         const ForcePlateConfig& plate, const PlateReading& reading) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  if (!reading.contact) return;
+  if (!reading.loaded) return;
   const Frame<Scalar>& foot = model.frames[static_cast<std::size_t>(foot_frame)];
   const int s = foot.segment;
   const Eigen::Vector3d foot_world =

@@ -66,6 +66,11 @@ struct Model {
   std::vector<int> coordinate;
   std::vector<Scalar> multiplier;
   std::vector<Scalar> offset;
+  /// The URDF joint's <dynamics damping friction> (0 where absent or not moving): viscous
+  /// damping [N m s/rad or N s/m] and Coulomb friction [N m or N], for the optional
+  /// friction term of the motor effort (friction.hpp).
+  std::vector<Scalar> damping;
+  std::vector<Scalar> friction;
   std::vector<Scalar> mass;          ///< lumped mass [kg]
   std::vector<Vector3> com;          ///< lumped centre of mass in the segment frame [m]
   std::vector<Matrix3> inertia_com;  ///< lumped inertia about the com, segment axes [kg m^2]
@@ -178,6 +183,8 @@ struct Model {
       out.axis.push_back(axis[i].template cast<Other>());
       out.multiplier.push_back(static_cast<Other>(multiplier[i]));
       out.offset.push_back(static_cast<Other>(offset[i]));
+      out.damping.push_back(static_cast<Other>(damping[i]));
+      out.friction.push_back(static_cast<Other>(friction[i]));
       out.mass.push_back(static_cast<Other>(mass[i]));
       out.com.push_back(com[i].template cast<Other>());
       out.inertia_com.push_back(inertia_com[i].template cast<Other>());

@@ -98,6 +98,12 @@ struct LoadsRecord {
   /// joint, row-major, 36 numbers (fx fy fz mx my mz), or 6 variances (diagonal_only).
   std::vector<double> effort_stddev, covariance;
   std::vector<double> effort_per_kg;  ///< effort / body_mass; empty when not configured
+  /// The q, q-dot, q-ddot the loads were computed from (the filter's estimate at `stamp`,
+  /// a mimic joint's mapped from its leader's) [rad or m, /s, /s^2]; 0 for a fixed joint.
+  std::vector<double> position, velocity, acceleration;
+  /// With settings.friction.enabled: effort + damping velocity + friction tanh(velocity /
+  /// velocity_scale) (friction.hpp) [N m or N]; empty when off.
+  std::vector<double> motor_effort;
 };
 
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
@@ -215,6 +221,7 @@ class Pipeline {
   bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord();
+  void fillCoordinates(std::size_t i, std::size_t segment);
   const Sample* sampleAt(double t) const;
 
   Settings settings_;

@@ -18,9 +18,12 @@ namespace jle {
 struct PlateInputConfig;  // config.hpp
 
 /// The force plates of one estimator, each filtered in six bank channels (force, moment:
-/// what the foot applies to the plate, plate frame, about its origin). A sample below the
-/// contact threshold enters the filter as zero; the reaction is applied only where the
-/// raw signal is in contact at the estimate's stamp, decoded from the filtered wrench.
+/// what the foot applies to the plate, plate frame, about its origin). Every sample
+/// enters the filter as measured. Where the raw signal at the estimate's stamp is in
+/// contact (at or above the threshold) the reaction is the filtered wrench, decoded (COP,
+/// free moment); below the threshold it is the raw wrench at the stamp, applied without a
+/// COP (a force of at most the threshold; so the filters' memory of a stance never loads
+/// a swinging foot, and the reaction has no step at heel strike or toe-off).
 class PlateInputs {
  public:
   PlateInputs() = default;
@@ -53,14 +56,16 @@ class PlateInputs {
   /// The contact of every needed plate on its raw signal at the estimate's stamp [s];
   /// true when any changed since the last call.
   bool updateContacts(double stamp);
-  /// The reaction of every plate in contact at the stamp, decoded from its filtered
-  /// wrench, added to its foot (after forwardKinematics, before inverseDynamics).
+  /// The reaction of every needed plate, added to its foot (after forwardKinematics,
+  /// before inverseDynamics): in contact at the stamp decoded from its filtered wrench,
+  /// else the raw wrench at the stamp (nothing where it does not press into the plate).
   template <typename Scalar>
   void apply(const Model<Scalar>& model, Data<Scalar>& data, const DifferentiatorBank& bank);
   /// Forgets every sample and contact.
   void reset();
 
-  /// Plate k as applied at the last apply() (no contact: nothing was applied).
+  /// Plate k as applied at the last apply() (not loaded: nothing was applied; loaded
+  /// without contact: the raw wrench, no COP).
   const PlateReading& reading(int k) const { return plates_[static_cast<std::size_t>(k)].reading; }
   /// Whether plate k was stale at the last joint sample.
   bool stale(int k) const { return plates_[static_cast<std::size_t>(k)].samples.stale(); }
@@ -71,8 +76,9 @@ class PlateInputs {
   struct Plate {
     ForcePlateConfig raw;       // as configured (the threshold acts on the raw signal)
     ForcePlateConfig filtered;  // raw with a zero threshold: decodes the filtered wrench
-    InputBuffer samples;        // zero below the threshold
-    int frame = 0;              // the foot
+    InputBuffer samples;        // as measured
+    InputBuffer::Vector6 raw_at_stamp = InputBuffer::Vector6::Zero();  // at the estimate's stamp
+    int frame = 0;                                                     // the foot
     int channel = 0;
     bool needed = true;
     bool contact = false;  // raw signal in contact at the estimate's stamp
@@ -86,10 +92,15 @@ void PlateInputs::apply(const Model<Scalar>& model, Data<Scalar>& data,
                         const DifferentiatorBank& bank) {
   for (Plate& p : plates_) {
     p.reading = PlateReading();
-    if (!p.needed || !p.contact) continue;
-    const Wrench<double> w = filteredWrench(bank, p.channel);
-    // In contact at the stamp; the filtered wrench still pressing into the plate.
-    p.reading = readForcePlate(p.filtered, w.force, w.moment);
+    if (!p.needed) continue;
+    if (p.contact) {
+      const Wrench<double> w = filteredWrench(bank, p.channel);
+      // In contact at the stamp; the filtered wrench still pressing into the plate.
+      p.reading = readForcePlate(p.filtered, w.force, w.moment);
+    } else {
+      // Below the threshold: loaded without a COP (raw's threshold), or not at all.
+      p.reading = readForcePlate(p.raw, p.raw_at_stamp.head<3>(), p.raw_at_stamp.tail<3>());
+    }
     applyPlateReaction(model, data, p.frame, p.filtered, p.reading);  // joint_loads' code too
   }
 }

@@ -139,6 +139,7 @@ void validate(const Settings& settings) {
   positive("base_residual_threshold", settings.base_residual_threshold);
   positive("still_velocity", settings.still_velocity);
   positive("diagnostic_period", settings.diagnostic_period);
+  positive("friction/velocity_scale", settings.friction.velocity_scale);
   const double m = settings.body_mass;
   if (!((m >= 0.0 && std::isfinite(m)) || m == -1.0))
     fail("body_mass",

@@ -604,6 +604,11 @@ std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints
   }
   if (layout.effort_stddev)
     for (const std::string& joint : joints) names.push_back(joint + ".effort_stddev");
+  if (layout.kinematics)
+    for (const std::string& joint : joints)
+      for (const char* c : {".q", ".qd", ".qdd"}) names.push_back(joint + c);
+  if (layout.motor_effort)
+    for (const std::string& joint : joints) names.push_back(joint + ".motor_effort");
   for (const std::string& plate : layout.plates)
     for (const char* column : kPlateOutputs) names.push_back(kPlatePrefix + plate + "." + column);
   return names;

@@ -1,4 +1,5 @@
 #include <joint_load_estimator/frames.hpp>
+#include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/pipeline.hpp>
 
 #include <algorithm>
@@ -146,6 +147,10 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
   record_.moment.assign(n, Eigen::Vector3d::Zero());
   record_.effort.assign(n, 0.0);
   record_.measured_effort.assign(n, kNaN);
+  record_.position.assign(n, 0.0);
+  record_.velocity.assign(n, 0.0);
+  record_.acceleration.assign(n, 0.0);
+  if (settings_.friction.enabled) record_.motor_effort.assign(n, 0.0);
   const UncertaintyConfig& u = settings_.estimator.uncertainty;
   if (u.enabled) {
     record_.effort_stddev.assign(n, 0.0);
@@ -399,6 +404,7 @@ void Pipeline::fillRecord() {
     record_.effort[i] = data.effort[j];
     record_.measured_effort[i] = measured ? s->effort[i] : kNaN;
     if (!record_.effort_per_kg.empty()) record_.effort_per_kg[i] = data.effort[j] / body_mass_;
+    fillCoordinates(i, j);
     if (!u.enabled) continue;
     const Eigen::Matrix<double, 6, 6>& C = estimator_.covariance(segment);
     double* out = &record_.covariance[per_joint * i];
@@ -410,6 +416,21 @@ void Pipeline::fillRecord() {
           out[r] = C(r, r);
     record_.effort_stddev[i] = std::sqrt(estimator_.effortVariance(segment));
   }
+}
+
+void Pipeline::fillCoordinates(std::size_t i, std::size_t segment) {
+  const Model<double>& m = model();
+  const int c = m.coordinate[segment];
+  if (c < 0) return;  // a fixed joint kept as a segment: 0 from the constructor
+  // As forwardKinematics maps them (a mimic joint follows its leader).
+  const double k = m.multiplier[segment];
+  record_.position[i] = k * estimator_.q()[c] + m.offset[segment];
+  record_.velocity[i] = k * estimator_.qd()[c];
+  record_.acceleration[i] = k * estimator_.qdd()[c];
+  if (!record_.motor_effort.empty())
+    record_.motor_effort[i] =
+        record_.effort[i] + frictionEffort(m.damping[segment], m.friction[segment],
+                                           record_.velocity[i], settings_.friction.velocity_scale);
 }
 
 void Pipeline::setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {

@@ -35,9 +35,8 @@ bool PlateInputs::add(int k, double t, const Eigen::Vector3d& force_plate,
   InputBuffer::Vector6 value;
   value << force_plate, moment_plate;
   if (!value.allFinite()) return false;
-  // Below the threshold (noise, a foot above the plate): zero, so that the filters hold
-  // no phantom load between contacts.
-  if (!readForcePlate(plate.raw, force_plate, moment_plate).contact) value.setZero();
+  // Every sample enters the filters as measured: a force rising from zero at heel strike
+  // is filtered like the kinematics, without a step at the threshold.
   return plate.samples.add(t, value);
 }
 
@@ -64,14 +63,18 @@ bool PlateInputs::updateContacts(double stamp) {
   bool changed = false;
   for (Plate& p : plates_) {
     bool contact = false;
+    InputBuffer::Vector6 value = InputBuffer::Vector6::Zero();
     if (p.needed) {
       // The raw signal at the estimate's stamp (the staleness of the newest joint sample
       // is kept).
-      const double normal = -p.samples.valueAt(stamp)[2];
+      value = p.samples.valueAt(stamp);
+      const double normal = -value[2];
       contact = normal >= p.raw.contact_threshold && normal > 0.0;
     }
-    changed = changed || contact != p.contact;
+    // Out of contact the raw value itself is applied: a new value is a new input.
+    changed = changed || contact != p.contact || (!contact && value != p.raw_at_stamp);
     p.contact = contact;
+    p.raw_at_stamp = value;
   }
   return changed;
 }
@@ -80,6 +83,7 @@ void PlateInputs::reset() {
   for (Plate& p : plates_) {
     p.samples.reset();
     p.contact = false;
+    p.raw_at_stamp.setZero();
     p.reading = PlateReading();
   }
 }

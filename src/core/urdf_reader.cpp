@@ -47,6 +47,7 @@ struct JointDesc {
   bool mimic = false;
   std::string mimic_joint;
   double multiplier = 1.0, offset = 0.0;
+  double damping = 0.0, friction = 0.0;  // <dynamics>
 };
 
 [[noreturn]] void fail(const std::string& what) { throw ModelError(what); }
@@ -168,6 +169,10 @@ JointDesc parseJoint(const tinyxml2::XMLElement* e) {
     joint.multiplier = number(m, "multiplier", what + " mimic", false, 1.0);
     joint.offset = number(m, "offset", what + " mimic", false, 0.0);
   }
+  if (const tinyxml2::XMLElement* d = e->FirstChildElement("dynamics")) {
+    joint.damping = number(d, "damping", what + " dynamics", false, 0.0);
+    joint.friction = number(d, "friction", what + " dynamics", false, 0.0);
+  }
   return joint;
 }
 
@@ -228,6 +233,8 @@ struct Builder {
     model.multiplier.push_back(1.0);
     model.offset.push_back(0.0);
     parts.emplace_back();
+    model.damping.push_back(0.0);
+    model.friction.push_back(0.0);
     return static_cast<int>(model.parent.size()) - 1;
   }
 
@@ -314,6 +321,8 @@ struct Builder {
         const double norm = joint.axis.norm();
         if (!(norm > 1e-12)) fail(what + ": axis of zero length");
         model.axis[s] = joint.axis / norm;
+        model.damping[s] = joint.damping;
+        model.friction[s] = joint.friction;
       }
       place(child, s, Pose());
     }

@@ -72,6 +72,10 @@ void prepare(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
   msg.effort_stddev.resize(record.effort_stddev.size());
   msg.covariance.resize(record.covariance.size());
   msg.effort_per_kg.resize(record.effort_per_kg.size());
+  msg.position.resize(n);
+  msg.velocity.resize(n);
+  msg.acceleration.resize(n);
+  msg.motor_effort.resize(record.motor_effort.size());
 }
 
 void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
@@ -90,6 +94,10 @@ void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg)
   msg.effort_stddev = record.effort_stddev;
   msg.covariance = record.covariance;
   msg.effort_per_kg = record.effort_per_kg;
+  msg.position = record.position;
+  msg.velocity = record.velocity;
+  msg.acceleration = record.acceleration;
+  msg.motor_effort = record.motor_effort;
 }
 
 void toWrenchMessage(const LoadsRecord& record, std::size_t i, geometry_msgs::WrenchStamped& msg) {

@@ -219,6 +219,11 @@ void readUncertainty(Section& s, UncertaintyConfig& u) {
                         s.name("period") + "' [s] (docs/uncertainty.md)");
 }
 
+void readFriction(Section& s, FrictionConfig& f) {
+  s.read("enabled", f.enabled);
+  s.read("velocity_scale", f.velocity_scale);
+}
+
 void readWrench(Section& s, WrenchTopicSettings& w, WrenchInputConfig& input) {
   s.read("topic", w.topic);
   s.read("frame", w.frame);
@@ -314,6 +319,7 @@ Settings parseSettings(const XmlRpcValue& params) {
   readTopLevel(s, n);
   s.readMap("savings", [&](Section& m) { readSavings(m, n.estimator.savings); });
   s.readMap("uncertainty", [&](Section& m) { readUncertainty(m, n.estimator.uncertainty); });
+  s.readMap("friction", [&](Section& m) { readFriction(m, n.friction); });
   s.readMap("differentiator",
             [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });
   s.readList("wrenches", [&](Section& m) {

@@ -5,6 +5,7 @@
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/force_plate.hpp>
+#include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -33,6 +34,7 @@ const char* const kUsage =
                    [--gravity GX,GY,GZ] [--frame child|parent|world]
                    [--floating-base] [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
                    [--contact-threshold N] [--per-kg [--body-mass KG]]
+                   [--kinematics] [--friction [--velocity-scale V]]
                    [--format csv|sto]
                    [--cutoff HZ|auto] [--cutoff-rule residual|gcv]
                    [--filter-order N] [--write-kinematics STATES.csv]
@@ -85,9 +87,18 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    about the world z axis; the foot LINK stands on it and receives the
                    reaction at the centre of pressure
   --contact-threshold N
-                   plate force [N] below which a foot is not in contact (default 20)
+                   plate force [N] below which no centre of pressure is decoded and
+                   the plate is not in contact; the reading still acts on the foot
+                   as measured (default 20; 0: every pressing reading in contact)
   --per-kg         also JOINT.effort_per_kg = effort / body mass [N m/kg, N/kg]
   --body-mass KG   the body mass for --per-kg (default: the URDF's total mass)
+  --kinematics     also JOINT.q, .qd, .qdd of every joint (what the loads were
+                   computed from; a mimic joint's from its leader's)
+  --friction       also JOINT.motor_effort = effort + damping qd + friction
+                   tanh(qd / V), from each joint's URDF <dynamics damping friction>
+                   (docs/outputs.md)
+  --velocity-scale V
+                   [rad/s or m/s] width of the smooth sign of --friction (default 0.01)
   --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
   --cutoff HZ|auto positions only (no JOINT.qd, JOINT.qdd column): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
@@ -108,7 +119,8 @@ apply to the root link: world frame, moment about the root link origin; zero whe
 the measured loads explain the motion); for every moving joint in URDF tree order
 (depth first from the root, children in document order; mimic joints included)
 JOINT.fx,JOINT.fy,JOINT.fz,JOINT.mx,JOINT.my,JOINT.mz,JOINT.effort
-[,JOINT.effort_per_kg]; for every plate plate@NAME.contact (1 or 0) and
+[,JOINT.effort_per_kg]; with --kinematics JOINT.q,.qd,.qdd for every joint; with
+--friction JOINT.motor_effort for every joint; for every plate plate@NAME.contact (1 or 0) and
 plate@NAME.cop_x,.cop_y,.cop_z (centre of pressure in the world [m], 0 without
 contact). Every number with 17 significant digits (%.17g).
 
@@ -132,7 +144,10 @@ struct Options {
   // given (refused for a CSV with JOINT.qd, JOINT.qdd).
   jle::ZeroPhaseConfig smoothing;
   bool smoothing_given = false;
-  std::string kinematics;  // --write-kinematics
+  std::string write_kinematics;  // --write-kinematics FILE
+  bool kinematics = false;
+  bool friction = false;
+  double velocity_scale = 0.01;  // [rad/s or m/s], jle::FrictionConfig's default
 };
 
 Eigen::Vector3d parseGravity(const std::string& text) {
@@ -224,9 +239,22 @@ void parseSmoothing(std::map<std::string, std::string>& v, Options& options) {
   }
   if (v.count("--filter-order"))
     z.order = static_cast<int>(parseInteger("--filter-order", v["--filter-order"], 1, 8));
-  if (v.count("--write-kinematics")) options.kinematics = v["--write-kinematics"];
+  if (v.count("--write-kinematics")) options.write_kinematics = v["--write-kinematics"];
   for (const char* key : {"--cutoff", "--cutoff-rule", "--filter-order", "--write-kinematics"})
     options.smoothing_given = options.smoothing_given || v.count(key) > 0;
+}
+
+// --kinematics, --friction, --velocity-scale.
+void parseOutputOptions(std::map<std::string, std::string>& v, Options& options) {
+  options.kinematics = v.count("--kinematics") > 0;
+  options.friction = v.count("--friction") > 0;
+  if (v.count("--velocity-scale")) {
+    if (!options.friction) throw UsageError("--velocity-scale is only used with --friction");
+    options.velocity_scale =
+        parseNumber("--velocity-scale", v["--velocity-scale"], Sign::kPositive);
+  }
+  if (options.sto && (options.kinematics || options.friction))
+    throw UsageError("--kinematics and --friction are columns of the csv format only");
 }
 
 Options parseOptions(int argc, char** argv) {
@@ -237,8 +265,8 @@ Options parseOptions(int argc, char** argv) {
       optionValues(static_cast<int>(rest.size()), rest.data(),
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
                     "--body-mass", "--format", "--cutoff", "--cutoff-rule", "--filter-order",
-                    "--write-kinematics"},
-                   {"--floating-base", "--per-kg"});
+                    "--write-kinematics", "--velocity-scale"},
+                   {"--floating-base", "--per-kg", "--kinematics", "--friction"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   options.input = requiredValue(v, "--input", "STATES.csv");
@@ -259,6 +287,7 @@ Options parseOptions(int argc, char** argv) {
     throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
   options.sto = v.count("--format") && v["--format"] == "sto";
   parseSmoothing(v, options);
+  parseOutputOptions(v, options);
   return options;
 }
 
@@ -348,6 +377,8 @@ class Processor {
     jle::LoadColumnLayout layout;
     layout.base = model.floating_base;
     layout.per_kg = options.per_kg;
+    layout.kinematics = options.kinematics;
+    layout.motor_effort = options.friction;
     for (const jle::ForcePlateConfig& plate : options.plates) {
       plate_frames_.push_back(model.frameIndex(plate.link));
       layout.plates.push_back(plate.name);
@@ -485,6 +516,21 @@ class Processor {
     }
   }
 
+  // The --kinematics and --friction columns of the row, from `o` on.
+  double* putOutputs(double* o) const {
+    if (options_.kinematics)
+      for (int s : model_.moving_segments) {
+        *o++ = data_.q[s];
+        *o++ = data_.qd[s];
+        *o++ = data_.qdd[s];
+      }
+    if (options_.friction)
+      for (int s : model_.moving_segments)
+        *o++ = data_.effort[s] + jle::frictionEffort(model_.damping[s], model_.friction[s],
+                                                     data_.qd[s], options_.velocity_scale);
+    return o;
+  }
+
   // One output row, in the order of names().
   void writeLoads(const std::vector<double>& cells, Output& out) {
     const auto put = [](const jle::Wrench<double>& w, double* o) {
@@ -501,6 +547,7 @@ class Processor {
       *o++ = data_.effort[s];
       if (options_.per_kg) *o++ = data_.effort[s] / mass_;
     }
+    o = putOutputs(o);
     for (double x : cop_) *o++ = x;
     assert(static_cast<std::size_t>(o - loads_.data()) == loads_.size());
     out.row(loads_);
@@ -623,7 +670,7 @@ void writeKinematics(const Options& options, const jle::Model<double>& model,
   order.insert(order.end(), forces.begin(), forces.end());
   jle::ExtraStateInputs extra;
   for (const jle::ForcePlateConfig& plate : options.plates) extra.plates.push_back(plate.name);
-  jle::CsvWriter out(options.kinematics);
+  jle::CsvWriter out(options.write_kinematics);
   out.writeHeader(jle::stateColumnNames(model, links, extra));
   std::vector<double> row(order.size());
   for (const std::vector<double>& cells : r.cells) {
@@ -643,7 +690,7 @@ void runPositionsOnly(const Options& options, const jle::Model<double>& model,
                "joint_loads: positions only: zero-phase Butterworth, order %d per pass, "
                "cutoff %.17g Hz (%s)\n",
                options.smoothing.order, cutoff, jle::toString(options.smoothing.rule));
-  if (!options.kinematics.empty()) writeKinematics(options, model, columns, record);
+  if (!options.write_kinematics.empty()) writeKinematics(options, model, columns, record);
   Processor processor(options, model, columns, record.cells.front().size());
   Output out(options, model, processor.names());
   long n = 0;

@@ -23,6 +23,7 @@
 
 #include <unistd.h>
 
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -42,7 +43,7 @@ using jle::cli::optionValues;
 
 const char* const kUsage =
     R"(usage: process_bag --bag IN.bag --urdf ROBOT.urdf [--config CONFIG.yaml]
-                   [--output OUT.bag | --csv OUT.csv] [--sto OUT.sto]
+                   [--output OUT.bag | --csv OUT.csv [--kinematics]] [--sto OUT.sto]
                    [--topic-prefix /joint_load_estimator]
                    [--zero-phase HZ|auto [--cutoff-rule gcv|residual]]
 
@@ -65,7 +66,11 @@ bag is played to it, without the timing of a live system.
                        joint JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort (the columns of
                        joint_loads; wrenches in the child link frame, moment about the
                        joint origin), %.17g; with uncertainty enabled, then
-                       JOINT.effort_stddev for every joint
+                       JOINT.effort_stddev for every joint; with --kinematics,
+                       then JOINT.q, .qd, .qdd for every joint (what the loads were
+                       computed from: the filter's estimate); with friction enabled
+                       in the config, then JOINT.motor_effort for every joint
+  --kinematics         the JOINT.q, .qd, .qdd columns in the CSV (docs/outputs.md)
   --sto PATH           also (or only) write them as an OpenSim storage file: the
                        same numbers, tab-separated, under OpenSim's column names
                        (time, JOINT_moment or JOINT_force, and
@@ -104,6 +109,7 @@ struct Options {
   std::string prefix = "/joint_load_estimator";
   bool smooth = false;  // --zero-phase
   jle::ZeroPhaseConfig smoothing;
+  bool kinematics = false;  // JOINT.q, .qd, .qdd in the CSV
 };
 
 // --zero-phase, --cutoff-rule.
@@ -124,7 +130,8 @@ Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v =
       optionValues(argc, argv,
                    {"--bag", "--urdf", "--config", "--output", "--csv", "--sto", "--topic-prefix",
-                    "--zero-phase", "--cutoff-rule"});
+                    "--zero-phase", "--cutoff-rule"},
+                   {"--kinematics"});
   Options o;
   if (!v.count("--bag")) throw UsageError("--bag IN.bag is required");
   if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
@@ -136,6 +143,8 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--output")) o.output = v["--output"];
   if (v.count("--csv")) o.csv = v["--csv"];
   if (v.count("--sto")) o.sto = v["--sto"];
+  o.kinematics = v.count("--kinematics") > 0;
+  if (o.kinematics && o.csv.empty()) throw UsageError("--kinematics is only used with --csv");
   if (v.count("--topic-prefix")) o.prefix = v["--topic-prefix"];
   if (o.prefix[0] != '/') o.prefix = "/" + o.prefix;
   while (o.prefix.size() > 1 && o.prefix.back() == '/') o.prefix.pop_back();
@@ -186,6 +195,7 @@ class Outputs {
   const Options& options_;
   joint_load_estimator::JointLoads loads_;
   std::vector<double> row_;
+  std::size_t sto_columns_ = 0;  // the first numbers of row_: the .sto row
   std::unique_ptr<rosbag::Bag> bag_;
   std::string bag_temporary_, topic_;
   std::unique_ptr<jle::CsvWriter> csv_;
@@ -195,7 +205,9 @@ class Outputs {
 Outputs::Outputs(const Options& options, const jle::Pipeline& pipeline) : options_(options) {
   const jle::LoadsRecord& record = pipeline.record();
   jle::prepare(record, loads_);
-  row_.resize(1 + 7 * record.joint.size() + record.effort_stddev.size());
+  sto_columns_ = 1 + 7 * record.joint.size() + record.effort_stddev.size();
+  const std::size_t kinematics = options.kinematics ? 3 * record.joint.size() : 0;
+  row_.resize(sto_columns_ + (options.csv.empty() ? 0 : kinematics + record.motor_effort.size()));
   if (!options.output.empty()) {
     bag_temporary_ = options.output + ".partial";
     bag_ = std::make_unique<rosbag::Bag>();
@@ -213,6 +225,8 @@ Outputs::Outputs(const Options& options, const jle::Pipeline& pipeline) : option
   if (!options.csv.empty()) {
     jle::LoadColumnLayout layout;
     layout.effort_stddev = !record.effort_stddev.empty();
+    layout.kinematics = options.kinematics;
+    layout.motor_effort = !record.motor_effort.empty();
     csv_ = std::make_unique<jle::CsvWriter>(options.csv);
     csv_->writeHeader(jle::jointLoadColumns(record.joint, layout));
   }
@@ -237,8 +251,17 @@ void Outputs::write(const jle::LoadsRecord& record, long seq) {
     *row++ = record.effort[i];
   }
   for (double s : record.effort_stddev) *row++ = s;
+  if (csv_ && options_.kinematics)
+    for (std::size_t i = 0; i < record.joint.size(); ++i) {
+      *row++ = record.position[i];
+      *row++ = record.velocity[i];
+      *row++ = record.acceleration[i];
+    }
+  if (csv_)
+    for (double e : record.motor_effort) *row++ = e;
+  assert(static_cast<std::size_t>(row - row_.data()) == (csv_ ? row_.size() : sto_columns_));
   if (csv_) csv_->writeRow(row_.data(), row_.size());
-  if (sto_) sto_->writeRow(row_.data(), row_.size());
+  if (sto_) sto_->writeRow(row_.data(), sto_columns_);
   if (bag_) {
     jle::toMessage(record, loads_);
     loads_.header.seq = static_cast<std::uint32_t>(seq);

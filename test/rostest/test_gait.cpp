@@ -94,8 +94,9 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   // The residual. Without the plates it would be the body weight (735 N) and more; with
   // them it is what the filters cost, bounded by:
   // - the contact threshold (20 N): at each foot's loading and unloading the plate's force
-  //   ramps from 0 (a quintic smooth step over the 110 ms of double support) and the node
-  //   ignores it below the threshold (for about 15 ms);
+  //   ramps from 0 (a quintic smooth step over the 110 ms of double support); below the
+  //   threshold (for about 15 ms) the node applies the raw force, unfiltered while the
+  //   kinematics are filtered (a mismatch of at most the 20 N);
   // - the truncation error of the centred cubic Savitzky-Golay fit over 11 samples at
   //   200 Hz (h = 5 ms): its second derivative misses 2.08 h^2 x'''' (the least-squares
   //   quadratic coefficient of t^4 over k = -5..5 is 25 h^2), i.e. 5.2e-5 s^2 x''''; the

@@ -66,6 +66,25 @@ std::vector<ros::Time> jitteredStamps(const ros::Time& first, int n, unsigned se
   return stamps;
 }
 
+// The q, q-dot, q-ddot the message's loads were computed from: the 3-point estimate, exact
+// for a quadratic, so the trajectory's own, to rounding (positions to 1e-12 rad; the
+// differences amplify it by 1 / dt and 4 / dt^2: 1e-9 rad/s, 1e-7 rad/s^2, see kExactRel;
+// a sample off by one is 1e-3 or more); friction off: no motor_effort.
+void expectCoordinates(const joint_load_estimator::JointLoads& msg, const VectorXd& q,
+                       const VectorXd& qd, const VectorXd& qdd) {
+  const std::size_t n = static_cast<std::size_t>(q.size());
+  ASSERT_EQ(msg.position.size(), n);
+  ASSERT_EQ(msg.velocity.size(), n);
+  ASSERT_EQ(msg.acceleration.size(), n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const Eigen::Index i = static_cast<Eigen::Index>(j);
+    EXPECT_NEAR(msg.position[j], q[i], 1e-12) << msg.name[j];
+    EXPECT_NEAR(msg.velocity[j], qd[i], 1e-9) << msg.name[j];
+    EXPECT_NEAR(msg.acceleration[j], qdd[i], 1e-7) << msg.name[j];
+  }
+  EXPECT_TRUE(msg.motor_effort.empty());
+}
+
 // Drives `node` (finite_difference: 3-point warm-up) with a quadratic trajectory at
 // `stamps` and returns the largest relative deviation from the reference over all the
 // publications; checks that each stamp after the warm-up is published exactly once with
@@ -93,6 +112,7 @@ double runQuadratic(NodeUnderTest& node, Reference& ref, const Quadratic& traj,
     EXPECT_EQ(msg->name, ref.model.coordinate_names);
     for (std::size_t j = 0; j < msg->measured_effort.size() && j < js.effort.size(); ++j)
       EXPECT_EQ(msg->measured_effort[j], js.effort[j]) << msg->name[j];
+    expectCoordinates(*msg, traj.q(t), traj.qd(t), traj.a);
   }
   // One publication per sample after the warm-up: nothing from the warm-up samples.
   EXPECT_EQ(node.loads().size() - before, stamps.size() - 2);

@@ -316,8 +316,11 @@ TEST(Plates, PapersPlanarFootOnAFloatingShankWithTheLabPlateFromTf) {
 //   M_A = -[(c - A) x F + (0, 0, -2) + (G - A) x m g]
 //       = -[(9.4, -31, 2) + (0, 0, -2) + (0, 0.4903325, 0)] = (-9.4, 30.5096675, 0)
 // with c - A = (0.05, 0.01, -0.08). The effort (axis y) is 30.5096675 N m.
-// Below the threshold (20 N) the plate is ignored: F_A = (0, 0, 9.80665),
-// M_A = -(G - A) x m g = (0, -0.4903325, 0).
+// Below the threshold (20 N) the reading acts as measured, without a COP: f = (1, 0, -15)
+// with m = (0.3, -0.2, 0) about O gives the foot (-1, 0, 15) and, about A,
+// (-0.3, 0.2, 0) + (O - A) x (-1, 0, 15) = (2.7, -2.68, 0.2) with O - A = (0.2, 0.2, -0.12):
+// F_A = (1, 0, -15 + 9.80665) = (1, 0, -5.19335),
+// M_A = -[(2.7, -2.68, 0.2) + (0, 0.4903325, 0)] = (-2.7, 2.1896675, -0.2).
 TEST(Plates, SignsByHand) {
   NodeUnderTest node("sign");
   ASSERT_TRUE(node.connect());
@@ -327,7 +330,7 @@ TEST(Plates, SignsByHand) {
   ASSERT_TRUE(cop.connectTo(node.name()));
 
   const Vector3d f_contact(50.0, -30.0, -700.0), m_contact(134.2, -103.0, 16.0);
-  // 15 N of noise pressing (below the 20 N threshold), with a moment: ignored.
+  // 15 N pressing (below the 20 N threshold), with a moment: no COP, the wrench acts.
   const Vector3d f_noise(1.0, 0.0, -15.0), m_noise(0.3, -0.2, 0.0);
   // Phases of 10 samples: contact, below the threshold, contact again.
   const ros::Time start(40, 0);
@@ -369,12 +372,13 @@ TEST(Plates, SignsByHand) {
       EXPECT_NEAR(M.z(), 0.0, tol_m) << k;
       EXPECT_NEAR(msg->effort[0], 30.5096675, tol_m) << k;
     } else {
-      EXPECT_NEAR(F.x(), 0.0, tol_f) << k;
+      EXPECT_NEAR(F.x(), 1.0, tol_f) << k;
       EXPECT_NEAR(F.y(), 0.0, tol_f) << k;
-      EXPECT_NEAR(F.z(), 9.80665, tol_f) << k;
-      EXPECT_NEAR(M.x(), 0.0, tol_m) << k;
-      EXPECT_NEAR(M.y(), -0.4903325, tol_m) << k;
-      EXPECT_NEAR(M.z(), 0.0, tol_m) << k;
+      EXPECT_NEAR(F.z(), -5.19335, tol_f) << k;
+      EXPECT_NEAR(M.x(), -2.7, tol_m) << k;
+      EXPECT_NEAR(M.y(), 2.1896675, tol_m) << k;
+      EXPECT_NEAR(M.z(), -0.2, tol_m) << k;
+      EXPECT_NEAR(msg->effort[0], 2.1896675, tol_m) << k;
     }
     // body_mass 70 kg.
     ASSERT_EQ(msg->effort_per_kg.size(), 1u);

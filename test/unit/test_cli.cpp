@@ -200,6 +200,53 @@ TEST_F(CliTest, PandaWithMimicFingerRoundTripMatchesTheLibrary) {
                        jle::WrenchFrame::kChild, Eigen::Vector3d(0, 0, -9.80665));
 }
 
+// --kinematics and --friction (docs/outputs.md): after the joints' columns J.q, J.qd,
+// J.qdd of every joint (the input's, a mimic finger's from its leader's through
+// multiplier and offset), then J.motor_effort = J.effort + damping qd + friction
+// tanh(qd / 0.05) from the URDF's <dynamics> (panda: damping 0.003 on the arm's joints).
+// Same doubles, same arithmetic: 1e-12 relative as in expectMatchesLibrary.
+TEST_F(CliTest, KinematicsAndFrictionColumns) {
+  const std::string in = trajectory("states.csv", kPanda, {"--duration", "0.02", "--seed", "5"});
+  const Result r = jointLoads({"--urdf", kPanda, "--input", in, "--output", outPath(),
+                               "--kinematics", "--friction", "--velocity-scale", "0.05"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table input = parseTable(readFile(in)), out = parseTable(readFile(outPath()));
+  const jle::Model<double> model = jle::modelFromUrdfFile(kPanda);
+  std::vector<std::string> joints = pandaArm(), header;
+  joints.push_back("panda_finger_joint1");
+  joints.push_back("panda_finger_joint2");
+  header = loadHeader(joints);
+  for (const std::string& j : joints)
+    for (const char* c : {".q", ".qd", ".qdd"}) header.push_back(j + c);
+  for (const std::string& j : joints) header.push_back(j + ".motor_effort");
+  ASSERT_EQ(out.header, header);
+  ASSERT_EQ(out.rows.size(), input.rows.size());
+  const auto near = [](double a, double b) {
+    return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b));
+  };
+  for (std::size_t row = 0; row < out.rows.size(); ++row)
+    for (const std::string& j : joints) {
+      const int s = model.segmentOfJoint(j);
+      const std::string leader = model.coordinate_names[model.coordinate[s]];
+      const double k = model.multiplier[s], qd = k * input.number(row, leader + ".qd");
+      EXPECT_TRUE(
+          near(out.number(row, j + ".q"), k * input.number(row, leader + ".q") + model.offset[s]))
+          << j << " " << row;
+      EXPECT_TRUE(near(out.number(row, j + ".qd"), qd)) << j << " " << row;
+      EXPECT_TRUE(near(out.number(row, j + ".qdd"), k * input.number(row, leader + ".qdd")))
+          << j << " " << row;
+      const double friction = model.damping[s] * qd + model.friction[s] * std::tanh(qd / 0.05);
+      EXPECT_TRUE(
+          near(out.number(row, j + ".motor_effort"), out.number(row, j + ".effort") + friction))
+          << j << " " << row;
+    }
+  EXPECT_EQ(model.damping[model.segmentOfJoint("panda_joint1")], 0.003);
+  // Only with the csv format; --velocity-scale only with --friction.
+  EXPECT_EQ(jointLoads({"--urdf", kPanda, "--input", in, "--kinematics", "--format", "sto"}).status,
+            2);
+  EXPECT_EQ(jointLoads({"--urdf", kPanda, "--input", in, "--velocity-scale", "0.1"}).status, 2);
+}
+
 TEST_F(CliTest, OutputReplacesTheFileALinkNamesAndWritesIntoAFifo) {
   const std::string in = trajectory("states.csv", kPandaChain, {"--duration", "0.003"});
   const Result reference = jointLoads({"--urdf", kPandaChain, "--input", in});

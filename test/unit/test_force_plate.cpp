@@ -129,9 +129,12 @@ TEST(ForcePlate, PlateWithItsZAxisDownGivesTheSamePhysicalCop) {
   expectVector(moment, Vector3d(350.0, -210.0, 0.0), 1e-10);  // 350 N m: a few ulps of it
 }
 
-// Contact starts at the threshold (20 N by default) of force pressing into the plate;
-// below it, or with the foot pulling on the plate, the reading is no contact and every
-// decoded quantity and the reaction are zero.
+// Contact starts at the threshold (20 N by default) of force pressing into the plate.
+// Below it the reading has no COP but still acts as measured: 19.9 N pressing with the
+// moment (-1, 0.5, 0) about the plate origin (the world's) gives the foot (-1, 0, 19.9)
+// and, about (1, 2, 3), (1, -0.5, 0) + (-1, -2, -3) x (-1, 0, 19.9) = (1, -0.5, 0) +
+// (-39.8, 22.9, -2) = (-38.8, 22.4, -2). With the foot pulling on the plate (or not
+// touching it) every decoded quantity and the reaction are zero.
 TEST(ForcePlate, ContactThreshold) {
   jle::ForcePlateConfig plate;
   ASSERT_EQ(plate.contact_threshold, 20.0);
@@ -139,13 +142,18 @@ TEST(ForcePlate, ContactThreshold) {
   EXPECT_TRUE(jle::readForcePlate(plate, Vector3d(0.0, 0.0, -20.0), moment).contact);
   for (const double fz : {-19.9, 0.0, 300.0}) {
     const jle::PlateReading r = jle::readForcePlate(plate, Vector3d(1.0, 0.0, fz), moment);
+    const bool pressing = fz < 0.0;
     EXPECT_FALSE(r.contact) << fz;
+    EXPECT_EQ(r.loaded, pressing) << fz;
     EXPECT_EQ(r.cop_plate, Vector3d::Zero()) << fz;
-    EXPECT_EQ(r.force_on_foot_plate, Vector3d::Zero()) << fz;
+    EXPECT_EQ(r.force_on_foot_plate, pressing ? Vector3d(-1.0, 0.0, 19.9) : Vector3d::Zero()) << fz;
     Vector3d force(9, 9, 9), reaction_moment(9, 9, 9);
     jle::plateReactionInWorld(plate, r, Vector3d(1, 2, 3), force, reaction_moment);
-    EXPECT_EQ(force, Vector3d::Zero()) << fz;
-    EXPECT_EQ(reaction_moment, Vector3d::Zero()) << fz;
+    EXPECT_EQ(force, pressing ? Vector3d(-1.0, 0.0, 19.9) : Vector3d::Zero()) << fz;
+    if (pressing)
+      expectVector(reaction_moment, Vector3d(-38.8, 22.4, -2.0), 1e-14);  // 3 m x 20 N: 1e-14
+    else
+      EXPECT_EQ(reaction_moment, Vector3d::Zero()) << fz;
   }
   // A zero threshold still needs a force pressing in.
   plate.contact_threshold = 0.0;
@@ -209,7 +217,7 @@ void expectFootHeldByThePlate(double tol) {
   expectVector(w.moment.template cast<double>(), Vector3d(0.0, 0.1 * m * g, 0.0), tol * m * g);
   EXPECT_NEAR(static_cast<double>(data.effort[s]), 0.1 * m * g, tol * m * g);
 
-  // Without contact nothing is applied: the ankle carries the whole weight.
+  // A reading that is not loaded: nothing is applied, the ankle carries the whole weight.
   jle::forwardKinematics(model, data, zero, zero, zero,
                          Eigen::Matrix<Scalar, 3, 1>(0, 0, static_cast<Scalar>(-g)));
   jle::applyPlateReaction(model, data, model.frameIndex("foot"), plate, jle::PlateReading());

@@ -72,8 +72,9 @@ TEST_F(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   // shank and foot, 0.5 N; the heel rocker (15 deg in 0.11 s, J = 1.2e4 rad/s^3) 1.3
   // rad/s^2 on the 1.1 kg foot 0.1 m from the ankle, 0.15 N; the legs' angles follow
   // the feet through the inverse kinematics with errors of the same kind: 2 N in all.
-  // Plus a plate pressed by less than the threshold (1 N) at the ends of each contact:
-  // 3 N; the moment about the pelvis, the same forces at the feet, about 1 m away: 3 N m.
+  // (A plate pressed by less than the threshold, 1 N, at the ends of each contact acts
+  // as measured: nothing more.) 3 N; the moment about the pelvis, the same forces at the
+  // feet, about 1 m away: 3 N m.
   // (Without the plates the residual would be the body weight, 735 N.)
   EXPECT_LT(max_force, 3.0);
   EXPECT_LT(max_moment, 3.0);

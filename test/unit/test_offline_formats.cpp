@@ -271,11 +271,17 @@ TEST_F(OfflineFormatsTest, StandingOnTwoPlatesLeavesNoResidualAndLoadsTheAnkles)
   ASSERT_EQ(r.status, 0) << r.err;
   const Table t = parseCsv(r.out);
   ASSERT_EQ(t.rows.size(), 2u);
-  // The plates explain the whole weight and its moment: 1e-11 covers rounding of terms
-  // of order W = 216 N.
-  for (std::size_t row = 0; row < 2; ++row)
-    for (const char* c : {"base.fx", "base.fy", "base.fz", "base.mx", "base.my", "base.mz"})
-      EXPECT_NEAR(t.number(row, c), 0.0, 1e-11) << row << " " << c;
+  // Row 0: the plates explain the whole weight and its moment: 1e-11 covers rounding of
+  // terms of order W = 216 N. Row 1: the right plate's 5 N (below the threshold: no COP,
+  // but it acts as measured, at its origin (0, -0.1, 0), 0.9 m below the pelvis and 0.1 m
+  // to its right) is more than the weight: the world must pull down by 5 N, and about x
+  // cancel (0, -0.1, -0.9) x (0, 0, 5) = (-0.5, 0, 0).
+  const double row1[6] = {0.0, 0.0, -5.0, 0.5, 0.0, 0.0};
+  int i = 0;
+  for (const char* c : {"base.fx", "base.fy", "base.fz", "base.mx", "base.my", "base.mz"}) {
+    EXPECT_NEAR(t.number(0, c), 0.0, 1e-11) << c;
+    EXPECT_NEAR(t.number(1, c), row1[i++], 1e-11) << c;
+  }
   // Row 0, the left foot (1 kg, centre of mass (0.05, 0, -0.05) from the ankle) in
   // equilibrium under the ankle wrench, its weight and the reaction W/2 up at the COP,
   // (x_c, 0, -0.1) from the ankle. About y: M + (-x_c W/2) + 0.05 g = 0 (r x F, y
@@ -297,17 +303,18 @@ TEST_F(OfflineFormatsTest, StandingOnTwoPlatesLeavesNoResidualAndLoadsTheAnkles)
   EXPECT_NEAR(t.number(0, "plate@right.cop_x"), kXc, 1e-14);
   EXPECT_NEAR(t.number(0, "plate@right.cop_y"), -0.1, 1e-14);
   EXPECT_NEAR(t.number(0, "plate@right.cop_z"), 0.0, 1e-14);
-  // Row 1: the right foot in the air (5 N is below the 20 N threshold): no contact, its
-  // COP written as zeros, its ankle holds only the foot (M_y = -0.05 g: the foot's weight
-  // 5 cm forward pulls its toe down, about -y).
+  // Row 1: the right foot barely touching (5 N is below the 20 N threshold): no contact,
+  // its COP written as zeros; its ankle holds the foot (M_y = -0.05 g: the foot's weight
+  // 5 cm forward pulls its toe down, about -y) less the 5 N pushing up below the ankle
+  // (no moment about it): F_z = g - 5.
   EXPECT_EQ(t.number(1, "plate@right.contact"), 0.0);
   for (const char* c : {"plate@right.cop_x", "plate@right.cop_y", "plate@right.cop_z"})
     EXPECT_EQ(t.number(1, c), 0.0) << c;
   EXPECT_NEAR(t.number(1, "ankle_r.my"), -0.05 * kG, 1e-12);
-  EXPECT_NEAR(t.number(1, "ankle_r.fz"), kG, 1e-12);
+  EXPECT_NEAR(t.number(1, "ankle_r.fz"), kG - 5.0, 1e-12);
   EXPECT_NEAR(t.number(1, "plate@left.cop_y"), 0.0, 1e-14);
-  // With --contact-threshold 1 the 5 N count, and the residual shows them: the world
-  // must pull down by 5 N.
+  // With --contact-threshold 1 the 5 N are in contact (a COP), with the same loads: the
+  // world must pull down by 5 N.
   const Result r2 = jointLoads(standArgs(path("in.csv"), {"--contact-threshold", "1"}));
   ASSERT_EQ(r2.status, 0) << r2.err;
   const Table t2 = parseCsv(r2.out);

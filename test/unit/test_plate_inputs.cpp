@@ -1,5 +1,5 @@
 // The force plates' unit (plate_inputs.hpp): a static plate under a known foot, the
-// contact threshold on the raw samples, the contact at the estimate's stamp, the stale
+// contact threshold at the estimate's stamp (filtered above it, raw below it), the stale
 // policies and the refused configurations, against numbers worked by hand.
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/estimator.hpp>  // PlateInputConfig
@@ -98,18 +98,25 @@ TEST(PlateInputs, StaticPlateUnderAKnownFoot) {
   EXPECT_NEAR((rig.data.n_ext[foot] - kReactionMoment).norm(), 0.0, kTol);
 }
 
-// 15 N pressing is below the 20 N threshold: the samples enter the filter as zero, and
-// nothing is applied.
-TEST(PlateInputs, BelowTheThresholdIsZero) {
+// 15 N pressing is below the 20 N threshold: the samples enter the filter as measured,
+// and the raw wrench at the stamp acts without a COP: on the foot (-1, 0, 15) N and, about
+// A, (-0.3, 0.2, 0) + (O - A) x (-1, 0, 15) with O - A = (0, -0.1, -0.1):
+// (-0.3, 0.2, 0) + (-1.5, 0.1, -0.1) = (-1.8, 0.3, -0.1) N m.
+TEST(PlateInputs, BelowTheThresholdActsWithoutACop) {
   Rig rig(threePoint());
   const Vector3d light(1.0, 0.0, -15.0), light_moment(0.3, -0.2, 0.0);
   for (int k = 0; k < 3; ++k) rig.step(1.0 + 1e-3 * k, light, light_moment);
-  for (double c : rig.channels) EXPECT_EQ(c, 0.0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(rig.channels[c], light[c]);
+    EXPECT_EQ(rig.channels[3 + c], light_moment[c]);
+  }
   rig.apply();
   EXPECT_FALSE(rig.plates.reading(0).contact);
+  EXPECT_TRUE(rig.plates.reading(0).loaded);
   const int foot = rig.model.segmentOfJoint("ankle_l");
-  EXPECT_EQ(rig.data.f_ext[foot], Vector3d::Zero());
-  EXPECT_EQ(rig.data.n_ext[foot], Vector3d::Zero());
+  // Products of 0.1 m and 15 N: 1e-14.
+  EXPECT_NEAR((rig.data.f_ext[foot] - Vector3d(-1.0, 0.0, 15.0)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((rig.data.n_ext[foot] - Vector3d(-1.8, 0.3, -0.1)).norm(), 0.0, 1e-14);
 }
 
 // A 9-sample causal fit right after lift-off still holds most of the stance in its
