@@ -21,8 +21,10 @@ namespace jle {
 class BandwidthSelection {
  public:
   /// Time constant of the noise estimate's memory [s] (the first samples are averaged
-  /// equally until there are this many seconds of them).
-  static constexpr double kNoiseMemory = 1.0;
+  /// equally until there are this many seconds of them): a sensor's noise is a property
+  /// of the sensor, and the widest filter's innovations are correlated, which leaves
+  /// fewer independent ones than samples.
+  static constexpr double kNoiseMemory = 5.0;
   /// Log-likelihood [nats] by which a filter narrower than the selected one may fall
   /// behind before it restarts from the selected one's state (after an impact its memory
   /// describes a motion that ended).
@@ -127,8 +129,8 @@ class BandwidthSelection {
       if (!chooses(c)) continue;
       // squares such that logLikelihood(m) = logLikelihood(best) - kBehind
       const double target = logLikelihood(best_, c, r2) - kBehind;
-      squares_(m, c) = std::min(squares_(m, c),
-                                std::max(0.0, r2 * (-2.0 * target - log_variances_[m])));
+      squares_(m, c) =
+          std::min(squares_(m, c), std::max(0.0, r2 * (-2.0 * target - log_variances_[m])));
     }
   }
 
@@ -141,9 +143,7 @@ class BandwidthSelection {
 
   /// Whether channel c takes part in the choice: its noise is known, or estimated from
   /// kNoiseSamples informative samples.
-  bool chooses(int c) const {
-    return fixed_variance_ > 0.0 || noise_samples_[c] >= kNoiseSamples;
-  }
+  bool chooses(int c) const { return fixed_variance_ > 0.0 || noise_samples_[c] >= kNoiseSamples; }
 
  private:
   int models_ = 1;
