@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 namespace {
 
@@ -212,6 +213,46 @@ TEST(AdaptiveDifferentiator, NoiseGainIsTheSelectedFilters) {
   // The same gain up to the rounding of q's two spellings (relative 1e-9).
   EXPECT_LT((a - f).cwiseAbs().maxCoeff(), 1e-9 * f.cwiseAbs().maxCoeff());
   EXPECT_NEAR(adaptive.accel(0), fixed.accel(0), 1e-6);
+}
+
+TEST(AdaptiveDifferentiator, NoiseGainAgainstAMonteCarlo) {
+  // The same cubic, the same jittered stamps (+-40%), 300 draws of white noise (1e-4
+  // rad, given): the covariance of the estimate's errors at the last sample against the
+  // mean over the draws of sigma^2 noiseGain(). A cubic is in every filter's model, so
+  // the error is the noise part alone. noiseGain() is exact for the filter that made the
+  // estimate, but which filter that is, and when the narrow ones restarted, depends on
+  // the noise: the errors of the selection are larger than the selected filter's gain
+  // says. Measured ratios 1.20, 1.50, 1.86 (value, rate, acceleration; a single fixed
+  // filter of the same bandwidth: 1.08, 1.20, 1.21, within the 8% sampling error of 300
+  // draws, 3 sigma). Bounds: the value within 1 +- 0.35, rate and acceleration in
+  // [0.8, 2.5]. A known limitation (docs/differentiators.md): the covariance module
+  // understates the noise of q-dot and q-ddot by up to about 2 with the adaptive filter.
+  constexpr int kDraws = 300;
+  constexpr double kSigma = 1e-4;
+  DifferentiatorConfig c;
+  c.noise = kSigma;
+  jle::PortableRandom stamps(7), noise(11);
+  std::vector<double> t(1500);
+  for (std::size_t k = 1; k < t.size(); ++k) t[k] = t[k - 1] + 1e-3 * stamps.uniform(0.6, 1.4);
+  const auto p = [](double x) { return 0.1 + 0.4 * x + 1.5 * x * x - 0.3 * x * x * x; };
+  const double te = t.back();
+  const Eigen::Vector3d truth(p(te), 0.4 + 3.0 * te - 0.9 * te * te, 3.0 - 1.8 * te);
+  Eigen::Matrix3d empirical = Eigen::Matrix3d::Zero(), predicted = Eigen::Matrix3d::Zero();
+  for (int d = 0; d < kDraws; ++d) {
+    DifferentiatorBank bank(c, 1);
+    for (double tk : t) {
+      const double x = p(tk) + kSigma * noise.gaussian();
+      bank.update(tk, &x);
+    }
+    const Eigen::Vector3d e = Eigen::Vector3d(bank.value(0), bank.rate(0), bank.accel(0)) - truth;
+    empirical += e * e.transpose() / kDraws;
+    predicted += kSigma * kSigma * bank.noiseGain() / kDraws;
+  }
+  EXPECT_NEAR(empirical(0, 0) / predicted(0, 0), 1.0, 0.35);
+  for (int i = 1; i < 3; ++i) {
+    EXPECT_GT(empirical(i, i) / predicted(i, i), 0.8) << "component " << i;
+    EXPECT_LT(empirical(i, i) / predicted(i, i), 2.5) << "component " << i;
+  }
 }
 
 TEST(AdaptiveDifferentiator, InvalidKnobsNameTheKey) {
