@@ -47,6 +47,7 @@ class BandwidthSelection {
         log_variance_(Eigen::VectorXd::Zero(channels)),
         noise_time_(Eigen::VectorXd::Zero(channels)),
         noise_samples_(Eigen::VectorXi::Zero(channels)),
+        last_(Eigen::VectorXd::Constant(channels, std::nan(""))),
         best_per_channel_(Eigen::VectorXi::Zero(channels)) {
     reset();
   }
@@ -59,14 +60,18 @@ class BandwidthSelection {
     best_ = models_ - 1;
   }
 
-  /// The widest filter's innovations (channels) and their variance per unit noise
-  /// variance when the signal is predicted exactly; dt [s] since the last sample. A zero
-  /// innovation (a quantised signal at rest) carries no information on the noise.
-  void observeNoise(const double* innovation, double variance, double dt) {
+  /// The samples x (channels), the widest filter's innovations and their variance per
+  /// unit noise variance when the signal is predicted exactly; dt [s] since the last
+  /// sample. A sample equal to the channel's previous one (a quantised signal at rest, a
+  /// constant channel) carries no information on the noise: its innovation is what is
+  /// left of the filter's transient, not noise.
+  void observeNoise(const double* x, const double* innovation, double variance, double dt) {
     if (fixed_variance_ > 0.0) return;
     for (int c = 0; c < channels_; ++c) {
+      const bool repeated = x[c] == last_[c];
+      last_[c] = x[c];
       const double z2 = innovation[c] * innovation[c] / variance;
-      if (!(z2 > 0.0) || !std::isfinite(z2)) continue;
+      if (repeated || !(z2 > 0.0) || !std::isfinite(z2)) continue;
       noise_time_[c] += dt;
       ++noise_samples_[c];
       const double w = std::min(1.0, dt / std::min(noise_time_[c], kNoiseMemory));
@@ -156,6 +161,7 @@ class BandwidthSelection {
   Eigen::VectorXd log_variance_;   // per channel: log of the noise variance estimate
   Eigen::VectorXd noise_time_;     // per channel: seconds of informative innovations
   Eigen::VectorXi noise_samples_;  // per channel: their count
+  Eigen::VectorXd last_;           // per channel: the previous sample
   Eigen::VectorXi best_per_channel_;
 };
 

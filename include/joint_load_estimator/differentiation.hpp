@@ -246,7 +246,7 @@ class DifferentiatorBank {
     prev_t_ = t;
     stamp_ = t;
     // The innovations describe the noise once the filters predict from data alone.
-    if (count_ > n_) selectModel(dt);
+    if (count_ > n_) selectModel(dt, x);
     if (count_ <= n_) ++count_;
     out_ = models_[selection_.selected()].out_;
     return count_ >= n_;
@@ -254,9 +254,9 @@ class DifferentiatorBank {
 
   // The noise from the widest filter (the least disturbed by the motion), the likeliest
   // filter, and the narrower ones left far behind restarted from it.
-  void selectModel(double dt) {
+  void selectModel(double dt, const double* x) {
     const DifferentiatorBank& widest = models_.back();
-    selection_.observeNoise(widest.innovation_.data(), widest.noise_innovation_, dt);
+    selection_.observeNoise(x, widest.innovation_.data(), widest.noise_innovation_, dt);
     const int count = static_cast<int>(models_.size());
     for (int m = 0; m < count; ++m)
       selection_.score(m, models_[m].innovation_.data(), models_[m].innovation_variance_, dt);
