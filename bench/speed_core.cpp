@@ -172,13 +172,9 @@ void kdlChain(benchmark::State& state, const std::string& file, const std::strin
   }
 }
 
-void differentiation(benchmark::State& state, jle::DifferentiatorType type, int window) {
-  jle::DifferentiatorConfig c;
-  c.type = type;
-  c.window = window;
-  c.kalman_model = jle::KalmanModel::kConstantAcceleration;  // for kKalman
-  c.process_noise = 1e3;
-  const int channels = 7 + 12;  // a 7-joint arm with two wrench inputs
+// A bank of `c` over a 7-joint arm with two wrench inputs, sampled every 1 ms.
+void runBank(benchmark::State& state, const jle::DifferentiatorConfig& c) {
+  const int channels = 7 + 12;
   jle::DifferentiatorBank bank(c, channels);
   std::vector<double> x(channels, 0.0);
   double t = 0.0;
@@ -187,6 +183,23 @@ void differentiation(benchmark::State& state, jle::DifferentiatorType type, int 
     for (int i = 0; i < channels; ++i) x[i] = std::sin(t + i);
     benchmark::DoNotOptimize(bank.update(t, x.data()));
   }
+}
+
+void differentiation(benchmark::State& state, jle::DifferentiatorType type, int window) {
+  jle::DifferentiatorConfig c;
+  c.type = type;
+  c.window = window;
+  c.kalman_model = jle::KalmanModel::kConstantAcceleration;  // for kKalman
+  c.process_noise = 1e3;
+  runBank(state, c);
+}
+
+// The filters as configured by default: the adaptive bank (the node's), against the old
+// default, the constant-jerk Kalman filter (q = 1e4, r = 1e-4), on the same channels.
+void differentiationDefault(benchmark::State& state, jle::DifferentiatorType type) {
+  jle::DifferentiatorConfig c;
+  c.type = type;
+  runBank(state, c);
 }
 
 // Scaling: random serial chains and random trees of n moving joints (seeded), all 6-D
@@ -377,5 +390,7 @@ BENCHMARK_CAPTURE(differentiation, finite_difference, jle::DifferentiatorType::k
                   3);
 BENCHMARK_CAPTURE(differentiation, savitzky_golay_9, jle::DifferentiatorType::kSavitzkyGolay, 9);
 BENCHMARK_CAPTURE(differentiation, kalman, jle::DifferentiatorType::kKalman, 1);
+BENCHMARK_CAPTURE(differentiationDefault, kalman_cj, jle::DifferentiatorType::kKalman);
+BENCHMARK_CAPTURE(differentiationDefault, adaptive, jle::DifferentiatorType::kAdaptive);
 
 BENCHMARK_MAIN();

@@ -5,6 +5,8 @@
 // of one set of coefficients.
 #pragma once
 
+#include <joint_load_estimator/bandwidth_selection.hpp>
+
 #include <Eigen/Core>
 #include <Eigen/Householder>
 
@@ -19,6 +21,10 @@ enum class DifferentiatorType : std::uint8_t {
   kFiniteDifference,  ///< exact through order+1 points (3-point, 2nd order by default)
   kSavitzkyGolay,     ///< least-squares polynomial of `order` over `window` samples
   kKalman,            ///< white-noise acceleration or jerk model
+  /// Kalman filters of `kalman_model` on a grid of bandwidths, the one whose innovations
+  /// are the likeliest over the recent samples selected, the noise estimated online
+  /// (bandwidth_selection.hpp).
+  kAdaptive,
 };
 
 enum class KalmanModel : std::uint8_t {
@@ -26,11 +32,11 @@ enum class KalmanModel : std::uint8_t {
   kConstantJerk,          ///< state (x, x', x'', x'''), white noise on x''''
 };
 
-/// The default is what the node runs (config/default.yaml): on the accuracy study's
-/// error-delay Pareto front, closest to the best in every scene (docs/accuracy.md), a
-/// constant-jerk Kalman filter, process noise 1e4, measurement noise 1e-4 rad.
+/// The default is what the node runs (config/default.yaml): the adaptive filter
+/// (constant-jerk Kalman filters from 0.5 to 50 Hz, the noise estimated online), tuned by
+/// the data rather than by hand (README "Differentiators").
 struct DifferentiatorConfig {
-  DifferentiatorType type = DifferentiatorType::kKalman;
+  DifferentiatorType type = DifferentiatorType::kAdaptive;
   /// Savitzky-Golay: samples in the fit and degree of the polynomial (2..5). The
   /// estimate describes the sample `delay` steps before the newest: 0 is causal,
   /// (window - 1) / 2 is centred. Finite differences use window = order + 1.
@@ -42,6 +48,14 @@ struct DifferentiatorConfig {
   KalmanModel kalman_model = KalmanModel::kConstantJerk;
   double process_noise = 1e4;
   double measurement_noise = 1e-4;
+  /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
+  /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
+  /// noise [unit] if known (0: estimated online from the innovations), and the time
+  /// constant [s] of the likelihood that selects the bandwidth.
+  double min_bandwidth = 0.5;
+  double max_bandwidth = 50.0;
+  double noise = 0.0;
+  double memory = 1.0;
   /// A gap between samples longer than this [s] restarts the filter (its memory no
   /// longer describes the signal).
   double max_gap = 0.5;
@@ -54,7 +68,15 @@ inline void validate(const DifferentiatorConfig& c) {
   const auto fail = [](const char* key, const std::string& what) {
     throw std::invalid_argument(std::string("parameter 'differentiator/") + key + "' " + what);
   };
-  if (c.type == DifferentiatorType::kKalman) {
+  if (c.type == DifferentiatorType::kAdaptive) {
+    if (!(c.min_bandwidth > 0.0) || !std::isfinite(c.min_bandwidth))
+      fail("min_bandwidth", "must be finite and > 0 [Hz]");
+    if (!(c.max_bandwidth >= c.min_bandwidth) || !std::isfinite(c.max_bandwidth))
+      fail("max_bandwidth", "must be finite and >= min_bandwidth [Hz]");
+    if (!(c.noise >= 0.0) || !std::isfinite(c.noise))
+      fail("noise", "must be finite and >= 0 (0: estimated online)");
+    if (!(c.memory > 0.0) || !std::isfinite(c.memory)) fail("memory", "must be finite and > 0 [s]");
+  } else if (c.type == DifferentiatorType::kKalman) {
     if (!(c.process_noise > 0.0) || !std::isfinite(c.process_noise))
       fail("process_noise", "must be finite and > 0");
     if (!(c.measurement_noise > 0.0) || !std::isfinite(c.measurement_noise))
@@ -82,6 +104,8 @@ inline void validate(const DifferentiatorConfig& c) {
 class DifferentiatorBank {
  public:
   static constexpr int kMaxOrder = 5;
+  /// Adaptive: ratio of neighbouring bandwidths of its filters.
+  static constexpr double kBandwidthRatio = 2.0;
   using SmallMatrix =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, kMaxOrder + 1>;
 
@@ -91,12 +115,15 @@ class DifferentiatorBank {
     if (config_.type == DifferentiatorType::kFiniteDifference) {
       config_.window = config_.order + 1;
     }
-    if (config_.type == DifferentiatorType::kKalman) {
+    if (config_.type == DifferentiatorType::kKalman ||
+        config_.type == DifferentiatorType::kAdaptive) {
       n_ = config_.kalman_model == KalmanModel::kConstantAcceleration ? 3 : 4;
       config_.window = 1;
       config_.delay = 0;
       state_.setZero(n_, channels_);
       P_.setZero(n_, n_);
+      innovation_.setZero(channels_);
+      if (config_.type == DifferentiatorType::kAdaptive) buildModels();
     } else {
       n_ = config_.order + 1;
       coeff_.setZero(3, config_.window);
@@ -110,13 +137,25 @@ class DifferentiatorBank {
   const DifferentiatorConfig& config() const { return config_; }
   int channels() const { return channels_; }
   /// Samples needed after a reset before the first estimate.
-  int warmup() const { return config_.type == DifferentiatorType::kKalman ? n_ : config_.window; }
+  int warmup() const { return isKalman() ? n_ : config_.window; }
 
   void reset() {
     count_ = 0;
     head_ = 0;
-    if (config_.type != DifferentiatorType::kKalman) tau_prev_.setConstant(std::nan(""));
+    if (!isKalman()) tau_prev_.setConstant(std::nan(""));
     dt_prev_ = -1.0;  // a restarted filter is a fresh one, to the bit: no cached F, Q
+    for (DifferentiatorBank& m : models_) m.reset();
+    selection_.reset();
+  }
+
+  /// Adaptive: the bandwidth [Hz] of the filter in use, and the position noise's
+  /// standard deviation [unit] of channel c it assumes (estimated or given; 0 before the
+  /// first estimate).
+  double bandwidth() const {
+    return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
+  }
+  double noise(int c) const {
+    return models_.empty() ? 0.0 : std::sqrt(selection_.noiseVariance(c));
   }
 
   /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.
@@ -129,6 +168,7 @@ class DifferentiatorBank {
     }
     last_time_ = t;
     if (config_.type == DifferentiatorType::kKalman) return updateKalman(t, x);
+    if (config_.type == DifferentiatorType::kAdaptive) return updateAdaptive(t, x);
     // Ring buffer of the last `window` samples.
     times_[head_] = t;
     for (int c = 0; c < channels_; ++c) values_(head_, c) = x[c];
@@ -150,8 +190,12 @@ class DifferentiatorBank {
   /// noise part of the estimation error, S_k = A_k S_(k-1) A_k^T + K_k K_k^T with
   /// A_k = (I - K_k H) F_k from S = diag(1, 0, ..) at the first sample: exact through the
   /// start-up, and at a steady rate the fixed point of the discrete Lyapunov equation,
-  /// after which it is kept (cached) while dt and the gain stay.
+  /// after which it is kept (cached) while dt and the gain stay. Adaptive: the selected
+  /// filter's (pooled over the channels: the selection is common to the bank), which is
+  /// exact for the filter that made the estimate, restarts from another one included.
   Eigen::Matrix3d noiseGain() const {
+    if (config_.type == DifferentiatorType::kAdaptive)
+      return models_[selection_.selected()].noiseGain();
     if (config_.type == DifferentiatorType::kKalman) return S_.topLeftCorner(3, 3);
     Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
     for (int k = 0; k < config_.window; ++k) {
@@ -162,6 +206,76 @@ class DifferentiatorBank {
   }
 
  private:
+  bool isKalman() const {
+    return config_.type == DifferentiatorType::kKalman ||
+           config_.type == DifferentiatorType::kAdaptive;
+  }
+
+  // Adaptive: one Kalman filter per bandwidth from min_bandwidth to max_bandwidth (the
+  // ratio kBandwidthRatio, the last one at max_bandwidth), in unit measurement noise
+  // (the gain depends on process / measurement noise only); their process noise is set
+  // from the first interval (tuneModels).
+  void buildModels() {
+    const double span = std::log(config_.max_bandwidth / config_.min_bandwidth);
+    const int count = 1 + static_cast<int>(std::ceil(span / std::log(kBandwidthRatio) - 1e-9));
+    DifferentiatorConfig k = config_;
+    k.type = DifferentiatorType::kKalman;
+    k.measurement_noise = 1.0;
+    k.process_noise = 1.0;
+    for (int m = 0; m < count; ++m) {
+      bandwidths_.push_back(
+          std::min(config_.max_bandwidth, config_.min_bandwidth * std::pow(kBandwidthRatio, m)));
+      models_.emplace_back(k, channels_);
+    }
+    selection_ = BandwidthSelection(count, channels_, config_.noise, config_.memory);
+  }
+
+  // The process noise of every filter for samples h [s] apart: the density q at which
+  // the signal's spectrum q / w^(2n) meets the noise's, h (unit noise), at 2 pi f.
+  void tuneModels(double h) {
+    for (std::size_t m = 0; m < models_.size(); ++m) {
+      models_[m].config_.process_noise = h * std::pow(2.0 * M_PI * bandwidths_[m], 2 * n_);
+      models_[m].dt_prev_ = -1.0;
+    }
+  }
+
+  bool updateAdaptive(double t, const double* x) {
+    const double dt = t - prev_t_;
+    if (count_ == 1) tuneModels(dt);
+    for (DifferentiatorBank& m : models_) m.update(t, x);
+    prev_t_ = t;
+    stamp_ = t;
+    // The innovations describe the noise once the filters predict from data alone.
+    if (count_ > n_) selectModel(dt, x);
+    if (count_ <= n_) ++count_;
+    out_ = models_[selection_.selected()].out_;
+    return count_ >= n_;
+  }
+
+  // The noise from the widest filter (the least disturbed by the motion), the likeliest
+  // filter, and the narrower ones left far behind restarted from it.
+  void selectModel(double dt, const double* x) {
+    const DifferentiatorBank& widest = models_.back();
+    selection_.observeNoise(x, widest.innovation_.data(), widest.noise_innovation_, dt);
+    const int count = static_cast<int>(models_.size());
+    for (int m = 0; m < count; ++m)
+      selection_.score(m, models_[m].innovation_.data(), models_[m].innovation_variance_, dt);
+    const int best = selection_.select();
+    for (int m = 0; m < best; ++m) {
+      if (!selection_.behind(m)) continue;
+      models_[m].adopt(models_[best]);
+      selection_.restarted(m);
+    }
+  }
+
+  // The state and noise gain of another filter of the same model and channels.
+  void adopt(const DifferentiatorBank& other) {
+    state_ = other.state_;
+    S_ = other.S_;
+    noise_settled_ = false;
+    out_ = other.out_;
+  }
+
   // Index in the ring of the sample k steps before the newest.
   int ring(int k) const { return (head_ - 1 - k + 2 * config_.window) % config_.window; }
 
@@ -338,7 +452,9 @@ class DifferentiatorBank {
     const SmallMatrix& F = F_;
     const SmallMatrix& Q = Q_;
     P_ = F * P_ * F.transpose() + Q;
-    const double S = P_(0, 0) + config_.measurement_noise * config_.measurement_noise;
+    const double r2 = config_.measurement_noise * config_.measurement_noise;
+    const double S = P_(0, 0) + r2;
+    innovation_variance_ = S / r2;
     const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
     P_ -= K * P_.row(0);
     P_ = 0.5 * (P_ + P_.transpose()).eval();
@@ -350,6 +466,7 @@ class DifferentiatorBank {
   // The noise gain S_ = A S_ A^T + K K^T with A = (I - K H) F (noiseGain()).
   void updateNoiseGain(bool steady) {
     const SmallMatrix& F = F_;
+    noise_innovation_ = (F.row(0) * S_ * F.row(0).transpose()).value() + 1.0;
     SmallMatrix A = -K_ * F.row(0);
     A += F;  // (I - K H) F with H = (1, 0, ..)
     SmallMatrix S = A * S_ * A.transpose();
@@ -366,7 +483,9 @@ class DifferentiatorBank {
     for (int c = 0; c < channels_; ++c) {
       Eigen::Map<Eigen::Matrix<double, N, 1>> state(state_.col(c).data());
       Eigen::Matrix<double, N, 1> s = F * state;
-      s += K * (x[c] - s[0]);
+      const double innovation = x[c] - s[0];
+      innovation_[c] = innovation;
+      s += K * innovation;
       state = s;
     }
   }
@@ -399,6 +518,16 @@ class DifferentiatorBank {
   Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 101, 3> coeff_t_;  // w x 3
   Eigen::MatrixXd state_;                                        // Kalman: n x channels
   SmallMatrix P_;
+  // Kalman: the last measurements minus their predictions (channels), their predicted
+  // variance, and that of their noise part alone, per unit measurement variance.
+  Eigen::VectorXd innovation_;
+  double innovation_variance_ = 1.0;
+  double noise_innovation_ = 1.0;
+  // Adaptive: the filters from the narrowest to the widest, their bandwidths [Hz], and
+  // the choice among them.
+  std::vector<DifferentiatorBank> models_;
+  std::vector<double> bandwidths_;
+  BandwidthSelection selection_;
 };
 
 }  // namespace jle

@@ -163,7 +163,8 @@ void readDifferentiator(Section& s, DifferentiatorConfig& c) {
   s.read("type", c.type,
          {{"finite_difference", DifferentiatorType::kFiniteDifference},
           {"savitzky_golay", DifferentiatorType::kSavitzkyGolay},
-          {"kalman", DifferentiatorType::kKalman}});
+          {"kalman", DifferentiatorType::kKalman},
+          {"adaptive", DifferentiatorType::kAdaptive}});
   s.read("window", c.window);
   s.read("order", c.order);
   if (s.has("delay")) {
@@ -183,6 +184,10 @@ void readDifferentiator(Section& s, DifferentiatorConfig& c) {
   s.read("process_noise", c.process_noise);
   s.read("measurement_noise", c.measurement_noise);
   s.read("max_gap", c.max_gap);
+  s.read("min_bandwidth", c.min_bandwidth);
+  s.read("max_bandwidth", c.max_bandwidth);
+  s.read("noise", c.noise);
+  s.read("memory", c.memory);
 }
 
 void readSavings(Section& s, Savings& v) {

@@ -67,16 +67,22 @@ void expectAll(const std::vector<Change>& changes, bool ok) {
 }
 
 TEST(Config, DefaultsAreTheNodes) {
-  // The differentiator the node runs (docs/accuracy.md): constant-jerk Kalman, q = 1e4,
-  // r = 1e-4 rad; an Estimator built from EstimatorConfig{} runs the same.
+  // The differentiator the node runs (README "Differentiators"): adaptive constant-jerk
+  // Kalman filters from 0.5 to 50 Hz, the noise estimated, a 1 s likelihood; the fixed
+  // Kalman filter's keys keep q = 1e4, r = 1e-4 rad. An Estimator built from
+  // EstimatorConfig{} runs the same.
   const jle::DifferentiatorConfig d;
-  EXPECT_EQ(d.type, jle::DifferentiatorType::kKalman);
+  EXPECT_EQ(d.type, jle::DifferentiatorType::kAdaptive);
   EXPECT_EQ(d.kalman_model, jle::KalmanModel::kConstantJerk);
   EXPECT_EQ(d.process_noise, 1e4);
   EXPECT_EQ(d.measurement_noise, 1e-4);
   EXPECT_EQ(d.max_gap, 0.5);
+  EXPECT_EQ(d.min_bandwidth, 0.5);
+  EXPECT_EQ(d.max_bandwidth, 50.0);
+  EXPECT_EQ(d.noise, 0.0);
+  EXPECT_EQ(d.memory, 1.0);
   const Settings s;
-  EXPECT_EQ(s.estimator.differentiator.type, jle::DifferentiatorType::kKalman);
+  EXPECT_EQ(s.estimator.differentiator.type, jle::DifferentiatorType::kAdaptive);
   EXPECT_EQ(s.estimator.decimation, 1);
   EXPECT_EQ(s.estimator.gravity_world, Eigen::Vector3d(0.0, 0.0, -9.80665));
   EXPECT_EQ(s.diagnostic_period, 1.0);
@@ -102,7 +108,7 @@ TEST(Config, DefaultsAreTheNodes) {
   const jle::Model<double> ur5 =
       jle::modelFromUrdfFile(std::string(JLE_TEST_DATA) + "/urdf/chains/ur5_chain.urdf");
   const jle::Estimator estimator(ur5, jle::EstimatorConfig{});
-  EXPECT_EQ(estimator.config().differentiator.type, jle::DifferentiatorType::kKalman);
+  EXPECT_EQ(estimator.config().differentiator.type, jle::DifferentiatorType::kAdaptive);
   EXPECT_EQ(estimator.config().differentiator.kalman_model, jle::KalmanModel::kConstantJerk);
 }
 
@@ -171,24 +177,32 @@ TEST(Config, Differentiator) {
   auto sg = [](Settings& s) {
     s.estimator.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
   };
-  expectAll({{"differentiator/order",
-              [&](Settings& s) {
-                sg(s);
-                s.estimator.differentiator.order = 5;
-              }},
-             {"differentiator/window",
-              [&](Settings& s) {
-                sg(s);
-                s.estimator.differentiator.window = 101;
-              }},
-             {"differentiator/delay",
-              [&](Settings& s) {
-                sg(s);
-                s.estimator.differentiator.delay = 8;
-              }},
-             // A Kalman filter has no window: its Savitzky-Golay fields are not checked.
-             {"differentiator/order", [](Settings& s) { s.estimator.differentiator.order = 9; }}},
-            true);
+  auto kalman = [](Settings& s) {
+    s.estimator.differentiator.type = jle::DifferentiatorType::kKalman;
+  };
+  expectAll(
+      {{"differentiator/order",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.order = 5;
+        }},
+       {"differentiator/window",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.window = 101;
+        }},
+       {"differentiator/delay",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.delay = 8;
+        }},
+       // A Kalman filter has no window: its Savitzky-Golay fields are not checked.
+       {"differentiator/order", [](Settings& s) { s.estimator.differentiator.order = 9; }},
+       // The adaptive filter's own keys: one bandwidth, a known noise.
+       {"differentiator/max_bandwidth",
+        [](Settings& s) { s.estimator.differentiator.max_bandwidth = 0.5; }},
+       {"differentiator/noise", [](Settings& s) { s.estimator.differentiator.noise = 2e-4; }}},
+      true);
   expectAll(
       {{"differentiator/order",
         [&](Settings& s) {
@@ -206,10 +220,22 @@ TEST(Config, Differentiator) {
           s.estimator.differentiator.delay = 9;
         }},
        {"differentiator/process_noise",
-        [](Settings& s) { s.estimator.differentiator.process_noise = 0; }},
+        [&](Settings& s) {
+          kalman(s);
+          s.estimator.differentiator.process_noise = 0;
+        }},
        {"differentiator/measurement_noise",
-        [](Settings& s) { s.estimator.differentiator.measurement_noise = kInf; }},
-       {"differentiator/max_gap", [](Settings& s) { s.estimator.differentiator.max_gap = -1.0; }}},
+        [&](Settings& s) {
+          kalman(s);
+          s.estimator.differentiator.measurement_noise = kInf;
+        }},
+       {"differentiator/max_gap", [](Settings& s) { s.estimator.differentiator.max_gap = -1.0; }},
+       {"differentiator/min_bandwidth",
+        [](Settings& s) { s.estimator.differentiator.min_bandwidth = 0.0; }},
+       {"differentiator/max_bandwidth",
+        [](Settings& s) { s.estimator.differentiator.max_bandwidth = 0.1; }},
+       {"differentiator/noise", [](Settings& s) { s.estimator.differentiator.noise = -1e-4; }},
+       {"differentiator/memory", [](Settings& s) { s.estimator.differentiator.memory = kNaN; }}},
       false);
 }
 

@@ -51,14 +51,16 @@ TEST(NoAllocation, CorePassesOnTalos) {
   EXPECT_EQ(g_allocations - before, 0);
 }
 
-// Finite differences, Savitzky-Golay, the constant-acceleration Kalman filter and the
-// default (the node's constant-jerk Kalman filter).
+// Finite differences, Savitzky-Golay, the constant-acceleration and the constant-jerk
+// Kalman filters and the default (the node's adaptive filter).
 std::vector<jle::DifferentiatorConfig> eachDifferentiator() {
-  std::vector<jle::DifferentiatorConfig> filters(4);
+  std::vector<jle::DifferentiatorConfig> filters(5);
   filters[0].type = jle::DifferentiatorType::kFiniteDifference;
   filters[1].type = jle::DifferentiatorType::kSavitzkyGolay;
+  filters[2].type = jle::DifferentiatorType::kKalman;
   filters[2].kalman_model = jle::KalmanModel::kConstantAcceleration;
   filters[2].process_noise = 1e3;
+  filters[3].type = jle::DifferentiatorType::kKalman;
   return filters;
 }
 

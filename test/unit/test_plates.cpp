@@ -226,7 +226,7 @@ TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootSavitzkyGolayCentred) {
 }
 
 TEST(EstimatorPlates, NoStanceSmearedOnTheSwingFootKalman) {
-  jle::DifferentiatorConfig d;  // the node's default
+  jle::DifferentiatorConfig d;  // the node's default before the adaptive filter
   d.type = jle::DifferentiatorType::kKalman;
   d.kalman_model = jle::KalmanModel::kConstantJerk;
   d.process_noise = 1e4;

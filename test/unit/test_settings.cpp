@@ -65,6 +65,10 @@ void expectSame(const jle::DifferentiatorConfig& a, const jle::DifferentiatorCon
   EXPECT_SAME(process_noise);
   EXPECT_SAME(measurement_noise);
   EXPECT_SAME(max_gap);
+  EXPECT_SAME(min_bandwidth);
+  EXPECT_SAME(max_bandwidth);
+  EXPECT_SAME(noise);
+  EXPECT_SAME(memory);
 }
 
 void expectSame(const jle::Savings& a, const jle::Savings& b, const std::string& where) {
@@ -233,6 +237,10 @@ TEST(SettingsReader, DifferentiatorKeys) {
   d.process_noise = 1e3;
   d.measurement_noise = 1e-3;
   d.max_gap = 0.25;
+  d.min_bandwidth = 2.0;
+  d.max_bandwidth = 20.0;
+  d.noise = 5e-4;
+  d.memory = 0.5;
   expectSame(parseFile(kConfig + "/ok_differentiator.yaml"), e);
 }
 
