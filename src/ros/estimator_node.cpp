@@ -237,6 +237,7 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("loads published", published);
   status.add("dropped: invalid", c.count(Outcome::kInvalid) + exceptions_);
   status.add("dropped: stamp order", c.count(Outcome::kOrder));
+  status.add("dropped: rogue stamp", c.count(Outcome::kRogueStamp));
   status.add("dropped: unresolved frame", c.count(Outcome::kFrame) + c.count(Outcome::kNoBasePose));
   status.add("dropped: no base pose", c.count(Outcome::kNoBasePose));
   status.add("not published: waiting for a joint", c.count(Outcome::kWaiting));

@@ -204,6 +204,19 @@ void readSavings(Section& s, Savings& v) {
   }
 }
 
+void readStamps(Section& s, StampSettings& v) {
+  // rosparam reads a bare off as false (YAML 1.1), as for savings/planar.
+  if (s.has("regularize") && s.get("regularize").getType() == XmlRpcValue::TypeBoolean) {
+    bool on = false;
+    s.read("regularize", on);
+    v.regularize = on ? StampRegularize::kAuto : StampRegularize::kOff;
+  } else {
+    s.read("regularize", v.regularize,
+           {{"auto", StampRegularize::kAuto}, {"off", StampRegularize::kOff}});
+  }
+  s.read("jump_confirm", v.jump_confirm);
+}
+
 void readUncertainty(Section& s, UncertaintyConfig& u) {
   s.read<bool>({{"enabled", &u.enabled},
                 {"diagonal_only", &u.diagonal_only},
@@ -313,6 +326,7 @@ Settings parseSettings(const XmlRpcValue& params) {
   Section s(params, "");
   readTopLevel(s, n);
   s.readMap("savings", [&](Section& m) { readSavings(m, n.estimator.savings); });
+  s.readMap("stamps", [&](Section& m) { readStamps(m, n.stamps); });
   s.readMap("uncertainty", [&](Section& m) { readUncertainty(m, n.estimator.uncertainty); });
   s.readMap("differentiator",
             [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });
