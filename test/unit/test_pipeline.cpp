@@ -354,17 +354,17 @@ std::vector<Message> cleanStream(int n, Stamp start, double t0) {
   return out;
 }
 
-struct Run {
+struct StreamRun {
   std::map<Stamp, std::vector<double>> effort;  // by the record's stamp
   jle::PipelineCounters counters;
 };
 
-Run run(const std::vector<Message>& messages) {
+StreamRun feedStream(const std::vector<Message>& messages) {
   const jle::Model<double> model = ur5();
   jle::Settings settings;
   addWrenchInput(settings, "tool0");
   jle::Pipeline pipeline(model, settings, nullptr);
-  Run out;
+  StreamRun out;
   std::vector<double> p(6);
   for (const Message& msg : messages) {
     if (msg.wrench) {
@@ -383,7 +383,7 @@ Run run(const std::vector<Message>& messages) {
 }
 
 // The loads at every stamp both runs have are the same (1e-12 N m); returns how many.
-long expectSameLoads(const Run& a, const Run& b) {
+long expectSameLoads(const StreamRun& a, const StreamRun& b) {
   long common = 0;
   for (const auto& kv : a.effort) {
     const auto it = b.effort.find(kv.first);
@@ -399,7 +399,7 @@ constexpr Stamp kTwoHours = Stamp{7200} * 1000000000;
 
 TEST(Pipeline, ASingleRogueStampIsDroppedAndCounted) {
   const std::vector<Message> clean = cleanStream(400, kStart, 0.0);
-  const Run reference = run(clean);
+  const StreamRun reference = feedStream(clean);
   ASSERT_GT(reference.effort.size(), 390u);
   struct Case {
     const char* name;
@@ -415,7 +415,7 @@ TEST(Pipeline, ASingleRogueStampIsDroppedAndCounted) {
     const Message& at = clean[2 * 200 + 1];  // the 200th joint state
     hostile.insert(hostile.begin() + 2 * 200 + 2,
                    {c.wrench, at.stamp + c.offset, at.clock + kMs, at.t + 0.001});
-    const Run r = run(hostile);
+    const StreamRun r = feedStream(hostile);
     EXPECT_EQ(expectSameLoads(r, reference), static_cast<long>(reference.effort.size()));
     EXPECT_EQ(r.effort.size(), reference.effort.size());
     const InputKind kind = c.wrench ? InputKind::kWrench : InputKind::kJointState;
@@ -437,10 +437,10 @@ TEST(Pipeline, AConfirmedJumpResetsAsAFreshStartWould) {
   std::vector<Message> after = cleanStream(300, kStart - 9000 * kMs, 1.0);
   for (Message& m : after) m.clock += 10000 * kMs;
   stream.insert(stream.end(), after.begin(), after.end());
-  const Run jumped = run(stream);
+  const StreamRun jumped = feedStream(stream);
   // A fresh start from the confirming joint state (the third of the new timeline): the
   // two before it and the three wrenches until it were rogue stamps.
-  const Run fresh = run(std::vector<Message>(after.begin() + 5, after.end()));
+  const StreamRun fresh = feedStream(std::vector<Message>(after.begin() + 5, after.end()));
   EXPECT_EQ(expectSameLoads(jumped, fresh), static_cast<long>(fresh.effort.size()));
   EXPECT_EQ(jumped.counters.resets, 1);
   EXPECT_EQ(jumped.counters.count(InputKind::kJointState, Outcome::kRogueStamp), 2);
@@ -457,8 +457,8 @@ TEST(Pipeline, ALoopingBagWithItsClockResetsAtOnce) {
   std::vector<Message> stream = cleanStream(500, kStart, 0.0);
   const std::vector<Message> loop = cleanStream(300, kStart, 0.0);
   stream.insert(stream.end(), loop.begin(), loop.end());
-  const Run looped = run(stream);
-  const Run fresh = run(loop);
+  const StreamRun looped = feedStream(stream);
+  const StreamRun fresh = feedStream(loop);
   EXPECT_EQ(expectSameLoads(looped, fresh), static_cast<long>(fresh.effort.size()));
   EXPECT_EQ(looped.counters.resets, 1);
   EXPECT_EQ(looped.counters.count(Outcome::kRogueStamp), 0);
