@@ -28,7 +28,7 @@ class SampleClock {
   bool regular() const { return regular_; }
   /// The stream's mean spacing [ns] over the window (the fit's slope), 0 before the
   /// first fit.
-  double period() const { return slope_; }
+  double period() const { return fitted_ ? slope_ : 0.0; }
   /// The robust scale (1.4826 MAD) [ns] of the stamps about the fitted lattice.
   double jitter() const { return scale_; }
 
@@ -38,7 +38,8 @@ class SampleClock {
     double index = 0.0;  // sample index, counted through gaps
   };
   const Point& point(int i) const;  // i-th oldest in the window
-  double nextIndex(std::int64_t stamp) const;
+  Point& at(int i);
+  double nextIndex(std::int64_t stamp);
   void fit();
   void robustLine(double& intercept, double& slope);
   double median(int n);
@@ -50,6 +51,7 @@ class SampleClock {
   // The fit: stamp = origin_ + intercept_ + slope_ (index - index_origin_) [ns].
   std::int64_t origin_ = 0;
   double index_origin_ = 0.0, intercept_ = 0.0, slope_ = 0.0, scale_ = 0.0;
+  double spacing_ = 0.0;  // [ns] median spacing of consecutive samples in the window
   bool fitted_ = false, regular_ = false;
   std::int64_t last_instant_ = 0;
 };

@@ -32,7 +32,7 @@ SampleClock::SampleClock(bool regularize, int window)
 void SampleClock::reset() {
   head_ = count_ = 0;
   fitted_ = regular_ = false;
-  intercept_ = slope_ = scale_ = 0.0;
+  intercept_ = slope_ = scale_ = spacing_ = 0.0;
   last_instant_ = 0;
 }
 
@@ -41,21 +41,32 @@ const SampleClock::Point& SampleClock::point(int i) const {
   return ring_[static_cast<std::size_t>((head_ - count_ + i + n) % n)];
 }
 
-double SampleClock::nextIndex(std::int64_t stamp) const {
-  const Point& last = point(count_ - 1);
-  if (fitted_) {
-    // The nearest lattice node of the fit; at least one after the last (a late sample
-    // rounds to its successor's node, which the next on-time sample takes back).
-    const double n = (static_cast<double>(stamp - origin_) - intercept_) / slope_;
-    return std::max(index_origin_ + std::round(n), last.index + 1.0);
+SampleClock::Point& SampleClock::at(int i) {
+  const int n = static_cast<int>(ring_.size());
+  return ring_[static_cast<std::size_t>((head_ - count_ + i + n) % n)];
+}
+
+double SampleClock::nextIndex(std::int64_t stamp) {
+  // The index steps by the spacing over the period, rounded: gaps and dropped samples are
+  // counted. The period is the fit's on a periodic stream, else the window's median
+  // spacing (never the fit's, whose lattice would follow the indices it gave), or before
+  // the first fit the smallest spacing seen (drops only lengthen it).
+  double period = regular_ ? slope_ : spacing_;
+  if (period <= 0.0) {
+    period = static_cast<double>(stamp - point(count_ - 1).stamp);
+    for (int i = 1; i < count_; ++i)
+      period = std::min(period, static_cast<double>(point(i).stamp - point(i - 1).stamp));
   }
-  // Before the first fit: the spacing is the smallest seen so far (drops only lengthen it).
-  double spacing = static_cast<double>(stamp - last.stamp);
-  for (int i = 1; i < count_; ++i) {
-    const Point &a = point(i - 1), &b = point(i);
-    spacing = std::min(spacing, static_cast<double>(b.stamp - a.stamp) / (b.index - a.index));
+  const double steps = static_cast<double>(stamp - point(count_ - 1).stamp) / period;
+  // Received less than half a period after the last: the last ones were late (a burst),
+  // not a period apart after dropped samples: the newest step of more than one index was
+  // one too many.
+  for (int i = count_ - 1; steps < 0.5 && i > 0; --i) {
+    if (!(at(i).index - at(i - 1).index > 1.0)) continue;
+    for (int j = i; j < count_; ++j) at(j).index -= 1.0;
+    break;
   }
-  return last.index + std::max(1.0, std::round(static_cast<double>(stamp - last.stamp) / spacing));
+  return point(count_ - 1).index + std::max(1.0, std::round(steps));
 }
 
 std::int64_t SampleClock::add(std::int64_t stamp) {
@@ -69,6 +80,10 @@ std::int64_t SampleClock::add(std::int64_t stamp) {
   fit();
   std::int64_t instant = stamp;
   if (regular_) instant = origin_ + std::llround(intercept_ + slope_ * (index - index_origin_));
+  // A burst's samples follow a late one whose instant was taken for later: spread over
+  // the period after it rather than squeezed into nanoseconds.
+  const std::int64_t step = std::max<std::int64_t>(1, std::llround(0.125 * period()));
+  if (count_ > 1 && instant < last_instant_ + step && regular_) instant = last_instant_ + step;
   if (count_ > 1 && instant <= last_instant_) instant = last_instant_ + 1;
   last_instant_ = instant;
   return instant;
@@ -100,6 +115,10 @@ void SampleClock::robustLine(double& intercept, double& slope) {
 
 void SampleClock::fit() {
   if (count_ < kMinFit) return;
+  for (int i = 1; i < count_; ++i)
+    scratch_[static_cast<std::size_t>(i - 1)] =
+        static_cast<double>(point(i).stamp - point(i - 1).stamp);
+  spacing_ = median(count_ - 1);
   origin_ = point(0).stamp;
   index_origin_ = point(0).index;
   double a = 0.0, b = 0.0;
