@@ -80,9 +80,9 @@ std::int64_t SampleClock::add(std::int64_t stamp) {
   fit();
   std::int64_t instant = stamp;
   if (regular_) instant = origin_ + std::llround(intercept_ + slope_ * (index - index_origin_));
-  // A burst's samples follow a late one whose instant was taken for later: spread over
-  // the period after it rather than squeezed into nanoseconds.
-  const std::int64_t step = std::max<std::int64_t>(1, std::llround(0.125 * period()));
+  // A burst's samples follow a late one whose instant was taken for later: 1% of a period
+  // apart (measured on the Panda at 1 kHz: 1/8 of a period was worse than the stamps).
+  const std::int64_t step = std::max<std::int64_t>(1, std::llround(0.01 * period()));
   if (count_ > 1 && instant < last_instant_ + step && regular_) instant = last_instant_ + step;
   if (count_ > 1 && instant <= last_instant_) instant = last_instant_ + 1;
   last_instant_ = instant;
