@@ -127,7 +127,8 @@ class Pipeline {
                        const std::vector<double>& effort);
   /// A wrench of input k (settings.wrenches[k]) as the message carries it: force [N]
   /// and torque [N m] in `frame_id` (the configured frame, when set, wins), moment about
-  /// its origin.
+  /// its origin. Its stamp follows the rules of README, "Time stamps": stamp 0, and a
+  /// reading ahead of the joint states by more than its timeout, are rogue stamps.
   Outcome onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
                    const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
   /// A sample of force plate k (settings.force_plates[k]): what the foot applies to
