@@ -235,7 +235,8 @@ class Pipeline {
   bool have_ref_ = false;
   Stamp last_stamp_ = 0;  // last joint state taken (0 after a reset)
   Stamp last_clock_ = 0;
-  SampleClock clock_;  // the joint-state stream's
+  Stamp last_taken_clock_ = 0;  // the clock when the last joint state was taken
+  SampleClock clock_;           // the joint-state stream's
   bool joints_stamped_ = false;
   // Joint states on another timeline, in a row: the last one's stamp and how many.
   Stamp pending_stamp_ = 0;

@@ -231,7 +231,11 @@ Outcome Pipeline::checkJointStamp(Stamp stamp, Stamp clock) {
   const double threshold = settings_.time_jump_threshold;
   // Forward, a gap of 10 periods is no jump either (a slow stream).
   const double forward = std::max(threshold, 10e-9 * clock_.period());
-  if (ahead >= -threshold && ahead <= forward) {
+  // A gap that the clock saw as well (a driver or a bag paused) keeps the stream's lag
+  // behind the clock: no jump either.
+  const double lag = static_cast<double>((stamp - clock) - (last_stamp_ - last_taken_clock_));
+  if ((ahead >= -threshold && ahead <= forward) ||
+      (ahead > 0.0 && std::abs(lag) * 1e-9 <= threshold)) {
     pending_ = 0;
     return Outcome::kUsed;
   }
@@ -367,6 +371,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
     default: break;
   }
   last_stamp_ = stamp;
+  last_taken_clock_ = last_clock_;
   if (clock_back_ > 0) --clock_back_;
   remember(t, stamp, has_effort);
   if (status == SampleStatus::kStale) return staleProblem();

@@ -165,11 +165,11 @@ void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
 
 // The shadow of the pipeline's rules on stamps (README, "Time stamps"; the settings'
 // time_jump_threshold 1 s, stamps/jump_confirm 3, the wrench's timeout 0.05 s): stamp 0
-// per input, the last joint state taken, rogue stamps and the jumps they confirm, the
-// clock going back.
+// per input, the last joint state taken, rogue stamps (a gap the clock saw too is none)
+// and the jumps they confirm, the clock going back.
 struct Shadow {
   jle::Stamp last = 0;  // 0: none since the start or a reset
-  jle::Stamp last_clock = 0, pending_stamp = 0;
+  jle::Stamp last_clock = 0, pending_stamp = 0, taken_clock = 0;
   int pending = 0, clock_back = 0;
   bool joints_stamped = false, wrench_stamped = false;
   double period = 0.0;  // [ns] the joint stream's (its sample clock's) before the message
@@ -188,11 +188,13 @@ struct Shadow {
     if (back && !(stamp > last)) reset();
   }
   // Whether a joint state's stamp is rogue (dropped); a confirmed jump resets.
-  bool jointRogue(jle::Stamp stamp) {
+  bool jointRogue(jle::Stamp stamp, jle::Stamp clock) {
     if (last == 0) return false;
     const double ahead = static_cast<double>(stamp - last) * 1e-9;
     const double forward = std::max(1.0, 10e-9 * period);
-    if (ahead >= -1.0 && ahead <= forward) return (pending = 0) != 0;
+    const double lag = static_cast<double>((stamp - clock) - (last - taken_clock));
+    if ((ahead >= -1.0 && ahead <= forward) || (ahead > 0.0 && std::abs(lag) * 1e-9 <= 1.0))
+      return (pending = 0) != 0;
     const bool follows = pending > 0 && stamp > pending_stamp &&
                          static_cast<double>(stamp - pending_stamp) * 1e-9 <= forward;
     pending = follows ? pending + 1 : 1;
@@ -207,6 +209,7 @@ struct Shadow {
   }
   void taken(jle::Stamp stamp) {
     last = stamp;
+    taken_clock = last_clock;
     if (clock_back > 0) --clock_back;
   }
 };
@@ -245,7 +248,7 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
     return;
   }
   const bool rogue = !Shadow::zero(shadow.joints_stamped, stamp, clock) ||
-                     (shadow.clockSeen(stamp, clock), shadow.jointRogue(stamp));
+                     (shadow.clockSeen(stamp, clock), shadow.jointRogue(stamp, clock));
   JLE_FUZZ_CHECK(rogue == (outcome == Outcome::kRogueStamp));
   if (rogue) {
     JLE_FUZZ_CHECK(!p.problem().empty());

@@ -292,9 +292,14 @@ TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
   EXPECT_EQ(pipeline.timeOrigin(), kStart - 1998 * kMs);
   EXPECT_EQ(pipeline.counters().resets, 1);
   EXPECT_EQ(pipeline.counters().count(InputKind::kJointState, Outcome::kRogueStamp), 2);
+  // A gap of 5 s that the clock saw too (a paused driver or bag): no rogue stamp, no jump.
+  EXPECT_EQ(feed(kStart + 3002 * kMs, kStart + 5008 * kMs), Outcome::kUsed);
+  EXPECT_EQ(pipeline.counters().resets, 1);
+  EXPECT_EQ(pipeline.counters().count(InputKind::kJointState, Outcome::kRogueStamp), 2);
   // The clock going back while the stamps do not move forward: a reset at once.
   EXPECT_EQ(feed(kStart - 1998 * kMs, kStart), Outcome::kUsed);
   EXPECT_EQ(pipeline.counters().resets, 2);
+  EXPECT_EQ(feed(kStart - 1997 * kMs, kStart + kMs), Outcome::kUsed);
   // 100 days ahead: beyond what the time axis resolves to 1 ns, confirmed like any jump,
   // with a new origin; the record still carries the exact stamps.
   const Stamp far = kStart + Stamp{100} * 86400 * 1000000000;
