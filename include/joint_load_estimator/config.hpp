@@ -219,8 +219,8 @@ struct Settings {
   std::string world_frame = "world";  ///< tf2 frame of the world (floating base)
   std::string base_frame;             ///< tf2 frame of the base; empty: the URDF root link
   /// [s] > 0; a joint-state stamp this far from the last one taken (back, or forward
-  /// beyond 10 periods too) is a rogue stamp, or, confirmed (stamps.jump_confirm), a jump
-  /// of time: reset.
+  /// beyond 10 periods too, unless the clock moved as far) is a rogue stamp, or,
+  /// confirmed (stamps.jump_confirm), a jump of time: reset.
   double time_jump_threshold = 1.0;
   StampSettings stamps;
   /// Fixed joints kept as their own segments (their wrench is published). The joints of
