@@ -200,6 +200,26 @@ struct FrictionConfig {
   double velocity_scale = 0.01;
 };
 
+/// How the message stamps of the joint-state stream become the estimator's times
+/// (README, "Time stamps").
+enum class StampRegularize : std::uint8_t {
+  /// A periodic stream whose stamps jitter about a lattice (stamps taken at reception)
+  /// is detected, and its samples' instants are estimated from the stamps (SampleClock);
+  /// an irregular stream, and a periodic one with exact stamps, keep their stamps.
+  kAuto,
+  kOff,  ///< the stamps are the instants
+};
+
+/// The joint-state stream's time base and its rogue stamps (stamps/...).
+struct StampSettings {
+  StampRegularize regularize = StampRegularize::kAuto;
+  /// Consecutive joint states on a new timeline (each more than time_jump_threshold
+  /// from the last taken stamp, back or forward, in order among themselves) that confirm
+  /// a jump of time (>= 1); fewer are dropped as rogue stamps. The clock going back
+  /// confirms a jump back at once.
+  int jump_confirm = 3;
+};
+
 /// Every setting of the node and of the offline front ends (process_bag), with the
 /// parameter names of config/default.yaml (README, "Parameters").
 struct Settings {
@@ -209,7 +229,11 @@ struct Settings {
   bool floating_base = false;
   std::string world_frame = "world";  ///< tf2 frame of the world (floating base)
   std::string base_frame;             ///< tf2 frame of the base; empty: the URDF root link
-  double time_jump_threshold = 1.0;   ///< [s] > 0; a stamp older than this is a jump back: reset
+  /// [s] > 0; a joint-state stamp this far from the last one taken (back, or forward
+  /// beyond 10 periods too, unless the clock moved as far) is a rogue stamp, or,
+  /// confirmed (stamps.jump_confirm), a jump of time: reset.
+  double time_jump_threshold = 1.0;
+  StampSettings stamps;
   /// Fixed joints kept as their own segments (their wrench is published). The joints of
   /// the sensor inputs (estimator.wrenches[k].sensor_joint) are kept too, without being
   /// listed here (modelOptions()).

@@ -9,6 +9,7 @@
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/sample_clock.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <Eigen/Core>
@@ -39,6 +40,10 @@ enum class Outcome : std::uint8_t {
   /// a joint state that sets no coordinate the computed loads need (empty, or only a
   /// gripper's joints): its positions are kept, but it is not a sample
   kNoJoint,
+  /// A rogue stamp (README, "Time stamps"): far from the joint-state stream's and not
+  /// (yet) a confirmed jump of time, a wrench or plate ahead of the joint states by more
+  /// than its timeout, or stamp 0 on a stream that has had stamps
+  kRogueStamp,
   kCount
 };
 
@@ -122,17 +127,20 @@ class Pipeline {
   /// std::invalid_argument naming the key, link or joint.
   Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames);
 
-  /// A joint state: names (each once), positions (same size), velocities and efforts
-  /// (empty or the same size; a non-finite effort only drops that joint's measured
-  /// effort). `stamp` 0 is replaced by `clock`, the front end's clock when the
-  /// message arrived (the node: ros::Time::now(); a bag: the message's bag time), which
-  /// also tells a backward jump of time (a looping bag).
+  /// A joint state: names, positions (same size), velocities and efforts (empty or the
+  /// same size; a non-finite effort only drops that joint's measured effort). `clock` is the front end's clock when the message arrived (the node:
+  /// ros::Time::now(); a bag: the message's bag time): it going back confirms a backward
+  /// jump of time (a looping bag), and it stands for stamp 0 on a stream that never had
+  /// a stamp (README, "Time stamps"). The estimator is fed the sample's instant (the
+  /// stamp, or with stamps/regularize the SampleClock's estimate); the loads keep the
+  /// message's own stamp.
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
                        const std::vector<double>& position, const std::vector<double>& velocity,
                        const std::vector<double>& effort);
   /// A wrench of input k (settings.wrenches[k]) as the message carries it: force [N]
   /// and torque [N m] in `frame_id` (the configured frame, when set, wins), moment about
-  /// its origin.
+  /// its origin. Its stamp follows the rules of README, "Time stamps": stamp 0, and a
+  /// reading ahead of the joint states by more than its timeout, are rogue stamps.
   Outcome onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
                    const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
   /// A sample of force plate k (settings.force_plates[k]): what the foot applies to
@@ -159,8 +167,8 @@ class Pipeline {
   /// The topics of the inputs with stale_policy stop that were stale at the last joint
   /// sample (no loads while there is one), ", " between them; empty if none.
   std::string stoppingInputs() const;
-  /// Whether the last message reset the filters (time jumped back), and from when to
-  /// when [ns].
+  /// Whether the last message reset the filters (a confirmed jump of time, back or
+  /// forward, or the clock going back), and from when to when [ns].
   bool jumped() const { return jumped_; }
   Stamp jumpFrom() const { return jump_from_; }
   Stamp jumpTo() const { return jump_to_; }
@@ -169,12 +177,14 @@ class Pipeline {
   const PipelineCounters& counters() const { return counters_; }
   const Settings& settings() const { return settings_; }
   const Estimator& estimator() const { return estimator_; }
+  /// The joint-state stream's sample clock (stamps/regularize).
+  const SampleClock& sampleClock() const { return clock_; }
   const Model<double>& model() const { return estimator_.model(); }
   /// The stamp [ns] of the estimator's time t [s].
   Stamp absolute(double t) const;
-  /// The origin of the estimator's time axis [ns]: the first stamp after the start or
-  /// after a stamp more than 2^52 ns (52 days) away from the previous origin. None until
-  /// a message has been taken.
+  /// The origin of the estimator's time axis [ns]: the first stamp after the start, after
+  /// a reset, or after a stamp more than 2^52 ns (52 days) away from the previous origin.
+  /// None until a message has been taken.
   bool hasTimeOrigin() const { return have_ref_; }
   Stamp timeOrigin() const { return time_ref_; }
 
@@ -191,10 +201,12 @@ class Pipeline {
     bool rigid = false;  // `frame` is a URDF frame rigid to the link: pose cached
     Eigen::Isometry3d X_link_frame = Eigen::Isometry3d::Identity();
     Eigen::Vector3d bias_force = Eigen::Vector3d::Zero(), bias_torque = Eigen::Vector3d::Zero();
+    bool stamped = false;  // has had a non-zero stamp
   };
   struct PlateInput {
     std::string frame;  // frame whose pose the estimator holds
     bool pose_known = false;
+    bool stamped = false;
   };
   // One joint sample entering the filters: its time, stamp and measured efforts.
   struct Sample {
@@ -208,14 +220,19 @@ class Pipeline {
   double relative(Stamp stamp);
   Outcome count(InputKind kind, Outcome outcome);
   Outcome fail(InputKind kind, Outcome outcome, const std::string& why);
-  void checkTimeJump(Stamp stamp, Stamp clock);
   bool movesNeeded() const;
+  void anchor(Stamp stamp);
+  bool clockWentBack(Stamp stamp, Stamp clock);
+  void resetTimeline(Stamp stamp);
+  Outcome checkJointStamp(Stamp stamp, Stamp clock);
+  Outcome checkInputStamp(InputKind kind, const std::string& input, double timeout, Stamp stamp,
+                          Stamp clock);
   bool checkJointState(const std::vector<std::string>& names, const std::vector<double>& position,
                        const std::vector<double>& velocity, const std::vector<double>& effort);
   void mapJointState(const std::vector<std::string>& names, const std::vector<double>& position,
                      const std::vector<double>& effort);
   bool basePose(Stamp stamp, BasePose& base);
-  Outcome sample(Stamp stamp, double t, bool has_effort, const BasePose* base);
+  Outcome sample(Stamp stamp, bool has_effort, const BasePose* base);
   Outcome staleProblem();
   void remember(double t, Stamp stamp, bool has_effort);
   bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
@@ -233,12 +250,19 @@ class Pipeline {
   std::vector<WrenchInput> wrenches_;
   std::vector<PlateInput> plates_;
   double body_mass_ = 0.0;  // [kg] effort_per_kg divisor; 0: none
-  // The time axis: seconds since the first stamp seen (a double holds epoch seconds only
-  // to 2.4e-7 s). Kept across resets: a negative time is fine.
+  // The time axis: seconds since the first stamp seen after the start or a reset (a
+  // double holds epoch seconds only to 2.4e-7 s).
   Stamp time_ref_ = 0;
   bool have_ref_ = false;
   Stamp last_stamp_ = 0;  // last joint state taken (0 after a reset)
   Stamp last_clock_ = 0;
+  Stamp last_taken_clock_ = 0;  // the clock when the last joint state was taken
+  SampleClock clock_;           // the joint-state stream's
+  bool joints_stamped_ = false;
+  // Joint states on another timeline, in a row: the last one's stamp and how many.
+  Stamp pending_stamp_ = 0;
+  int pending_ = 0;
+  int clock_back_ = 0;  // joint states taken since the clock went back that it confirms
   // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
   std::vector<Sample> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;

@@ -136,6 +136,9 @@ void validate(const Settings& settings) {
   required("joint_states_topic", settings.joint_states_topic);
   unique("keep_fixed_joints", settings.keep_fixed_joints);
   positive("time_jump_threshold", settings.time_jump_threshold);
+  if (settings.stamps.jump_confirm < 1)
+    fail("stamps/jump_confirm",
+         "must be >= 1, it is " + std::to_string(settings.stamps.jump_confirm));
   positive("base_residual_threshold", settings.base_residual_threshold);
   positive("still_velocity", settings.still_velocity);
   positive("diagnostic_period", settings.diagnostic_period);

@@ -32,6 +32,20 @@ std::string seconds(Stamp stamp) {
   return text;
 }
 
+// Stamp 0 on an input that has never had a stamp (a live driver that stamps nothing) is
+// the clock; on one that has, it is dropped: a bag's missing stamp is no reception time.
+bool zeroStamp(bool& stamped, Stamp& stamp, Stamp clock) {
+  if (stamp != 0) {
+    stamped = true;
+    return true;
+  }
+  if (stamped) return false;
+  stamp = clock;
+  return true;
+}
+
+const char* const kZeroStamp = ": stamp 0 on a stream that has had stamps: dropped";
+
 }  // namespace
 
 const char* toString(Outcome outcome) {
@@ -46,6 +60,7 @@ const char* toString(Outcome outcome) {
     case Outcome::kStale: return "stale input";
     case Outcome::kUnchanged: return "unchanged";
     case Outcome::kNoJoint: return "no needed joint";
+    case Outcome::kRogueStamp: return "rogue stamp";
     case Outcome::kCount: break;
   }
   return "?";
@@ -135,6 +150,7 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
               publishedSegments(estimator_.model(), settings_.estimator.joints)),
       wrenches_(settings_.estimator.wrenches.size()),
       plates_(settings_.estimator.plates.size()),
+      clock_(settings_.stamps.regularize == StampRegularize::kAuto),
       ring_(kRing) {
   const Model<double>& m = estimator_.model();
   record_.segment = publishedSegments(m, settings_.estimator.joints);
@@ -167,11 +183,16 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
 }
 
+void Pipeline::anchor(Stamp stamp) {
+  // The time axis resolves 1 ns within 2^52 ns (52 days) of its origin: a stamp farther
+  // away (taken at the start or after a reset) starts it again.
+  if (have_ref_ && std::abs(stamp - time_ref_) <= kReach) return;
+  time_ref_ = stamp;
+  have_ref_ = true;
+}
+
 double Pipeline::relative(Stamp stamp) {
-  if (!have_ref_) {
-    time_ref_ = stamp;
-    have_ref_ = true;
-  }
+  anchor(stamp);
   return static_cast<double>(stamp - time_ref_) * 1e-9;
 }
 
@@ -190,29 +211,76 @@ Outcome Pipeline::fail(InputKind kind, Outcome outcome, const std::string& why) 
   return count(kind, outcome);
 }
 
-void Pipeline::checkTimeJump(Stamp stamp, Stamp clock) {
-  // A looping bag (rosbag play -l) or a restarted simulation sends time backwards: the
-  // filters' memory belongs to another timeline. The clock and the stamps come on
-  // different connections, so the clock may go back one message after the stamps did
-  // (or before): a clock going back is a jump only while the stamps do not go forward,
-  // else one jump would reset twice.
-  jumped_ = false;
-  const bool clock_back = last_clock_ != 0 && clock < last_clock_ && !(stamp > last_stamp_);
-  const bool stamp_back = last_stamp_ != 0 && static_cast<double>(last_stamp_ - stamp) * 1e-9 >
-                                                  settings_.time_jump_threshold;
-  // The time axis resolves 1 ns within 2^52 ns (52 days) of its origin: a stamp farther
-  // away starts a new timeline, with a new origin.
-  const bool far = have_ref_ && std::abs(stamp - time_ref_) > kReach;
+bool Pipeline::clockWentBack(Stamp stamp, Stamp clock) {
+  // The clock and the stamps come on different connections, so the clock may go back
+  // one message after the stamps did (or before): a clock going back is a jump only
+  // while the stamps do not go forward, else one jump would reset twice; going back
+  // first, it confirms the stamps' jump back when they follow.
+  const bool back = last_clock_ != 0 && clock < last_clock_;
   last_clock_ = clock;
-  if (far) have_ref_ = false;
-  if (!clock_back && !stamp_back && !far) return;
+  if (back) clock_back_ = settings_.stamps.jump_confirm;
+  return back && !(stamp > last_stamp_);
+}
+
+void Pipeline::resetTimeline(Stamp stamp) {
+  // A looping bag (rosbag play -l), a restarted simulation, a driver's clock set: the
+  // filters' memory belongs to another timeline, and so does the time axis.
   jumped_ = true;
   jump_from_ = last_stamp_;
   jump_to_ = stamp;
   estimator_.reset();
+  clock_.reset();
   ring_count_ = 0;
   last_stamp_ = 0;
+  have_ref_ = false;
+  pending_ = clock_back_ = 0;
   ++counters_.resets;
+}
+
+Outcome Pipeline::checkJointStamp(Stamp stamp, Stamp clock) {
+  constexpr InputKind kind = InputKind::kJointState;
+  if (clockWentBack(stamp, clock)) resetTimeline(stamp);
+  if (last_stamp_ == 0) return Outcome::kUsed;
+  const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
+  const double threshold = settings_.time_jump_threshold;
+  // Forward, a gap of 10 periods is no jump either (a slow stream).
+  const double forward = std::max(threshold, 10e-9 * clock_.period());
+  // A gap that the clock saw as well (a driver or a bag paused) keeps the stream's lag
+  // behind the clock: no jump either.
+  const double lag = static_cast<double>((stamp - clock) - (last_stamp_ - last_taken_clock_));
+  if ((ahead >= -threshold && ahead <= forward) ||
+      (ahead > 0.0 && std::abs(lag) * 1e-9 <= threshold)) {
+    pending_ = 0;
+    return Outcome::kUsed;
+  }
+  // On another timeline: a jump once jump_confirm in a row agree (in order, each within
+  // `forward` of the one before), or at once back after the clock went back.
+  const bool follows = pending_ > 0 && stamp > pending_stamp_ &&
+                       static_cast<double>(stamp - pending_stamp_) * 1e-9 <= forward;
+  pending_ = follows ? pending_ + 1 : 1;
+  pending_stamp_ = stamp;
+  if (pending_ >= settings_.stamps.jump_confirm || (ahead < 0.0 && clock_back_ > 0)) {
+    resetTimeline(stamp);
+    return Outcome::kUsed;
+  }
+  return fail(kind, Outcome::kRogueStamp,
+              settings_.joint_states_topic + ": stamp " + seconds(stamp) + " is " +
+                  std::to_string(ahead) + " s from the stream's (" + seconds(last_stamp_) +
+                  "): dropped (a jump of time takes " +
+                  std::to_string(settings_.stamps.jump_confirm) + " in a row)");
+}
+
+Outcome Pipeline::checkInputStamp(InputKind kind, const std::string& input, double timeout,
+                                  Stamp stamp, Stamp clock) {
+  if (clockWentBack(stamp, clock)) resetTimeline(stamp);
+  if (last_stamp_ == 0) return Outcome::kUsed;  // no joint state on this timeline yet
+  // The joint states may be a period behind a reading that is on time.
+  const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
+  if (ahead <= timeout + 1e-9 * clock_.period() && ahead >= -settings_.time_jump_threshold)
+    return Outcome::kUsed;
+  return fail(kind, Outcome::kRogueStamp,
+              input + ": stamp " + seconds(stamp) + " is " + std::to_string(ahead) +
+                  " s from the joint states' (" + seconds(last_stamp_) + "): dropped");
 }
 
 bool Pipeline::checkJointState(const std::vector<std::string>& names,
@@ -285,15 +353,20 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   unknown_joint_.clear();
   nonfinite_effort_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
-  mapJointState(names, position, effort);
+  jumped_ = false;
   // Neither a sample nor a time: its stamp and clock are not the stream's.
-  if (!movesNeeded())
+  if (!movesNeeded()) {
+    mapJointState(names, position, effort);
     return fail(kind, Outcome::kNoJoint,
                 settings_.joint_states_topic +
                     ": a message with none of the joints the loads need: not a sample");
-  if (stamp == 0) stamp = clock;
-  checkTimeJump(stamp, clock);
-  const double t = relative(stamp);
+  }
+  if (!zeroStamp(joints_stamped_, stamp, clock))
+    return fail(kind, Outcome::kRogueStamp, settings_.joint_states_topic + kZeroStamp);
+  const Outcome timeline = checkJointStamp(stamp, clock);
+  if (timeline != Outcome::kUsed) return timeline;
+  mapJointState(names, position, effort);
+  anchor(stamp);
   const std::string& missing = missingJoint();
   if (!missing.empty())
     return fail(kind, Outcome::kWaiting,
@@ -301,7 +374,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
                     "': not publishing");
   BasePose base;
   if (model().floating_base && !basePose(stamp, base)) return count(kind, Outcome::kNoBasePose);
-  return sample(stamp, t, !effort.empty(), &base);
+  return sample(stamp, !effort.empty(), &base);
 }
 
 bool Pipeline::basePose(Stamp stamp, BasePose& base) {
@@ -317,21 +390,29 @@ bool Pipeline::basePose(Stamp stamp, BasePose& base) {
   return false;
 }
 
-Outcome Pipeline::sample(Stamp stamp, double t, bool has_effort, const BasePose* base) {
+Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   constexpr InputKind kind = InputKind::kJointState;
+  const auto order = [&](SampleStatus status) {
+    return fail(kind, Outcome::kOrder,
+                settings_.joint_states_topic + ": " + toString(status) + " " + seconds(stamp) +
+                    " (previous " + seconds(last_stamp_) + "): message dropped");
+  };
+  // The order of the stamps, not of the instants (which the sample clock makes increase).
+  if (last_stamp_ != 0 && stamp <= last_stamp_)
+    return order(stamp == last_stamp_ ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder);
+  const double t = relative(clock_.add(stamp));
   const SampleStatus status = estimator_.addJointSample(t, joints_.q().data(), base);
   switch (status) {
     case SampleStatus::kDuplicate:
-    case SampleStatus::kOutOfOrder:
-      return fail(kind, Outcome::kOrder,
-                  settings_.joint_states_topic + ": " + toString(status) + " " + seconds(stamp) +
-                      " (previous " + seconds(last_stamp_) + "): message dropped");
+    case SampleStatus::kOutOfOrder: return order(status);
     case SampleStatus::kNonFinite:
       return fail(kind, Outcome::kInvalid,
                   settings_.joint_states_topic + ": non-finite stamp or base pose: dropped");
     default: break;
   }
   last_stamp_ = stamp;
+  last_taken_clock_ = last_clock_;
+  if (clock_back_ > 0) --clock_back_;
   remember(t, stamp, has_effort);
   if (status == SampleStatus::kStale) return staleProblem();
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
@@ -472,10 +553,12 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   if (frame.empty())
     return fail(kind, Outcome::kFrame,
                 "wrench '" + topic + "': empty header.frame_id and no 'frame' configured: dropped");
-  if (stamp == 0) stamp = clock;
-  // A looping bag may deliver the new loop's first wrench before its first joint state:
-  // the jump is detected here too, so that wrench is not refused as old.
-  checkTimeJump(stamp, clock);
+  jumped_ = false;
+  if (!zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
+    return fail(kind, Outcome::kRogueStamp, "wrench '" + topic + "'" + kZeroStamp);
+  const Outcome timeline = checkInputStamp(
+      kind, "wrench '" + topic + "'", settings_.estimator.wrenches[ix(k)].timeout, stamp, clock);
+  if (timeline != Outcome::kUsed) return timeline;
   if (!resolveWrenchFrame(k, frame, stamp)) return count(kind, Outcome::kFrame);
   const WrenchInput& input = wrenches_[ix(k)];
   // The sensor's offset is in its own frame and sign: removed before anything else.
@@ -528,8 +611,12 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
     return fail(
         kind, Outcome::kFrame,
         "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
-  if (stamp == 0) stamp = clock;
-  checkTimeJump(stamp, clock);  // as for wrenches: a looping bag
+  jumped_ = false;
+  if (!zeroStamp(plates_[ix(k)].stamped, stamp, clock))
+    return fail(kind, Outcome::kRogueStamp, "force plate '" + name + "'" + kZeroStamp);
+  const Outcome timeline = checkInputStamp(kind, "force plate '" + name + "'",
+                                           settings_.estimator.plates[ix(k)].timeout, stamp, clock);
+  if (timeline != Outcome::kUsed) return timeline;
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
   if (!estimator_.addPlateSample(k, relative(stamp), force, moment))
     return fail(kind, Outcome::kOrder,

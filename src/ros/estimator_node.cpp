@@ -328,6 +328,7 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   const PipelineCounters& c = pipeline_->counters();
   status.add("dropped: invalid", c.count(Outcome::kInvalid) + exceptions_);
   status.add("dropped: stamp order", c.count(Outcome::kOrder));
+  status.add("dropped: rogue stamp", c.count(Outcome::kRogueStamp));
   status.add("dropped: unresolved frame", c.count(Outcome::kFrame) + c.count(Outcome::kNoBasePose));
   status.add("dropped: no base pose", c.count(Outcome::kNoBasePose));
   status.add("not used: no needed joint", c.count(Outcome::kNoJoint));

@@ -8,6 +8,7 @@ bool InputHealth::dropped(Outcome outcome) {
     case Outcome::kOrder:
     case Outcome::kFrame:
     case Outcome::kNoBasePose:
+    case Outcome::kRogueStamp:
     case Outcome::kNoJoint: return true;
     default: return false;
   }

@@ -116,6 +116,15 @@ class Section {
     throw SettingsError("parameter '" + name(key) + "' is '" + text + "'; expected one of " +
                         names);
   }
+  // As above, or a boolean: rosparam reads YAML 1.1, where a bare on/off is one; take
+  // it as meant (true: `on`, false: `off`).
+  template <typename Enum>
+  void read(const std::string& key, Enum& out, Choices<Enum> options, Enum on, Enum off) {
+    if (!has(key) || get(key).getType() != XmlRpcValue::TypeBoolean) return read(key, out, options);
+    bool value = false;
+    read(key, value);
+    out = value ? on : off;
+  }
   // The map `key` read by `each(Section&)`, then checked for unknown keys.
   template <typename Each>
   void readMap(const std::string& key, Each each) {
@@ -198,15 +207,16 @@ void readSavings(Section& s, Savings& v) {
                 {"republish_unchanged", &v.republish_unchanged}});
   s.read<double>(
       {{"static_velocity", &v.static_velocity}, {"static_acceleration", &v.static_acceleration}});
-  // rosparam reads YAML 1.1, where a bare on/off is a boolean: take it as meant.
-  if (s.has("planar") && s.get("planar").getType() == XmlRpcValue::TypeBoolean) {
-    bool planar = false;
-    s.read("planar", planar);
-    v.planar = planar ? PlanarMode::kOn : PlanarMode::kOff;
-  } else {
-    s.read("planar", v.planar,
-           {{"auto", PlanarMode::kAuto}, {"on", PlanarMode::kOn}, {"off", PlanarMode::kOff}});
-  }
+  s.read("planar", v.planar,
+         {{"auto", PlanarMode::kAuto}, {"on", PlanarMode::kOn}, {"off", PlanarMode::kOff}},
+         PlanarMode::kOn, PlanarMode::kOff);
+}
+
+void readStamps(Section& s, StampSettings& v) {
+  s.read("regularize", v.regularize,
+         {{"auto", StampRegularize::kAuto}, {"off", StampRegularize::kOff}}, StampRegularize::kAuto,
+         StampRegularize::kOff);
+  s.read("jump_confirm", v.jump_confirm);
 }
 
 void readUncertainty(Section& s, UncertaintyConfig& u) {
@@ -323,6 +333,7 @@ Settings parseSettings(const XmlRpcValue& params) {
   Section s(params, "");
   readTopLevel(s, n);
   s.readMap("savings", [&](Section& m) { readSavings(m, n.estimator.savings); });
+  s.readMap("stamps", [&](Section& m) { readStamps(m, n.stamps); });
   s.readMap("uncertainty", [&](Section& m) { readUncertainty(m, n.estimator.uncertainty); });
   s.readMap("friction", [&](Section& m) { readFriction(m, n.friction); });
   s.readMap("differentiator",

@@ -5,13 +5,15 @@
 // empty and mismatched arrays, stamp 0, duplicate, backward and jumping stamps over the
 // whole range a ROS stamp holds), wrench messages (frames known and unknown) and jumps
 // of the clock. Checks the documented outcome of every message against a shadow of
-// the rules (invalid sizes and values, stamp order, resets), that every message is
+// the rules (invalid sizes and values, stamp 0, stamp order, rogue stamps, confirmed
+// jumps and resets: README, "Time stamps"), that every message is
 // counted once, and the published record. Built by build_and_run.sh.
 #include "fuzz_check.hpp"
 
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -162,24 +164,54 @@ void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
   clock = std::min(kMaxStamp, clock + 1000000);
 }
 
-// The shadow of the pipeline's rules on stamps: the last joint state taken, resets (a
-// stamp more than time_jump_threshold back, the clock going back, a stamp 2^52 ns or
-// more from the time axis' origin, as the pipeline had it before the message).
+// The shadow of the pipeline's rules on stamps (README, "Time stamps"; the settings'
+// time_jump_threshold 1 s, stamps/jump_confirm 3, the wrench's timeout 0.05 s): stamp 0
+// per input, the last joint state taken, rogue stamps (a gap the clock saw too is none)
+// and the jumps they confirm, the clock going back.
 struct Shadow {
   jle::Stamp last = 0;  // 0: none since the start or a reset
-  jle::Stamp last_clock = 0;
-  bool had_origin = false;
-  jle::Stamp origin = 0;
-  void before(const jle::Pipeline& p) {
-    had_origin = p.hasTimeOrigin();
-    origin = p.timeOrigin();
+  jle::Stamp last_clock = 0, pending_stamp = 0, taken_clock = 0;
+  int pending = 0, clock_back = 0;
+  bool joints_stamped = false, wrench_stamped = false;
+  double period = 0.0;  // [ns] the joint stream's (its sample clock's) before the message
+  void before(const jle::Pipeline& p) { period = p.sampleClock().period(); }
+  // False: stamp 0 on an input that has had stamps (dropped); else `stamp` is effective.
+  static bool zero(bool& stamped, jle::Stamp& stamp, jle::Stamp clock) {
+    if (stamp != 0) return stamped = true;
+    if (!stamped) stamp = clock;
+    return !stamped;
   }
+  void reset() { last = 0, pending = 0, clock_back = 0; }
   void clockSeen(jle::Stamp stamp, jle::Stamp clock) {
-    const bool clock_back = last_clock != 0 && clock < last_clock && !(stamp > last);
-    const bool stamp_back = last != 0 && static_cast<double>(last - stamp) * 1e-9 > 1.0;
-    const bool far = had_origin && std::abs(stamp - origin) > (jle::Stamp{1} << 52);
+    const bool back = last_clock != 0 && clock < last_clock;
     last_clock = clock;
-    if (clock_back || stamp_back || far) last = 0;
+    if (back) clock_back = 3;
+    if (back && !(stamp > last)) reset();
+  }
+  // Whether a joint state's stamp is rogue (dropped); a confirmed jump resets.
+  bool jointRogue(jle::Stamp stamp, jle::Stamp clock) {
+    if (last == 0) return false;
+    const double ahead = static_cast<double>(stamp - last) * 1e-9;
+    const double forward = std::max(1.0, 10e-9 * period);
+    const double lag = static_cast<double>((stamp - clock) - (last - taken_clock));
+    if ((ahead >= -1.0 && ahead <= forward) || (ahead > 0.0 && std::abs(lag) * 1e-9 <= 1.0))
+      return (pending = 0) != 0;
+    const bool follows = pending > 0 && stamp > pending_stamp &&
+                         static_cast<double>(stamp - pending_stamp) * 1e-9 <= forward;
+    pending = follows ? pending + 1 : 1;
+    pending_stamp = stamp;
+    if (pending < 3 && !(ahead < 0.0 && clock_back > 0)) return true;
+    reset();
+    return false;
+  }
+  bool wrenchRogue(jle::Stamp stamp) const {
+    const double ahead = static_cast<double>(stamp - last) * 1e-9;
+    return last != 0 && !(ahead <= 0.05 + 1e-9 * period && ahead >= -1.0);
+  }
+  void taken(jle::Stamp stamp) {
+    last = stamp;
+    taken_clock = last_clock;
+    if (clock_back > 0) --clock_back;
   }
 };
 
@@ -223,25 +255,48 @@ void decodeJointState(Bytes& in, JointMessage& js) {
 }
 
 void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stamp stamp,
-                       jle::Outcome outcome, Shadow& shadow) {
+                       jle::Stamp clock, jle::Outcome outcome, Shadow& shadow) {
   using jle::Outcome;
   if (!js.valid) {
     JLE_FUZZ_CHECK(outcome == Outcome::kInvalid && !p.problem().empty());
     return;
   }
-  JLE_FUZZ_CHECK(outcome != Outcome::kInvalid && outcome != Outcome::kFrame);
+  // A message with no needed joint is neither a sample nor a time: checked first.
   JLE_FUZZ_CHECK((outcome == Outcome::kNoJoint) == !moves(p, js));
-  if (outcome == Outcome::kNoJoint || outcome == Outcome::kWaiting) return;
+  if (outcome == Outcome::kNoJoint) return;
+  const bool rogue = !Shadow::zero(shadow.joints_stamped, stamp, clock) ||
+                     (shadow.clockSeen(stamp, clock), shadow.jointRogue(stamp, clock));
+  JLE_FUZZ_CHECK(rogue == (outcome == Outcome::kRogueStamp));
+  if (rogue) {
+    JLE_FUZZ_CHECK(!p.problem().empty());
+    return;
+  }
+  JLE_FUZZ_CHECK(outcome != Outcome::kInvalid && outcome != Outcome::kFrame);
+  if (outcome == Outcome::kWaiting) return;
   if (outcome == Outcome::kOrder) {
     JLE_FUZZ_CHECK(shadow.last != 0 && stamp <= shadow.last);
     return;
   }
   JLE_FUZZ_CHECK(shadow.last == 0 || stamp > shadow.last);
-  shadow.last = stamp;
+  shadow.taken(stamp);
   if (outcome == Outcome::kPublished) {
     JLE_FUZZ_CHECK(p.record().stamp <= stamp);
     JLE_FUZZ_CHECK(p.record().effort.size() == p.record().joint.size());
   }
+}
+
+void checkWrenchOutcome(const jle::Pipeline& p, bool finite, const std::string& frame,
+                        jle::Stamp stamp, jle::Stamp clock, jle::Outcome outcome, Shadow& shadow) {
+  using jle::Outcome;
+  if (!finite) {
+    JLE_FUZZ_CHECK(outcome == Outcome::kInvalid);
+    return;
+  }
+  const bool rogue = !Shadow::zero(shadow.wrench_stamped, stamp, clock) ||
+                     (shadow.clockSeen(stamp, clock), shadow.wrenchRogue(stamp));
+  JLE_FUZZ_CHECK(rogue == (outcome == Outcome::kRogueStamp));
+  if (rogue) JLE_FUZZ_CHECK(!p.problem().empty());
+  if (frame == "nowhere" && !rogue) JLE_FUZZ_CHECK(outcome == Outcome::kFrame);
 }
 
 }  // namespace
@@ -264,24 +319,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     advance(in, stamp, clock);
     ++messages;
     shadow.before(p);
-    const jle::Stamp effective = stamp == 0 ? clock : stamp;
     if (kind % 8 >= 6) {  // a wrench message, in a frame the URDF has or not
       Eigen::Vector3d f, mo;
       for (int i = 0; i < 3; ++i) f[i] = in.value();
       for (int i = 0; i < 3; ++i) mo[i] = in.value();
       const std::string frame = kind % 8 == 7 ? "tool0" : (kind & 8) ? "base_link" : "nowhere";
       const jle::Outcome outcome = p.onWrench(0, stamp, clock, frame, f, mo);
-      if (f.allFinite() && mo.allFinite()) shadow.clockSeen(effective, clock);
-      if (!f.allFinite() || !mo.allFinite()) JLE_FUZZ_CHECK(outcome == jle::Outcome::kInvalid);
-      if (frame == "nowhere" && f.allFinite() && mo.allFinite())
-        JLE_FUZZ_CHECK(outcome == jle::Outcome::kFrame);
+      checkWrenchOutcome(p, f.allFinite() && mo.allFinite(), frame, stamp, clock, outcome, shadow);
       continue;
     }
     decodeJointState(in, js);
     const jle::Outcome outcome =
         p.onJointState(stamp, clock, js.names, js.position, js.velocity, js.effort);
-    if (js.valid && moves(p, js)) shadow.clockSeen(effective, clock);
-    checkJointOutcome(p, js, effective, outcome, shadow);
+    checkJointOutcome(p, js, stamp, clock, outcome, shadow);
   }
   const jle::PipelineCounters& c = p.counters();
   JLE_FUZZ_CHECK(c.received(jle::InputKind::kJointState) + c.received(jle::InputKind::kWrench) ==

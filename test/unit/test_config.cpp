@@ -87,6 +87,8 @@ TEST(Config, DefaultsAreTheNodes) {
   EXPECT_EQ(s.estimator.gravity_world, Eigen::Vector3d(0.0, 0.0, -9.80665));
   EXPECT_EQ(s.diagnostic_period, 1.0);
   EXPECT_EQ(s.time_jump_threshold, 1.0);
+  EXPECT_EQ(s.stamps.regularize, jle::StampRegularize::kAuto);
+  EXPECT_EQ(s.stamps.jump_confirm, 3);
   EXPECT_EQ(s.body_mass, 0.0);
   EXPECT_TRUE(s.estimator.joints.empty());
   EXPECT_TRUE(s.wrenches.empty() && s.force_plates.empty());
@@ -149,6 +151,7 @@ TEST(Config, TopLevel) {
              {"body_mass", [](Settings& s) { s.body_mass = -1.0; }},
              {"body_mass", [](Settings& s) { s.body_mass = 70.0; }},
              {"time_jump_threshold", [](Settings& s) { s.time_jump_threshold = 1e-3; }},
+             {"stamps/jump_confirm", [](Settings& s) { s.stamps.jump_confirm = 1; }},
              {"diagnostic_period", [](Settings& s) { s.diagnostic_period = 0.01; }}},
             true);
   expectAll({{"decimation", [](Settings& s) { s.estimator.decimation = 0; }},
@@ -156,6 +159,7 @@ TEST(Config, TopLevel) {
              {"body_mass", [](Settings& s) { s.body_mass = -2.0; }},
              {"body_mass", [](Settings& s) { s.body_mass = kInf; }},
              {"time_jump_threshold", [](Settings& s) { s.time_jump_threshold = 0.0; }},
+             {"stamps/jump_confirm", [](Settings& s) { s.stamps.jump_confirm = 0; }},
              {"base_residual_threshold", [](Settings& s) { s.base_residual_threshold = -0.1; }},
              {"still_velocity", [](Settings& s) { s.still_velocity = kNaN; }},
              {"diagnostic_period", [](Settings& s) { s.diagnostic_period = 0.0; }},

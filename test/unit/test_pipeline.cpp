@@ -74,6 +74,10 @@ class FixedFrames : public jle::FrameSource {
 TEST(Pipeline, PartialMessagesGiveTheExactLoads) {
   const jle::Model<double> model = ur5();
   jle::Settings settings = finiteDifferences();
+  // The stamps are the sampling instants (q is evaluated at them), jittered about a
+  // lattice: what stamps/regularize auto takes for receive-time stamps (README, "Time
+  // stamps"). Off, they are the instants.
+  settings.stamps.regularize = jle::StampRegularize::kOff;
   addWrenchInput(settings, "tool0");
   jle::Pipeline pipeline(model, settings, nullptr);
   const std::vector<std::string> arm = {model.coordinate_names[0], model.coordinate_names[1],
@@ -259,7 +263,7 @@ TEST(Pipeline, FloatingBasePoseFromTheFrameSource) {
   EXPECT_NEAR(pipeline.estimator().data().force[0].norm(), model.totalMass() * 9.80665, 1e-9);
 }
 
-TEST(Pipeline, TimeJumpsResetAndFarStampsReanchorTheTimeAxis) {
+TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
   const jle::Model<double> model = ur5();
   jle::Pipeline pipeline(model, finiteDifferences(), nullptr);
   const std::vector<double> p(6, 0.2);
@@ -270,19 +274,205 @@ TEST(Pipeline, TimeJumpsResetAndFarStampsReanchorTheTimeAxis) {
   // Back by less than time_jump_threshold (1 s): out of order, dropped, no reset.
   EXPECT_EQ(feed(kStart, kStart + 5 * kMs), Outcome::kOrder);
   EXPECT_EQ(pipeline.counters().resets, 0);
-  // Back by 2 s (a looping bag): reset, the filters start again from this sample.
-  EXPECT_EQ(feed(kStart - 2000 * kMs, kStart + 6 * kMs), Outcome::kUsed);
+  // Back by 2 s with the clock going on (a bag's stamps looping): two rogue stamps,
+  // dropped and named; the third in a row (stamps.jump_confirm) is a jump: reset, the
+  // filters start again from it, and so does the time axis.
+  EXPECT_EQ(feed(kStart - 2000 * kMs, kStart + 6 * kMs), Outcome::kRogueStamp);
+  EXPECT_NE(pipeline.problem().find("joint_states: stamp 1699999998.1234"), std::string::npos)
+      << pipeline.problem();
+  EXPECT_NE(pipeline.problem().find("-2.004000 s from the stream's"), std::string::npos)
+      << pipeline.problem();
+  EXPECT_EQ(feed(kStart - 1999 * kMs, kStart + 7 * kMs), Outcome::kRogueStamp);
+  EXPECT_FALSE(pipeline.jumped());
+  EXPECT_EQ(pipeline.counters().resets, 0);
+  EXPECT_EQ(feed(kStart - 1998 * kMs, kStart + 8 * kMs), Outcome::kUsed);
   EXPECT_TRUE(pipeline.jumped());
+  EXPECT_EQ(pipeline.jumpFrom(), kStart + 4 * kMs);
+  EXPECT_EQ(pipeline.jumpTo(), kStart - 1998 * kMs);
+  EXPECT_EQ(pipeline.timeOrigin(), kStart - 1998 * kMs);
   EXPECT_EQ(pipeline.counters().resets, 1);
-  // The clock going back while the stamps do not move forward: a reset too.
-  EXPECT_EQ(feed(kStart - 2000 * kMs, kStart), Outcome::kUsed);
+  EXPECT_EQ(pipeline.counters().count(InputKind::kJointState, Outcome::kRogueStamp), 2);
+  // A gap of 5 s that the clock saw too (a paused driver or bag): no rogue stamp, no jump.
+  EXPECT_EQ(feed(kStart + 3002 * kMs, kStart + 5008 * kMs), Outcome::kUsed);
+  EXPECT_EQ(pipeline.counters().resets, 1);
+  EXPECT_EQ(pipeline.counters().count(InputKind::kJointState, Outcome::kRogueStamp), 2);
+  // The clock going back while the stamps do not move forward: a reset at once.
+  EXPECT_EQ(feed(kStart - 1998 * kMs, kStart), Outcome::kUsed);
   EXPECT_EQ(pipeline.counters().resets, 2);
-  // 100 days ahead: beyond what the time axis resolves to 1 ns, a new origin; the record
-  // still carries the exact stamps.
+  EXPECT_EQ(feed(kStart - 1997 * kMs, kStart + kMs), Outcome::kUsed);
+  // 100 days ahead: beyond what the time axis resolves to 1 ns, confirmed like any jump,
+  // with a new origin; the record still carries the exact stamps.
   const Stamp far = kStart + Stamp{100} * 86400 * 1000000000;
-  for (int k = 0; k < 3; ++k) feed(far + k * kMs + 1, far + k * kMs + 1);
+  for (int k = 0; k < 5; ++k)
+    EXPECT_EQ(feed(far + k * kMs + 1, far + k * kMs + 1), k < 2   ? Outcome::kRogueStamp
+                                                          : k < 4 ? Outcome::kUsed
+                                                                  : Outcome::kPublished);
   EXPECT_EQ(pipeline.counters().resets, 3);
-  EXPECT_EQ(pipeline.record().stamp, far + (2 - pipeline.estimator().delaySamples()) * kMs + 1);
+  EXPECT_EQ(pipeline.timeOrigin(), far + 2 * kMs + 1);
+  EXPECT_EQ(pipeline.record().stamp, far + (4 - pipeline.estimator().delaySamples()) * kMs + 1);
+}
+
+TEST(Pipeline, StampZeroIsTheClockOnlyOnAStreamThatNeverHadStamps) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline pipeline(model, settings, nullptr);
+  const Eigen::Vector3d f(1.0, 2.0, 3.0), m(0.3, -0.2, 0.1);
+  // A live driver that stamps nothing: the clock (the reception time) stands in.
+  for (int k = 0; k < 4; ++k) {
+    const Stamp clock = kStart + k * kMs;
+    ASSERT_EQ(pipeline.onWrench(0, 0, clock, "tool0", f, m), Outcome::kUsed);
+    const std::vector<double> p(6, 0.1 * k);
+    const Outcome o = pipeline.onJointState(0, clock, model.coordinate_names, p, kNone, kNone);
+    ASSERT_EQ(o, k < 2 ? Outcome::kUsed : Outcome::kPublished);
+  }
+  EXPECT_EQ(pipeline.record().stamp, kStart + (3 - pipeline.estimator().delaySamples()) * kMs);
+  // Once a stream has had a stamp, a stamp 0 is dropped and counted, whatever the clock.
+  const std::vector<double> p(6, 0.5);
+  EXPECT_EQ(pipeline.onJointState(kStart + 5 * kMs, kStart + 5 * kMs, model.coordinate_names, p,
+                                  kNone, kNone),
+            Outcome::kPublished);
+  EXPECT_EQ(pipeline.onJointState(0, kStart + 6 * kMs, model.coordinate_names, p, kNone, kNone),
+            Outcome::kRogueStamp);
+  EXPECT_NE(pipeline.problem().find("joint_states: stamp 0"), std::string::npos)
+      << pipeline.problem();
+  EXPECT_EQ(pipeline.onWrench(0, kStart + 6 * kMs, kStart + 6 * kMs, "tool0", f, m),
+            Outcome::kUsed);
+  EXPECT_EQ(pipeline.onWrench(0, 0, kStart + 7 * kMs, "tool0", f, m), Outcome::kRogueStamp);
+  EXPECT_NE(pipeline.problem().find("wrench 'ft': stamp 0"), std::string::npos)
+      << pipeline.problem();
+  const jle::PipelineCounters& c = pipeline.counters();
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kRogueStamp), 1);
+  EXPECT_EQ(c.count(InputKind::kWrench, Outcome::kRogueStamp), 1);
+}
+
+// Rogue stamps against the clean stream: a UR5 at 500 Hz (default settings) with a
+// 2 sin(3t) N m torque at the tool; each message's values are those of its instant t.
+struct Message {
+  bool wrench = false;
+  Stamp stamp = 0, clock = 0;
+  double t = 0.0;
+};
+
+std::vector<Message> cleanStream(int n, Stamp start, double t0) {
+  std::vector<Message> out;
+  for (int k = 0; k < n; ++k) {
+    const Stamp stamp = start + 2 * k * kMs;
+    const double t = t0 + 0.002 * k;
+    out.push_back({true, stamp, stamp, t});
+    out.push_back({false, stamp, stamp, t});
+  }
+  return out;
+}
+
+struct StreamRun {
+  std::map<Stamp, std::vector<double>> effort;  // by the record's stamp
+  jle::PipelineCounters counters;
+};
+
+StreamRun feedStream(const std::vector<Message>& messages) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline pipeline(model, settings, nullptr);
+  StreamRun out;
+  std::vector<double> p(6);
+  for (const Message& msg : messages) {
+    if (msg.wrench) {
+      const Eigen::Vector3d f(1.0, -2.0, 0.5), m(0.0, 0.0, 2.0 * std::sin(3.0 * msg.t));
+      pipeline.onWrench(0, msg.stamp, msg.clock, "tool0", f, m);
+      continue;
+    }
+    for (int i = 0; i < 6; ++i)
+      p[static_cast<std::size_t>(i)] = q(i, msg.t) + 0.1 * std::sin(msg.t);
+    if (pipeline.onJointState(msg.stamp, msg.clock, model.coordinate_names, p, kNone, kNone) ==
+        Outcome::kPublished)
+      out.effort[pipeline.record().stamp] = pipeline.record().effort;
+  }
+  out.counters = pipeline.counters();
+  return out;
+}
+
+// The loads at every stamp both runs have are the same (1e-12 N m); returns how many.
+long expectSameLoads(const StreamRun& a, const StreamRun& b) {
+  long common = 0;
+  for (const auto& kv : a.effort) {
+    const auto it = b.effort.find(kv.first);
+    if (it == b.effort.end()) continue;
+    ++common;
+    for (std::size_t i = 0; i < kv.second.size(); ++i)
+      EXPECT_NEAR(kv.second[i], it->second[i], 1e-12) << "stamp " << kv.first << " joint " << i;
+  }
+  return common;
+}
+
+constexpr Stamp kTwoHours = Stamp{7200} * 1000000000;
+
+TEST(Pipeline, ASingleRogueStampIsDroppedAndCounted) {
+  const std::vector<Message> clean = cleanStream(400, kStart, 0.0);
+  const StreamRun reference = feedStream(clean);
+  ASSERT_GT(reference.effort.size(), 390u);
+  struct Case {
+    const char* name;
+    bool wrench;
+    Stamp offset;
+  };
+  for (const Case& c :
+       {Case{"joint state 2 h back", false, -kTwoHours},
+        Case{"joint state 2 h forward", false, kTwoHours},
+        Case{"wrench 2 h ahead", true, kTwoHours}, Case{"wrench 2 h back", true, -kTwoHours}}) {
+    SCOPED_TRACE(c.name);
+    std::vector<Message> hostile = clean;
+    const Message& at = clean[2 * 200 + 1];  // the 200th joint state
+    hostile.insert(hostile.begin() + 2 * 200 + 2,
+                   {c.wrench, at.stamp + c.offset, at.clock + kMs, at.t + 0.001});
+    const StreamRun r = feedStream(hostile);
+    EXPECT_EQ(expectSameLoads(r, reference), static_cast<long>(reference.effort.size()));
+    EXPECT_EQ(r.effort.size(), reference.effort.size());
+    const InputKind kind = c.wrench ? InputKind::kWrench : InputKind::kJointState;
+    EXPECT_EQ(r.counters.count(kind, Outcome::kRogueStamp), 1);
+    EXPECT_EQ(r.counters.count(Outcome::kRogueStamp), 1);
+    EXPECT_EQ(r.counters.resets, 0);
+    // Every later good reading of that input is used again.
+    EXPECT_EQ(r.counters.count(InputKind::kWrench, Outcome::kUsed),
+              reference.counters.count(InputKind::kWrench, Outcome::kUsed));
+    EXPECT_EQ(r.counters.count(InputKind::kJointState, Outcome::kPublished),
+              reference.counters.count(InputKind::kJointState, Outcome::kPublished));
+  }
+}
+
+TEST(Pipeline, AConfirmedJumpResetsAsAFreshStartWould) {
+  // 1 s, then the stamps go back by 10 s and run on, the clock going on (a driver's
+  // clock set back).
+  std::vector<Message> stream = cleanStream(500, kStart, 0.0);
+  std::vector<Message> after = cleanStream(300, kStart - 9000 * kMs, 1.0);
+  for (Message& m : after) m.clock += 10000 * kMs;
+  stream.insert(stream.end(), after.begin(), after.end());
+  const StreamRun jumped = feedStream(stream);
+  // A fresh start from the confirming joint state (the third of the new timeline): the
+  // two before it and the three wrenches until it were rogue stamps.
+  const StreamRun fresh = feedStream(std::vector<Message>(after.begin() + 5, after.end()));
+  EXPECT_EQ(expectSameLoads(jumped, fresh), static_cast<long>(fresh.effort.size()));
+  EXPECT_EQ(jumped.counters.resets, 1);
+  EXPECT_EQ(jumped.counters.count(InputKind::kJointState, Outcome::kRogueStamp), 2);
+  EXPECT_EQ(jumped.counters.count(InputKind::kWrench, Outcome::kRogueStamp), 3);
+  // After the jump, only loads of the new timeline (all before kStart), as many as fresh.
+  long after_jump = 0;
+  for (const auto& kv : jumped.effort) after_jump += kv.first < kStart;
+  EXPECT_EQ(after_jump, static_cast<long>(fresh.effort.size()));
+  EXPECT_GT(after_jump, 280);
+}
+
+TEST(Pipeline, ALoopingBagWithItsClockResetsAtOnce) {
+  // rosbag play -l under use_sim_time: the clock goes back with the stamps.
+  std::vector<Message> stream = cleanStream(500, kStart, 0.0);
+  const std::vector<Message> loop = cleanStream(300, kStart, 0.0);
+  stream.insert(stream.end(), loop.begin(), loop.end());
+  const StreamRun looped = feedStream(stream);
+  const StreamRun fresh = feedStream(loop);
+  EXPECT_EQ(expectSameLoads(looped, fresh), static_cast<long>(fresh.effort.size()));
+  EXPECT_EQ(looped.counters.resets, 1);
+  EXPECT_EQ(looped.counters.count(Outcome::kRogueStamp), 0);
 }
 
 TEST(Pipeline, MalformedMessagesAreCountedAndNamed) {
@@ -314,9 +504,9 @@ TEST(Pipeline, MalformedMessagesAreCountedAndNamed) {
   EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kInvalid), 3);
   EXPECT_EQ(c.unknown_joints, 1);
   EXPECT_EQ(c.received(InputKind::kWrench), 2);
-  // Stamp 0 takes the clock: the next message at that clock is a duplicate.
+  // Stamp 0 on a stream that has had stamps: dropped (README, "Time stamps").
   EXPECT_EQ(pipeline.onJointState(0, kStart, names, std::vector<double>(6), kNone, kNone),
-            Outcome::kOrder);
+            Outcome::kRogueStamp);
 }
 
 }  // namespace

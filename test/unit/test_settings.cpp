@@ -164,6 +164,8 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(world_frame);
   EXPECT_SAME(base_frame);
   EXPECT_SAME(time_jump_threshold);
+  EXPECT_SAME(stamps.regularize);
+  EXPECT_SAME(stamps.jump_confirm);
   EXPECT_SAME(keep_fixed_joints);
   EXPECT_SAME(base_residual_threshold);
   EXPECT_SAME(still_velocity);
@@ -193,6 +195,7 @@ const Refused kRefused[] = {
     {"ko_force_plates.yaml", "'force_plates[1]/name'", "names another plate too"},
     {"ko_uncertainty.yaml", "'uncertainty/position_noise'", "must be finite and >= 0"},
     {"ko_savings.yaml", "'savings/static_velocity'", "must be finite and >= 0"},
+    {"ko_stamps.yaml", "'stamps/jump_confirm'", "must be >= 1"},
 };
 
 TEST(SettingsReader, EachKoFileIsRefusedWithItsReason) {
@@ -318,6 +321,17 @@ TEST(SettingsReader, SavingsKeys) {
   EXPECT_EQ(jle::parseSettings(params).estimator.savings.planar, jle::PlanarMode::kOff);
 }
 
+TEST(SettingsReader, StampsKeys) {
+  Settings e;
+  e.stamps.regularize = jle::StampRegularize::kOff;
+  e.stamps.jump_confirm = 5;
+  expectSame(parseFile(kConfig + "/ok_stamps.yaml"), e);
+  // rosparam reads YAML 1.1, where a bare off is a boolean.
+  XmlRpc::XmlRpcValue params;
+  params["stamps"]["regularize"] = false;
+  EXPECT_EQ(jle::parseSettings(params).stamps.regularize, jle::StampRegularize::kOff);
+}
+
 // What the reader itself refuses (validate() never sees these): a wrong type, an
 // unknown key or name, a missing section shape.
 TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
@@ -344,6 +358,8 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
   expectRefused("force_plates: [{name: a, topic: t, link: f, orientation: [0, 0, 0, 0]}]",
                 "'force_plates[0]/orientation' must be a quaternion");
   expectRefused("savings: [prune]", "parameter 'savings' must be a map");
+  expectRefused("stamps: {regularize: always}",
+                "parameter 'stamps/regularize' is 'always'; expected one of auto, off");
   expectRefused("diagnostics_period: 1", "unknown parameter 'diagnostics_period'");
   // Issue 14: an empty topic and a joint listed twice are refused at start, key named.
   expectRefused("joint_states_topic: ''", "parameter 'joint_states_topic' is required");
@@ -365,7 +381,7 @@ TEST(SettingsDocs, DefaultYamlIsSettingsDefaults) {
 // config/default.yaml: top-level keys at the top, a map's keys in that map.
 TEST(SettingsDocs, DefaultYamlListsEveryKey) {
   XmlRpc::XmlRpcValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
-  for (const char* family : {"top_level", "differentiator", "savings", "uncertainty"}) {
+  for (const char* family : {"top_level", "differentiator", "savings", "uncertainty", "stamps"}) {
     XmlRpc::XmlRpcValue ok = jle::loadYaml(kConfig + "/ok_" + family + ".yaml");
     for (auto& kv : ok) {
       ASSERT_TRUE(defaults.hasMember(kv.first)) << kv.first << " is not in config/default.yaml";
