@@ -128,12 +128,12 @@ class Pipeline {
   Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames);
 
   /// A joint state: names, positions (same size), velocities and efforts (empty or the
-  /// same size; a non-finite effort only drops that joint's measured effort). `clock` is the front end's clock when the message arrived (the node:
-  /// ros::Time::now(); a bag: the message's bag time): it going back confirms a backward
-  /// jump of time (a looping bag), and it stands for stamp 0 on a stream that never had
-  /// a stamp (README, "Time stamps"). The estimator is fed the sample's instant (the
-  /// stamp, or with stamps/regularize the SampleClock's estimate); the loads keep the
-  /// message's own stamp.
+  /// same size; a non-finite effort only drops that joint's measured effort). `clock` is the front
+  /// end's clock when the message arrived (the node: ros::Time::now(); a bag: the message's bag
+  /// time): it going back confirms a backward jump of time (a looping bag), and it stands for stamp
+  /// 0 on a stream that never had a stamp (README, "Time stamps"). The estimator is fed the
+  /// sample's instant (the stamp, or with stamps/regularize the SampleClock's estimate); the loads
+  /// keep the message's own stamp.
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
                        const std::vector<double>& position, const std::vector<double>& velocity,
                        const std::vector<double>& effort);
