@@ -212,7 +212,7 @@ enum class StampRegularize : std::uint8_t {
 
 /// The joint-state stream's time base and its rogue stamps (stamps/...).
 struct StampSettings {
-  StampRegularize regularize = StampRegularize::kAuto;
+  StampRegularize regularize = StampRegularize::kOff;
   /// Consecutive joint states on a new timeline (each more than time_jump_threshold
   /// from the last taken stamp, back or forward, in order among themselves) that confirm
   /// a jump of time (>= 1); fewer are dropped as rogue stamps. The clock going back

@@ -32,11 +32,12 @@ enum class KalmanModel : std::uint8_t {
   kConstantJerk,          ///< state (x, x', x'', x'''), white noise on x''''
 };
 
-/// The default is what the node runs (config/default.yaml): the adaptive filter
-/// (constant-jerk Kalman filters from 0.5 to 50 Hz, the noise estimated online), tuned by
-/// the data rather than by hand (README "Differentiators").
+/// The default is what the node runs (config/default.yaml): the constant-jerk Kalman
+/// filter, process noise 1e4, measurement noise 1e-4 rad. The adaptive filter is an
+/// option: better on the accuracy study's scenes of real logs, worse on clean ones, and
+/// its noise gain understates the q'' noise (README "Differentiators").
 struct DifferentiatorConfig {
-  DifferentiatorType type = DifferentiatorType::kAdaptive;
+  DifferentiatorType type = DifferentiatorType::kKalman;
   /// Savitzky-Golay: samples in the fit and degree of the polynomial (2..5). The
   /// estimate describes the sample `delay` steps before the newest: 0 is causal,
   /// (window - 1) / 2 is centred. Finite differences use window = order + 1.

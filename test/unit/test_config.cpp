@@ -67,12 +67,12 @@ void expectAll(const std::vector<Change>& changes, bool ok) {
 }
 
 TEST(Config, DefaultsAreTheNodes) {
-  // The differentiator the node runs (README "Differentiators"): adaptive constant-jerk
-  // Kalman filters from 0.5 to 50 Hz, the noise estimated, a 1 s likelihood; the fixed
-  // Kalman filter's keys keep q = 1e4, r = 1e-4 rad. An Estimator built from
-  // EstimatorConfig{} runs the same.
+  // The differentiator the node runs (README "Differentiators"): the constant-jerk Kalman
+  // filter, q = 1e4, r = 1e-4 rad; the adaptive filter's keys default to 0.5 to 50 Hz,
+  // the noise estimated, a 1 s likelihood. An Estimator built from EstimatorConfig{} runs
+  // the same.
   const jle::DifferentiatorConfig d;
-  EXPECT_EQ(d.type, jle::DifferentiatorType::kAdaptive);
+  EXPECT_EQ(d.type, jle::DifferentiatorType::kKalman);
   EXPECT_EQ(d.kalman_model, jle::KalmanModel::kConstantJerk);
   EXPECT_EQ(d.process_noise, 1e4);
   EXPECT_EQ(d.measurement_noise, 1e-4);
@@ -82,12 +82,12 @@ TEST(Config, DefaultsAreTheNodes) {
   EXPECT_EQ(d.noise, 0.0);
   EXPECT_EQ(d.memory, 1.0);
   const Settings s;
-  EXPECT_EQ(s.estimator.differentiator.type, jle::DifferentiatorType::kAdaptive);
+  EXPECT_EQ(s.estimator.differentiator.type, jle::DifferentiatorType::kKalman);
   EXPECT_EQ(s.estimator.decimation, 1);
   EXPECT_EQ(s.estimator.gravity_world, Eigen::Vector3d(0.0, 0.0, -9.80665));
   EXPECT_EQ(s.diagnostic_period, 1.0);
   EXPECT_EQ(s.time_jump_threshold, 1.0);
-  EXPECT_EQ(s.stamps.regularize, jle::StampRegularize::kAuto);
+  EXPECT_EQ(s.stamps.regularize, jle::StampRegularize::kOff);
   EXPECT_EQ(s.stamps.jump_confirm, 3);
   EXPECT_EQ(s.body_mass, 0.0);
   EXPECT_TRUE(s.estimator.joints.empty());
@@ -110,7 +110,7 @@ TEST(Config, DefaultsAreTheNodes) {
   const jle::Model<double> ur5 =
       jle::modelFromUrdfFile(std::string(JLE_TEST_DATA) + "/urdf/chains/ur5_chain.urdf");
   const jle::Estimator estimator(ur5, jle::EstimatorConfig{});
-  EXPECT_EQ(estimator.config().differentiator.type, jle::DifferentiatorType::kAdaptive);
+  EXPECT_EQ(estimator.config().differentiator.type, jle::DifferentiatorType::kKalman);
   EXPECT_EQ(estimator.config().differentiator.kalman_model, jle::KalmanModel::kConstantJerk);
 }
 
@@ -184,6 +184,9 @@ TEST(Config, Differentiator) {
   auto kalman = [](Settings& s) {
     s.estimator.differentiator.type = jle::DifferentiatorType::kKalman;
   };
+  auto adaptive = [](Settings& s) {
+    s.estimator.differentiator.type = jle::DifferentiatorType::kAdaptive;
+  };
   expectAll(
       {{"differentiator/order",
         [&](Settings& s) {
@@ -235,11 +238,25 @@ TEST(Config, Differentiator) {
         }},
        {"differentiator/max_gap", [](Settings& s) { s.estimator.differentiator.max_gap = -1.0; }},
        {"differentiator/min_bandwidth",
-        [](Settings& s) { s.estimator.differentiator.min_bandwidth = 0.0; }},
+        [&](Settings& s) {
+          adaptive(s);
+          s.estimator.differentiator.min_bandwidth = 0.0;
+        }},
        {"differentiator/max_bandwidth",
-        [](Settings& s) { s.estimator.differentiator.max_bandwidth = 0.1; }},
-       {"differentiator/noise", [](Settings& s) { s.estimator.differentiator.noise = -1e-4; }},
-       {"differentiator/memory", [](Settings& s) { s.estimator.differentiator.memory = kNaN; }}},
+        [&](Settings& s) {
+          adaptive(s);
+          s.estimator.differentiator.max_bandwidth = 0.1;
+        }},
+       {"differentiator/noise",
+        [&](Settings& s) {
+          adaptive(s);
+          s.estimator.differentiator.noise = -1e-4;
+        }},
+       {"differentiator/memory",
+        [&](Settings& s) {
+          adaptive(s);
+          s.estimator.differentiator.memory = kNaN;
+        }}},
       false);
 }
 

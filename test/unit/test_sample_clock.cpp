@@ -131,7 +131,7 @@ TEST(SampleClock, ReceiveTimeStampsGiveTheInstants) {
 }
 
 // The Panda at 1 kHz, positions (noise 2e-4 rad) and an F/T reading at the hand, with
-// receive-time stamps: the default settings (stamps/regularize auto) against off. The
+// receive-time stamps: the default settings with stamps/regularize auto against off. The
 // published loads carry the messages' own stamps; each is scored against the truth at
 // the instant its sample was taken.
 struct Scored {

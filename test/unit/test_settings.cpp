@@ -323,13 +323,15 @@ TEST(SettingsReader, SavingsKeys) {
 
 TEST(SettingsReader, StampsKeys) {
   Settings e;
-  e.stamps.regularize = jle::StampRegularize::kOff;
+  e.stamps.regularize = jle::StampRegularize::kAuto;
   e.stamps.jump_confirm = 5;
   expectSame(parseFile(kConfig + "/ok_stamps.yaml"), e);
   // rosparam reads YAML 1.1, where a bare off is a boolean.
   XmlRpc::XmlRpcValue params;
   params["stamps"]["regularize"] = false;
   EXPECT_EQ(jle::parseSettings(params).stamps.regularize, jle::StampRegularize::kOff);
+  params["stamps"]["regularize"] = true;  // a bare on
+  EXPECT_EQ(jle::parseSettings(params).stamps.regularize, jle::StampRegularize::kAuto);
 }
 
 // What the reader itself refuses (validate() never sees these): a wrong type, an
