@@ -63,7 +63,7 @@ struct PipelineCounters {
              static_cast<int>(InputKind::kCount)>
       outcomes{};
   long unknown_joints = 0;  ///< joint states naming a joint the model does not have
-  long resets = 0;          ///< backward time jumps (the filters were reset)
+  long resets = 0;          ///< jumps of time, back or confirmed forward (the filters were reset)
   /// joint states with a non-finite effort (that joint's measured effort is none; the
   /// loads are computed)
   long nonfinite_efforts = 0;

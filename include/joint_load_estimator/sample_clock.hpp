@@ -26,9 +26,10 @@ class SampleClock {
 
   /// Whether the stream is periodic with jittered stamps: its instants are estimated.
   bool regular() const { return regular_; }
-  /// The stream's mean spacing [ns] over the window (the fit's slope), 0 before the
-  /// first fit.
-  double period() const { return fitted_ ? slope_ : 0.0; }
+  /// The stream's mean spacing [ns] over the window (the fit's slope); before the first
+  /// fit, and always with `regularize` false, the last spacing of the stamps (0 before
+  /// the second sample).
+  double period() const { return fitted_ ? slope_ : last_spacing_; }
   /// The robust scale (1.4826 MAD) [ns] of the stamps about the fitted lattice.
   double jitter() const { return scale_; }
 
@@ -54,6 +55,8 @@ class SampleClock {
   double spacing_ = 0.0;  // [ns] median spacing of consecutive samples in the window
   bool fitted_ = false, regular_ = false;
   std::int64_t last_instant_ = 0;
+  std::int64_t last_stamp_ = 0;
+  double last_spacing_ = 0.0;  // [ns] between the last two stamps
 };
 
 }  // namespace jle

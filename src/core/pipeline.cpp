@@ -274,9 +274,10 @@ Outcome Pipeline::checkInputStamp(InputKind kind, const std::string& input, doub
                                   Stamp stamp, Stamp clock) {
   if (clockWentBack(stamp, clock)) resetTimeline(stamp);
   if (last_stamp_ == 0) return Outcome::kUsed;  // no joint state on this timeline yet
-  // The joint states may be a period behind a reading that is on time.
+  // The joint states may lag a reading that is on time by a few periods (a sensor whose
+  // readings arrive before the joint states of their time): ten are allowed.
   const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
-  if (ahead <= timeout + 1e-9 * clock_.period() && ahead >= -settings_.time_jump_threshold)
+  if (ahead <= timeout + 1e-8 * clock_.period() && ahead >= -settings_.time_jump_threshold)
     return Outcome::kUsed;
   return fail(kind, Outcome::kRogueStamp,
               input + ": stamp " + seconds(stamp) + " is " + std::to_string(ahead) +

@@ -33,7 +33,8 @@ void SampleClock::reset() {
   head_ = count_ = 0;
   fitted_ = regular_ = false;
   intercept_ = slope_ = scale_ = spacing_ = 0.0;
-  last_instant_ = 0;
+  last_instant_ = last_stamp_ = 0;
+  last_spacing_ = 0.0;
 }
 
 const SampleClock::Point& SampleClock::point(int i) const {
@@ -70,6 +71,8 @@ double SampleClock::nextIndex(std::int64_t stamp) {
 }
 
 std::int64_t SampleClock::add(std::int64_t stamp) {
+  if (count_ > 0 || last_stamp_ != 0) last_spacing_ = static_cast<double>(stamp - last_stamp_);
+  last_stamp_ = stamp;
   if (!enabled_) return stamp;
   const double index = count_ == 0 ? 0.0 : nextIndex(stamp);
   Point& p = ring_[static_cast<std::size_t>(head_)];

@@ -204,9 +204,11 @@ struct Shadow {
     reset();
     return false;
   }
+  // Ahead of the joint states by more than the timeout plus ten periods, or behind by more
+  // than the jump threshold.
   bool wrenchRogue(jle::Stamp stamp) const {
     const double ahead = static_cast<double>(stamp - last) * 1e-9;
-    return last != 0 && !(ahead <= 0.05 + 1e-9 * period && ahead >= -1.0);
+    return last != 0 && !(ahead <= 0.05 + 1e-8 * period && ahead >= -1.0);
   }
   void taken(jle::Stamp stamp) {
     last = stamp;

@@ -90,9 +90,10 @@ class SensorNode {
 
   // Sends samples 1 ms apart from `origin` (each wrench `kLead` samples ahead
   // of the joint state of its stamp, so that the node holds it when the joint
-  // state comes) and calls check(t, residual) for every residual, until
-  // `samples` are sent or stop() holds. Returns the number of residuals checked
-  // (all but the warm-up and the first few that came before their reading).
+  // state comes; no more than its timeout plus ten joint periods ahead of the
+  // joint states, or it is a rogue stamp: README "Time stamps") and calls check(t, residual) for
+  // every residual, until `samples` are sent or stop() holds. Returns the number of residuals
+  // checked (all but the warm-up and the first few that came before their reading).
   static constexpr int kLead = 5;
   int run(
       const ros::Time& origin, int samples, const std::function<Sample(const ros::Time&)>& at,

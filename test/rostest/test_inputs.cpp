@@ -233,38 +233,48 @@ TEST(Inputs, BackwardTimeJumpRestartsTheFilters) {
   a << 2.0, -1.0, 3.0, -2.0, 1.5, -2.5;
   auto q = [&](double s) { return VectorXd(q0 + v0 * s + 0.5 * a * s * s); };
   const int window = 9, samples = 30;
+  // After a jump, the first joint states of the new timeline may reach the node before
+  // the /clock message that moved the clock with them: until it comes they are rogue
+  // stamps (README "Time stamps"), at most stamps/jump_confirm - 1 = 2 of them, and the
+  // first publication is up to 2 samples later.
+  const int late = 2;
 
-  auto play = [&](const ros::Time& start) {
+  auto play = [&](const ros::Time& start, int unchecked) {
     for (int k = 0; k < samples; ++k) {
       const ros::Time t = at(start, k);
       const double s = (t - start).toSec();
       node.send(jointState(t, ref.model.coordinate_names, q(s)));
-      if (k < window - 1) continue;
+      if (k < window - 1 + unchecked) continue;
       const auto msg = node.loads().waitForStamp(t);
       ASSERT_TRUE(msg) << "no loads stamped " << t;
       ref.compute(q(s), VectorXd(v0 + a * s), a);
       EXPECT_LT(ref.relativeError(*msg), kRel) << t;
     }
   };
-  play(bag_start);
+  play(bag_start, 0);
   const std::size_t before_jump = node.loads().size();
   ASSERT_EQ(before_jump, static_cast<std::size_t>(samples - (window - 1)));
 
   const ros::Time loop_start = bag_start - ros::Duration(5.0);
-  play(loop_start);
+  play(loop_start, late);
   ASSERT_GT(node.loads().size(), before_jump);
-  // The first publication after the jump is the 9th sample of the new timeline.
-  EXPECT_EQ(node.loads().msgs()[before_jump]->header.stamp, at(loop_start, window - 1));
+  // The first publication after the jump is the 9th sample of the new timeline (up to
+  // `late` samples later).
+  const ros::Time first = node.loads().msgs()[before_jump]->header.stamp;
+  EXPECT_TRUE(first >= at(loop_start, window - 1) && first <= at(loop_start, window - 1 + late))
+      << "first published " << first;
   for (std::size_t i = before_jump; i < node.loads().size(); ++i) {
     const ros::Time& stamp = node.loads().msgs()[i]->header.stamp;
     EXPECT_TRUE(stamp >= loop_start && stamp < bag_start) << "published " << stamp;
   }
-  EXPECT_EQ(node.loads().size() - before_jump, static_cast<std::size_t>(samples - (window - 1)));
+  EXPECT_LE(node.loads().size() - before_jump, static_cast<std::size_t>(samples - (window - 1)));
+  EXPECT_GE(node.loads().size() - before_jump,
+            static_cast<std::size_t>(samples - (window - 1) - late));
 
   // Play on 7 s later, past the diagnostics period (1 s of node time) counted from before
   // the jump: the warning was given once, and the diagnostics of the first publication
   // count one jump and no dropped sample.
-  play(bag_start + ros::Duration(2.0));
+  play(bag_start + ros::Duration(2.0), late);
   ASSERT_TRUE(log.waitFor(node.name(), rosgraph_msgs::Log::WARN, {"time jumped back"}));
   ASSERT_TRUE(
       waitFor([&] { return diag.latest(node.status(), "joint states received") > 2 * samples; }));
@@ -295,11 +305,14 @@ class BadInput : public ::testing::Test {
     ref_.compute(q_, VectorXd::Zero(6), VectorXd::Zero(6));
   }
 
-  // Three good samples 3 s after the last stamp used; waits for the publication of the
-  // third, and for the diagnostics that count them.
+  // Good samples 3 s after the last stamp used, with the clock standing still: a jump of
+  // time forward, which the first two confirm as rogue stamps (stamps/jump_confirm 3,
+  // README "Time stamps") and the third restarts the filter from; two more make the
+  // three the fit needs. Waits for the publication of the last, and for the
+  // diagnostics that count them.
   void prime() {
     next_ = next_ + ros::Duration(3.0);
-    for (int k = 0; k < 3; ++k) node_.send(good(tick()));
+    for (int k = 0; k < 5; ++k) node_.send(good(tick()));
     ASSERT_TRUE(node_.loads().waitForStamp(last_)) << "no loads after priming at " << last_;
     // The diagnostics come on the node's wall-clock timer (diagnostic_period 0.1 s in
     // inputs.test), whatever the inputs do.
@@ -420,6 +433,7 @@ TEST_F(BadInput, WrongNumberOfVelocitiesIsDropped) {
 TEST_F(BadInput, DuplicateAndOutOfOrderStampsAreDropped) {
   prime();
   const long before = counter("dropped: stamp order");
+  const long jumps = counter("time jumps back");
   const ros::Time newest = last_;
   sensor_msgs::JointState dup = good(newest), old = good(newest - ros::Duration(0, 500000));
   dup.position[0] += 0.1;  // if it were used, the loads would show it
@@ -436,7 +450,9 @@ TEST_F(BadInput, DuplicateAndOutOfOrderStampsAreDropped) {
   EXPECT_TRUE(log_.waitFor(node_.name(), rosgraph_msgs::Log::WARN, {"duplicate stamp"}));
   prime();
   EXPECT_EQ(counter("dropped: stamp order"), before + 2);
-  EXPECT_EQ(counter("time jumps back"), 0);
+  // Neither message reset anything; prime()'s own jump forward may count one (when its
+  // first joint states reach the node before the /clock message that moved the clock).
+  EXPECT_LE(counter("time jumps back"), jumps + 1);
 }
 
 // A wrench in a frame neither the URDF nor tf2 knows: dropped with an error naming it;
