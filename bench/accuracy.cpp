@@ -176,6 +176,10 @@ void addKalman(bool quick, std::vector<Differentiator>& out) {
     std::snprintf(label, sizeof label, "KF-CJ q=%.0e", q);
     add(label, "kalman_cj", c);
   }
+  // The adaptive bank (type: adaptive) with its keys' defaults: the noise estimated.
+  jle::DifferentiatorConfig adaptive;
+  adaptive.type = jle::DifferentiatorType::kAdaptive;
+  out.push_back({"adaptive", "adaptive", adaptive, adaptive.measurement_noise, false, {}});
   if (!quick) {
     // The filters with the measurement noise left at DifferentiatorConfig's default
     // (1e-4 rad), not matched to the encoder: the Kalman settings shipped before the
