@@ -74,18 +74,21 @@ struct CovarianceWorkspace {
   std::vector<int> sweep_mark;  ///< per segment: the coordinate being swept + 1, or 0
 
   /// uncertainty.period: the last three computed covariances (newest first) per segment,
-  /// their stamps [s], the noise gain of the newest, and how many are valid.
+  /// their stamps [s] and noise gains, and how many are valid.
   std::vector<Matrix6> last, prev, prev2;
   double time[3] = {0.0, 0.0, 0.0};
-  Eigen::Matrix3d gain = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d gain[3] = {Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero(),
+                             Eigen::Matrix3d::Zero()};
   int history = 0;
 };
 
 /// uncertainty.period: at stamp t [s] with the filter's noise gain `gain`, the quadratic
 /// through the last three computed covariances when t is less than a period after the
-/// newest and the gain has stayed within gain_tolerance (true); false: the covariance is
-/// to be computed (computeCovariance). A stamp not after the newest, more than three
-/// periods after it, or a changed gain restarts the history.
+/// newest and `gain` is within gain_tolerance of the gain of each of the three (true);
+/// false: the covariance is to be computed (computeCovariance). A stamp not after the
+/// newest, more than three periods after it, or a gain away from the newest's restarts
+/// the history. While a filter settles (after a start, a gap or a reset) its gain moves
+/// from one node to the next, so those samples are all computed.
 bool extrapolateCovariance(const CovarianceModel& cm, CovarianceWorkspace& ws,
                            const Eigen::Matrix3d& gain, double t);
 

@@ -84,44 +84,97 @@ DiagnosticsLog& diagnosticsLog() {
 
 double wallNow() { return ros::WallTime::now().toSec(); }
 
+// What a hostile kind sends beside the good sample: joint states and wrenches to the
+// hostile node (numbered as the node counts them).
+struct HostileSend {
+  std::function<void(sensor_msgs::JointState)> joint;
+  std::function<void(geometry_msgs::WrenchStamped)> wrench;
+};
+
 // One hostile kind: what it does to the hostile copy of a good sample `js` (sending
-// its own messages with `send`, which numbers them), and the key counting it.
+// its own messages with `send`), and the key counting it.
 struct Kind {
+  const char* name;  // the test's name
   const char* what;
   const char* key;
-  std::function<void(sensor_msgs::JointState& js,
-                     const std::function<void(sensor_msgs::JointState)>& send)>
-      apply;
+  std::function<void(sensor_msgs::JointState& js, const HostileSend& send)> apply;
 };
+
+// A joint state of the sample `js`, 0.3 rad off, stamped `stamp`.
+sensor_msgs::JointState offBy(const sensor_msgs::JointState& js, const ros::Time& stamp) {
+  sensor_msgs::JointState bad = js;
+  bad.header.stamp = stamp;
+  for (double& q : bad.position) q += 0.3;
+  return bad;
+}
+
+// A wrench of 1000 N stamped `stamp`: used, it would change every load.
+geometry_msgs::WrenchStamped wild(const ros::Time& stamp) {
+  geometry_msgs::WrenchStamped w;
+  w.header.stamp = stamp;
+  w.header.frame_id = "tool0";
+  w.wrench.force.x = 1000.0;
+  w.wrench.torque.y = -100.0;
+  return w;
+}
+
+const ros::Duration kTwoHours(7200.0);
 
 const std::vector<Kind>& kinds() {
   static const std::vector<Kind> table = {
-      {"a joint named twice, the second 0.5 rad off", "dropped: invalid",
-       [](sensor_msgs::JointState& js, const auto& send) {
+      {"DuplicateName", "a joint named twice, the second 0.5 rad off", "dropped: invalid",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
          sensor_msgs::JointState bad = js;
          bad.name.push_back(js.name[1]);
          bad.position.push_back(js.position[1] + 0.5);
          bad.effort.push_back(0.0);
-         send(bad);
+         send.joint(bad);
        }},
-      {"an empty joint state", "not used: no needed joint",
-       [](sensor_msgs::JointState& js, const auto& send) {
+      {"EmptyJointState", "an empty joint state", "not used: no needed joint",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
          sensor_msgs::JointState empty;
          empty.header.stamp = js.header.stamp - ros::Duration(0.0005);
-         send(empty);
+         send.joint(empty);
        }},
-      {"a gripper's joint alone", "not used: no needed joint",
-       [](sensor_msgs::JointState& js, const auto& send) {
+      {"OtherPublishersJoint", "a gripper's joint alone", "not used: no needed joint",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
          sensor_msgs::JointState gripper;
          gripper.header.stamp = js.header.stamp - ros::Duration(0.0003);
          gripper.name = {"gripper_finger_joint"};
          gripper.position = {0.02};
-         send(gripper);
+         send.joint(gripper);
        }},
-      {"a NaN effort", "efforts not compared: non-finite",
-       [](sensor_msgs::JointState& js, const auto&) {
+      {"NanEffort", "a NaN effort", "efforts not compared: non-finite",
+       [](sensor_msgs::JointState& js, const HostileSend&) {
          js.effort[2] = std::numeric_limits<double>::quiet_NaN();
        }},
+      // Stamps (README, "Time stamps"): a single outlier is not a jump of time.
+      {"JointStateTwoHoursAhead", "a joint state stamped 2 h ahead", "dropped: rogue stamp",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.joint(offBy(js, js.header.stamp + kTwoHours));
+       }},
+      {"JointStateTwoHoursBack", "a joint state stamped 2 h back", "dropped: rogue stamp",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.joint(offBy(js, js.header.stamp - kTwoHours));
+       }},
+      {"JointStateStampedZero", "a joint state stamped 0 on a stamped stream", "dropped: rogue stamp",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.joint(offBy(js, ros::Time()));
+       }},
+      {"WrenchTwoHoursAhead", "a wrench stamped 2 h ahead", "dropped: rogue stamp",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.wrench(wild(js.header.stamp + kTwoHours));
+       }},
+      {"WrenchTwoHoursBack", "a wrench stamped 2 h back", "dropped: rogue stamp",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.wrench(wild(js.header.stamp - kTwoHours));
+       }},
+      {"WrenchAheadOfItsTimeout", "a wrench ahead of the joint states by 0.5 s (timeout 0.05 s)", "dropped: rogue stamp",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.wrench(wild(js.header.stamp + ros::Duration(0.5)));
+       }},
+      {"WrenchStampedZero", "a wrench stamped 0 on a stamped input", "dropped: rogue stamp",
+       [](sensor_msgs::JointState&, const HostileSend& send) { send.wrench(wild(ros::Time())); }},
   };
   return table;
 }
@@ -137,11 +190,14 @@ void play(NodeUnderTest& node, const std::vector<std::string>& names, const ros:
   }
 }
 
-// Every load of `clean` is in `hostile` at the same stamp, equal to kExact; the loads
-// whose measured effort of joint 2 only the hostile copy lacks (NaN effort), counted.
-long sameLoads(const LoadsRecorder& clean, const LoadsRecorder& hostile) {
+// Every load of `clean` stamped in [from, to] is in `hostile` at the same stamp, equal
+// to kExact; the loads whose measured effort of joint 2 only the hostile copy lacks (NaN
+// effort), counted.
+long sameLoads(const LoadsRecorder& clean, const LoadsRecorder& hostile, const ros::Time& from,
+               const ros::Time& to) {
   long nan_compared = 0;
   for (const auto& c : clean.msgs()) {
+    if (c->header.stamp < from || c->header.stamp > to) continue;
     const auto h = hostile.find(c->header.stamp);
     EXPECT_TRUE(h) << "no hostile loads at " << c->header.stamp;
     if (!h) return -1;
@@ -158,30 +214,96 @@ long sameLoads(const LoadsRecorder& clean, const LoadsRecorder& hostile) {
   return nan_compared;
 }
 
-TEST(Hostile, AHostileMessageEveryTenSamplesChangesNoLoadsAndIsCounted) {
-  NodeUnderTest clean("clean"), hostile("hostile");
-  ASSERT_TRUE(clean.connect());
-  ASSERT_TRUE(hostile.connect());
+// The loads published in [from, to] by a node.
+long loadsIn(const LoadsRecorder& loads, const ros::Time& from, const ros::Time& to) {
+  long n = 0;
+  for (const auto& m : loads.msgs()) n += m->header.stamp >= from && m->header.stamp <= to;
+  return n;
+}
+
+// The clean and the hostile node of hostile.test, with their tool-wrench inputs.
+struct HostilePair {
+  NodeUnderTest clean{"clean"}, hostile{"hostile"};
+  ros::Publisher clean_ft = nh().advertise<geometry_msgs::WrenchStamped>("/clean/ft", 1000);
+  ros::Publisher hostile_ft = nh().advertise<geometry_msgs::WrenchStamped>("/hostile/ft", 1000);
+  bool connected = false;
+  // Both nodes get the same constant tool wrench at every sample: whichever order its
+  // reading and the joint state arrive in, each node reads the same value, so the two
+  // nodes' loads stay equal bit for bit while a used wild reading would not.
+  geometry_msgs::WrenchStamped tool;
+
+  ::testing::AssertionResult connect() {
+    if (connected) return ::testing::AssertionSuccess();
+    for (NodeUnderTest* n : {&clean, &hostile})
+      if (::testing::AssertionResult r = n->connect(); !r) return r;
+    if (!waitForSubscriber(clean_ft, clean.name()) ||
+        !waitForSubscriber(hostile_ft, hostile.name()))
+      return ::testing::AssertionFailure() << "no subscriber to the tool wrench";
+    tool.header.frame_id = "tool0";
+    tool.wrench.force.z = -15.0;
+    tool.wrench.torque.x = 0.7;
+    connected = true;
+    return ::testing::AssertionSuccess();
+  }
+  void sendTool(const ros::Time& stamp) {
+    tool.header.stamp = stamp;
+    clean_ft.publish(tool);
+    hostile_ft.publish(tool);
+  }
+};
+
+HostilePair& hostilePair() {
+  static HostilePair pair;
+  return pair;
+}
+
+// n samples of the 500 Hz arm from `start` to the clean and the hostile node, the
+// hostile one getting a message of the next kind of `cycle` every 10 samples: its loads
+// must be the clean node's at every stamp, each bad message counted under its key,
+// nothing lost, and /diagnostics at its rate throughout.
+void hostileStream(const std::vector<const Kind*>& cycle, const ros::Time& start, int n) {
+  HostilePair& pair = hostilePair();
+  ASSERT_TRUE(pair.connect());
+  NodeUnderTest &clean = pair.clean, &hostile = pair.hostile;
   DiagnosticsLog& diag = diagnosticsLog();
-  ASSERT_TRUE(waitFor([&] { return diag.latest(hostile.status(), "loads published") >= 0; }));
+  // What came before (another stream) has been taken: the counters from here on.
+  ASSERT_TRUE(waitFor([&] {
+    return diag.latest(hostile.status(), "joint states received") == hostile.sent() &&
+           diag.latest(clean.status(), "joint states received") == clean.sent();
+  }));
+  std::map<std::string, long> before;
+  const std::vector<std::string> keys = {"dropped: invalid",
+                                         "not used: no needed joint",
+                                         "efforts not compared: non-finite",
+                                         "dropped: rogue stamp",
+                                         "dropped: stamp order",
+                                         "time jumps back",
+                                         "input '/hostile/joint_states': lost (header.seq gaps)"};
+  for (const std::string& key : keys) before[key] = std::max(0L, diag.latest(hostile.status(), key));
   Reference ref(kUr5);
   const std::vector<std::string>& names = ref.model.coordinate_names;
-  const ros::Time start(100, 0);
-  const int n = 1000;  // 2 s at 500 Hz
   std::map<std::string, long> expected;
-  auto send = [&](const sensor_msgs::JointState& js) { hostile.sendKeepingClock(js); };
+  const HostileSend send{
+      [&](const sensor_msgs::JointState& js) { hostile.sendKeepingClock(js); },
+      [&](const geometry_msgs::WrenchStamped& w) { pair.hostile_ft.publish(w); }};
+  simClock().set(at(start, 0));
+  ros::WallDuration(0.1).sleep();  // the clock at the nodes before the first joint state
   const double begin = wallNow();
   ros::WallRate rate(kRate);
   for (int k = 0; k < n; ++k) {
     sensor_msgs::JointState good = armState(names, at(start, k), start), bad = good;
     simClock().set(good.header.stamp);
     if (k % 10 == 5) {
-      const Kind& kind = kinds()[static_cast<std::size_t>(k / 10) % kinds().size()];
+      const Kind& kind = *cycle[static_cast<std::size_t>(k / 10) % cycle.size()];
       kind.apply(bad, send);
       ++expected[kind.key];
     }
-    send(bad);
+    send.joint(bad);
     clean.sendKeepingClock(good);
+    // The wrench after the joint state of its stamp; the first one of a stream once the
+    // nodes have taken that joint state (it would be far ahead of the last stream's).
+    if (k == 0) ros::WallDuration(0.05).sleep();
+    pair.sendTool(good.header.stamp);
     ros::spinOnce();
     rate.sleep();
   }
@@ -193,21 +315,43 @@ TEST(Hostile, AHostileMessageEveryTenSamplesChangesNoLoadsAndIsCounted) {
       << " of " << hostile.sent();
 
   // The loads: those of the clean stream at every stamp, and at the same stamps.
-  ASSERT_GT(clean.loads().size(), static_cast<std::size_t>(n - 10));
-  EXPECT_EQ(hostile.loads().size(), clean.loads().size());
-  EXPECT_EQ(sameLoads(clean.loads(), hostile.loads()),
+  const ros::Time last = at(start, n - 1);
+  ASSERT_GT(loadsIn(clean.loads(), start, last), n - 10);
+  EXPECT_EQ(loadsIn(hostile.loads(), start, last), loadsIn(clean.loads(), start, last));
+  EXPECT_EQ(sameLoads(clean.loads(), hostile.loads(), start, last),
             expected["efforts not compared: non-finite"]);
-  // Each bad message under its reason; nothing lost at 500 Hz.
-  for (const auto& kv : expected) EXPECT_EQ(diag.latest(hostile.status(), kv.first), kv.second);
-  EXPECT_EQ(diag.latest(hostile.status(), "input '/hostile/joint_states': lost (header.seq gaps)"),
-            0);
+  // Each bad message under its reason, and nothing else; nothing lost at 500 Hz.
+  for (const std::string& key : keys)
+    EXPECT_EQ(diag.latest(hostile.status(), key) - before[key], expected[key]) << key;
   EXPECT_EQ(diag.latest(clean.status(), "input '/clean/joint_states': lost (header.seq gaps)"), 0);
-  EXPECT_EQ(diag.latest(hostile.status(), "dropped: stamp order"), 0);
-  EXPECT_EQ(diag.latest(hostile.status(), "time jumps back"), 0);
   // /diagnostics at its rate during the stream (one period of slack at each end).
   const long expected_count = static_cast<long>((end - begin) / kPeriod);
   EXPECT_GE(diag.count(hostile.status(), begin, end), expected_count - 2);
   EXPECT_LE(diag.count(hostile.status(), begin, end), expected_count + 2);
+}
+
+// Each kind on its own (the cases of issue 14, one test each): 200 samples, 20 of them
+// with the kind beside. Each stream starts 100 s after the last (the clock moves as
+// far: a pause, not a rogue stamp).
+class HostileKind : public ::testing::TestWithParam<int> {};
+
+TEST_P(HostileKind, ChangesNoLoadsAndIsCounted) {
+  const Kind& kind = kinds()[static_cast<std::size_t>(GetParam())];
+  RecordProperty("kind", kind.what);
+  hostileStream({&kind}, ros::Time(20000 + 100 * GetParam(), 0), 200);
+}
+
+INSTANTIATE_TEST_SUITE_P(Each, HostileKind,
+                         ::testing::Range(0, static_cast<int>(kinds().size())),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return std::string(kinds()[static_cast<std::size_t>(info.param)].name);
+                         });
+
+// Every kind in turn, a hostile message every 10 samples of a 2 s stream at 500 Hz.
+TEST(Hostile, AHostileMessageEveryTenSamplesChangesNoLoadsAndIsCounted) {
+  std::vector<const Kind*> cycle;
+  for (const Kind& kind : kinds()) cycle.push_back(&kind);
+  hostileStream(cycle, ros::Time(10000, 0), 1000);
 }
 
 // A burst faster than the node takes it: what its publisher numbered (roscpp numbers

@@ -1,9 +1,11 @@
 // Soak of the real node over ROS (run by test/soak/node_soak.sh, which starts a
 // private master and the joint_load_estimator executable): SAMPLES joint states
-// of the robot in robot_description at 1 kHz of simulated time, sent as fast as
-// the node keeps up, with a wrench every 10 samples and bad messages of every
-// kind the node counts mixed in, plus a few backward jumps of time (a looping
-// bag). Flow control: at most --window joint-state messages unacknowledged (a
+// of the robot in robot_description at 500 Hz of simulated time, sent as fast as
+// the node keeps up, with a wrench every 10 samples and a bad message every 10
+// samples (every kind the node counts, cycled: invalid values and sizes, stamp
+// order, rogue stamps of joint states and wrenches, unknown frames and joints),
+// plus a few backward jumps of time (a looping bag, confirmed by
+// stamps/jump_confirm joint states on the new timeline). Flow control: at most --window joint-state messages unacknowledged (a
 // message is acknowledged by the loads of it or of a later sample; the node's
 // subscriber queues hold 100), so no queue drops anything. Checks
 //  1. every good sample produces its loads: the sequence of ~joint_loads stamps
@@ -19,10 +21,17 @@
 //     buffers have grown to size by then) by at most --rss-limit kB;
 //  4. the node is alive at the end;
 //  5. /diagnostics came at the node's diagnostic_period (wall clock) throughout.
+//  6. the loads equal, to 1e-12 at every stamp, those of the clean stream (the good
+//     messages alone, in the order sent) through an in-process jle::Pipeline with the
+//     same settings. The tool wrench is constant, so that a joint state and a wrench
+//     arriving in either order (two TCP connections) read the same value; after each
+//     (re)start the first wrench is sent only once the node has taken the joint
+//     states before it.
 // Prints a summary; exits 1 on a failed check, 2 on a usage error.
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -42,6 +51,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -119,13 +129,23 @@ enum Bad {
   kDuplicateName,  // a joint named twice
   kEmpty,          // a joint state with no joint: not a sample
   kNanEffort,      // a good sample with a NaN effort: its loads are published
+  kRogueAhead,     // a joint state stamped 2 h ahead
+  kRogueBack,      // a joint state stamped 2 h back
+  kRogueZero,      // a joint state stamped 0 on a stamped stream
+  kWrenchAhead,    // a wrench stamped 2 h ahead
+  kWrenchBack,     // a wrench stamped 2 h back
+  kWrenchZero,     // a wrench stamped 0
+  kWrenchLead,     // a wrench ahead of the joint states by 0.5 s (timeout 0.1 s)
   kTimeJump,       // not in the periodic cycle: --jumps times
+  kUnconfirmed,    // the joint states of a jump before the one confirming it
   kKinds
 };
 const char* const kBadName[kKinds] = {
     "nan_position",    "inf_position",   "position_length", "velocity_length", "unknown_joint",
     "duplicate_stamp", "backward_stamp", "nan_wrench",      "backward_wrench", "unresolved_frame",
-    "duplicate_name",  "empty",          "nan_effort",      "time_jump_back"};
+    "duplicate_name",  "empty",          "nan_effort",      "rogue_ahead",     "rogue_back",
+    "rogue_zero",      "wrench_ahead",   "wrench_back",     "wrench_zero",     "wrench_lead",
+    "time_jump_back",  "unconfirmed"};
 const char* const kBadKey[kKinds] = {"dropped: invalid",
                                      "dropped: invalid",
                                      "dropped: invalid",
@@ -139,10 +159,21 @@ const char* const kBadKey[kKinds] = {"dropped: invalid",
                                      "dropped: invalid",
                                      "not used: no needed joint",
                                      "efforts not compared: non-finite",
-                                     "time jumps back"};
-constexpr long kBadPeriod = 50;          // one bad message per 50 good samples
-constexpr long kWrenchPeriod = 10;       // one wrench per 10 joint samples (100 Hz)
-constexpr std::int64_t kDtNs = 1000000;  // 1 kHz
+                                     "dropped: rogue stamp",
+                                     "dropped: rogue stamp",
+                                     "dropped: rogue stamp",
+                                     "dropped: rogue stamp",
+                                     "dropped: rogue stamp",
+                                     "dropped: rogue stamp",
+                                     "dropped: rogue stamp",
+                                     "time jumps back",
+                                     "dropped: rogue stamp"};
+constexpr long kBadPeriod = 10;          // one bad message per 10 good samples
+constexpr long kWrenchPeriod = 10;       // one wrench per 10 joint samples (50 Hz)
+constexpr std::int64_t kDtNs = 2000000;  // 500 Hz
+constexpr std::int64_t kTwoHoursNs = 7200LL * 1000000000LL;
+constexpr double kWrenchFx = 10.0;  // [N] the tool wrench's constant force along x
+constexpr double kExact = 1e-12;    // [N, N m] the loads against the clean stream's
 constexpr std::int64_t kEpochNs = 1700000000LL * 1000000000LL;
 
 ros::Time fromNs(std::int64_t ns) {
@@ -166,13 +197,15 @@ class Driver {
     wrench_link_ = settings.estimator.wrenches[0].link;
     diag_period_ = settings.diagnostic_period;
 
+    jump_confirm_ = settings.stamps.jump_confirm;
+
     std::string urdf;
     if (!nh_.getParam(settings.robot_description, urdf))
       throw std::runtime_error("parameter '" + settings.robot_description + "' is not set");
-    jle::ModelOptions options;
-    options.floating_base = settings.floating_base;
-    if (options.floating_base) throw std::runtime_error("the soak drives fixed-base models");
-    names_ = jle::modelFromUrdfString(urdf, options).coordinate_names;
+    if (settings.floating_base) throw std::runtime_error("the soak drives fixed-base models");
+    model_ = jle::modelFromUrdfString(urdf, jle::modelOptions(settings));
+    names_ = model_.coordinate_names;
+    reference_ = std::make_unique<jle::Pipeline>(model_, settings, nullptr);
 
     const std::string node = "/joint_load_estimator";
     joint_pub_ = nh_.advertise<sensor_msgs::JointState>(settings.joint_states_topic, 1000);
@@ -190,6 +223,7 @@ class Driver {
   bool step(long i, long& next_jump);
   void onLoads(const joint_load_estimator::JointLoads::ConstPtr& msg) {
     const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+    compareWithCleanStream(*msg, stamp);
     const std::size_t r = received_.size();
     received_.push_back(stamp);
     if (r < expected_.size()) acked_ = std::max(acked_, trigger_[r]);
@@ -201,6 +235,46 @@ class Driver {
                std::isfinite(w.torque.z);
     if (!finite) ++bad_loads_;
   }
+
+  // The next loads of the clean stream (reference_) against the node's, in order.
+  void compareWithCleanStream(const joint_load_estimator::JointLoads& msg, std::int64_t stamp) {
+    if (clean_.empty() || clean_.front().stamp != stamp ||
+        clean_.front().values.size() != 7 * msg.name.size()) {
+      ++mismatched_;
+      if (!clean_.empty()) clean_.pop_front();
+      return;
+    }
+    const std::vector<double>& v = clean_.front().values;
+    for (std::size_t j = 0; j < msg.name.size(); ++j) {
+      const auto& w = msg.wrench[j];
+      const double got[7] = {w.force.x,  w.force.y,  w.force.z,    w.torque.x,
+                             w.torque.y, w.torque.z, msg.effort[j]};
+      for (int c = 0; c < 7; ++c) {
+        const double d = std::abs(got[c] - v[7 * j + c]);
+        worst_difference_ = std::max(worst_difference_, std::isnan(d) ? HUGE_VAL : d);
+      }
+    }
+    ++compared_;
+    clean_.pop_front();
+  }
+
+  // The clean stream's joint state: the good sample alone (no ghost joint, no effort).
+  void takeClean(std::int64_t stamp, const std::vector<double>& position) {
+    static const std::vector<double> none;
+    if (reference_->onJointState(stamp, nowNs(), names_, position, none, none) !=
+        jle::Outcome::kPublished)
+      return;
+    const jle::LoadsRecord& r = reference_->record();
+    CleanLoads c{r.stamp, {}};
+    for (std::size_t j = 0; j < r.effort.size(); ++j) {
+      for (int a = 0; a < 3; ++a) c.values.push_back(r.force[j][a]);
+      for (int a = 0; a < 3; ++a) c.values.push_back(r.moment[j][a]);
+      c.values.push_back(r.effort[j]);
+    }
+    clean_.push_back(std::move(c));
+  }
+
+  static std::int64_t nowNs() { return static_cast<std::int64_t>(ros::Time::now().toNSec()); }
 
   void onDiagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
     for (const auto& status : msg->status) {
@@ -257,6 +331,27 @@ class Driver {
     return true;
   }
 
+  // The tool wrench (constant), to the node and the clean stream.
+  void sendGoodWrench(std::int64_t stamp) {
+    sendWrench(stamp, kWrenchFx, wrench_link_);
+    reference_->onWrench(0, stamp, nowNs(), wrench_link_,
+                         Eigen::Vector3d(kWrenchFx, 2.0, -5.0), Eigen::Vector3d(0.1, 0.0, 0.0));
+    last_wrench_ns_ = stamp;
+    wrench_in_segment_ = true;
+  }
+
+  // After a (re)start: the first wrench once the node has taken every joint state sent
+  // (so that it reads no wrench at them, as the clean stream), then nothing more until
+  // it has taken the wrench.
+  bool startWrench() {
+    if (!spinUntil([&] { return diag("joint states received") >= sent_; },
+                   "the node to take the joint states of the (re)start"))
+      return false;
+    sendGoodWrench(last_good_ns_);
+    return spinUntil([&] { return diag("wrenches received") >= wrenches_sent_; },
+                     "the node to take the first wrench of the (re)start");
+  }
+
   void sendWrench(std::int64_t stamp, double fx, const std::string& frame) {
     wrench_msg_.header.stamp = fromNs(stamp);
     wrench_msg_.header.frame_id = frame;
@@ -269,8 +364,9 @@ class Driver {
   }
 
   // The next good sample (positions: slow sines), the loads it must produce
-  // recorded.
-  bool sendGood(bool ghost, bool nan_effort = false) {
+  // recorded; `unconfirmed`: a joint state of a jump before the one confirming it,
+  // which publishes nothing.
+  bool sendGood(bool ghost, bool nan_effort = false, bool unconfirmed = false) {
     const std::int64_t stamp = next_ns_;
     next_ns_ += kDtNs;
     const double t = 1e-9 * static_cast<double>(stamp - kEpochNs);
@@ -279,6 +375,7 @@ class Driver {
     good_msg_.position.resize(names_.size());
     for (std::size_t k = 0; k < names_.size(); ++k)
       good_msg_.position[k] = 0.5 * std::sin(2.0 * M_PI * (0.2 + 0.05 * k) * t + k);
+    takeClean(stamp, good_msg_.position);
     if (ghost) {
       good_msg_.name.push_back("ghost_joint");
       good_msg_.position.push_back(1.0);
@@ -288,6 +385,9 @@ class Driver {
       good_msg_.effort.assign(names_.size(), 1.0);
       good_msg_.effort[0] = std::nan("");
     }
+    last_good_ns_ = stamp;
+    ++good_;
+    if (unconfirmed) return sendJoint(good_msg_);
     // The filter publishes from the warmup()-th sample after a (re)start on,
     // each time the estimate for the sample `delay` samples back.
     segment_.push_back(stamp);
@@ -296,8 +396,6 @@ class Driver {
       expected_.push_back(segment_.front());
       trigger_.push_back(sent_);
     }
-    last_good_ns_ = stamp;
-    ++good_;
     return sendJoint(good_msg_);
   }
 
@@ -354,6 +452,20 @@ class Driver {
         m.name.clear();
         m.position.clear();
         break;
+      case kRogueAhead:
+      case kRogueBack:
+      case kRogueZero:
+        m.header.stamp = fromNs(kind == kRogueZero ? 0
+                                : kind == kRogueAhead ? last_good_ns_ + kTwoHoursNs
+                                                      : last_good_ns_ - kTwoHoursNs);
+        for (double& q : m.position) q += 0.3;  // used, it would change every load
+        break;
+      case kWrenchAhead: sendWrench(last_good_ns_ + kTwoHoursNs, 1000.0, wrench_link_); return true;
+      case kWrenchBack: sendWrench(last_good_ns_ - kTwoHoursNs, 1000.0, wrench_link_); return true;
+      case kWrenchZero: sendWrench(0, 1000.0, wrench_link_); return true;
+      case kWrenchLead:
+        sendWrench(last_good_ns_ + 500000000, 1000.0, wrench_link_);
+        return true;
       default: return false;
     }
     return sendJoint(m);
@@ -365,7 +477,16 @@ class Driver {
   ros::Subscriber loads_sub_, diag_sub_;
   std::vector<std::string> names_;
   std::string wrench_link_;
-  int warmup_ = 0, delay_ = 0;
+  int warmup_ = 0, delay_ = 0, jump_confirm_ = 1;
+  jle::Model<double> model_;
+  std::unique_ptr<jle::Pipeline> reference_;  // the clean stream
+  struct CleanLoads {
+    std::int64_t stamp;
+    std::vector<double> values;  // per joint: force, moment, effort
+  };
+  std::deque<CleanLoads> clean_;  // the clean stream's loads the node has yet to publish
+  long compared_ = 0, mismatched_ = 0;
+  double worst_difference_ = 0.0;
   std::int64_t jump_back_ns_ = 0;
 
   sensor_msgs::JointState good_msg_;
@@ -384,6 +505,7 @@ class Driver {
 };
 
 bool Driver::step(long i, long& next_jump) {
+  bool restart = i == 0;
   if (next_jump <= o_.jumps && i == next_jump * o_.samples / (o_.jumps + 1)) {
     // A looping bag: back to the first stamp (or further, so that the jump is
     // at least twice the node's time_jump_threshold), once every input of the
@@ -395,6 +517,13 @@ bool Driver::step(long i, long& next_jump) {
     segment_count_ = 0;
     wrench_in_segment_ = false;
     ++injected_[kTimeJump];
+    restart = true;
+    // stamps/jump_confirm joint states on the new timeline confirm the jump; those
+    // before the last are rogue stamps.
+    for (int c = 1; c < jump_confirm_; ++c) {
+      if (!sendGood(false, false, true)) return false;
+      ++injected_[kUnconfirmed];
+    }
   }
   const Bad kind = static_cast<Bad>((i / kBadPeriod) % kTimeJump);
   const bool bad_here = i % kBadPeriod == kBadPeriod / 5;
@@ -403,11 +532,10 @@ bool Driver::step(long i, long& next_jump) {
   if (ghost) ++injected_[kUnknownJoint];
   if (nan_effort) ++injected_[kNanEffort];
   if (!sendGood(ghost, nan_effort)) return false;
-  if (i % kWrenchPeriod == 0) {
-    sendWrench(last_good_ns_, 10.0 * std::sin(1e-9 * static_cast<double>(last_good_ns_ - kEpochNs)),
-               wrench_link_);
-    last_wrench_ns_ = last_good_ns_;
-    wrench_in_segment_ = true;
+  if (restart) {
+    if (!startWrench()) return false;
+  } else if (i % kWrenchPeriod == 0) {
+    sendGoodWrench(last_good_ns_);
   }
   if (bad_here && !ghost && !nan_effort && sendBad(kind)) ++injected_[kind];
   return ros::ok();
@@ -501,7 +629,8 @@ bool Driver::run() {
     const long got = final_diag.count(kBadKey[k]) ? final_diag.at(kBadKey[k]) : -1;
     std::printf("%-18s %9ld   %-30s %9ld %9ld\n", kBadName[k], injected_[k], kBadKey[k],
                 expected_key[kBadKey[k]], got);
-    expect(injected_[k] > 0, std::string("no ") + kBadName[k] + " injected");
+    if (k != kUnconfirmed || jump_confirm_ > 1)
+      expect(injected_[k] > 0, std::string("no ") + kBadName[k] + " injected");
   }
   // The loads the node had published when it sent that diagnostics message.
   const long at_diag =
@@ -535,6 +664,13 @@ bool Driver::run() {
          "load " +
              std::to_string(first_mismatch) + ")");
   expect(bad_loads_ == 0, "loads with the wrong size or non-finite values");
+  std::printf(
+      "loads against the clean stream's: %ld compared, %ld at another stamp or size, worst "
+      "|difference| %.3g (limit %.0e), %zu never published\n",
+      compared_, mismatched_, worst_difference_, kExact, clean_.size());
+  expect(compared_ == static_cast<long>(received_.size()) && mismatched_ == 0 &&
+             worst_difference_ <= kExact && clean_.empty(),
+         "the loads differ from the clean stream's");
   expect(rss_10 > 0 && rss_100 > 0 && rss_100 - rss_10 <= o_.rss_limit_kb,
          "node VmRSS grew by more than " + std::to_string(o_.rss_limit_kb) + " kB");
   expect(alive, "the node is not alive at the end");

@@ -153,7 +153,7 @@ jle::CovarianceWorkspace quadraticHistory(const jle::CovarianceModel& cm, double
   ws.time[0] = t0;
   ws.time[1] = t0 - h;
   ws.time[2] = t0 - 2 * h;
-  ws.gain = Eigen::Matrix3d::Identity();
+  for (Eigen::Matrix3d& g : ws.gain) g = Eigen::Matrix3d::Identity();
   ws.history = 3;
   return ws;
 }
