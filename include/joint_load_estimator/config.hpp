@@ -86,9 +86,10 @@ struct UncertaintyConfig {
   double period = 0.018;
   /// With period > 0: an extrapolated sample is computed instead when the filter's noise
   /// gain (the covariance of the estimated q, q-dot, q-ddot per unit measurement
-  /// variance) has moved by more than this fraction since the last computed sample
-  /// (irregular stamps: the gain changes with every spacing, which no extrapolation of
-  /// the past follows). 0.02 bounds the sigma error from that source to ~1%.
+  /// variance) is more than this fraction away from the gain of any of the three computed
+  /// samples the extrapolation would use (irregular stamps: the gain changes with every
+  /// spacing; a Kalman filter settling after a start, a gap or a reset: its gain moves
+  /// from one node to the next). 0.02 bounds the sigma error from that source to ~1%.
   double gain_tolerance = 0.02;
 };
 

@@ -303,8 +303,10 @@ jle::DifferentiatorConfig savitzkyGolay(int window, int delay) {
 
 constexpr int kReplays = 10000;
 
-// Savitzky-Golay, 9 samples, causal at 1 kHz: q-ddot's noise dominates, wrench noise on top.
-TEST(CovarianceMonteCarlo, PandaDefaultFilter) {
+// Savitzky-Golay, 9 samples, causal at 1 kHz (not the node's default filter: the constant-jerk
+// Kalman filter's Monte Carlo through the node's path is test_covariance_pipeline): q-ddot's
+// noise dominates, wrench noise on top.
+TEST(CovarianceMonteCarlo, PandaSavitzkyGolay9Causal) {
   Scene s{"panda", "panda.urdf", {"panda_hand"}, savitzkyGolay(9, 0), 1000.0, 1e-4,
           0.5,     0.05,         {12, 20}};
   runMonteCarlo(s, kReplays);
