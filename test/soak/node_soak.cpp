@@ -68,14 +68,14 @@ const char kUsage[] =
     "with N joint states (default\n"
     "1000000) and bad messages; checks its loads, "
     "diagnostics and memory. --window: joint\n"
-    "states in flight (default 64, below the node's queue of "
-    "100); --jumps: backward time\n"
+    "states in flight (default 32, below the node's queue of "
+    "100, and their time below the wrench timeout); --jumps: backward time\n"
     "jumps (default 3); --rss-limit: allowed VmRSS growth "
     "from 10% to 100% (default 256).\n";
 
 struct Options {
   long samples = 1000000;
-  long window = 64;
+  long window = 32;
   long jumps = 3;
   long rss_limit_kb = 256;
   long pid = 0;
@@ -190,6 +190,11 @@ class Driver {
       throw std::runtime_error(o.config + ": the soak needs at least one entry in 'wrenches'");
     if (settings.estimator.decimation != 1)
       throw std::runtime_error(o.config + ": the soak expects decimation 1");
+    // A wrench is sent beside the newest joint state, up to `window` samples ahead of
+    // the one the node is taking: within its timeout, or it is a rogue stamp.
+    if (1e-9 * static_cast<double>(o.window * kDtNs) >= settings.estimator.wrenches[0].timeout)
+      throw std::runtime_error("--window " + std::to_string(o.window) +
+                               ": its joint states span the wrench timeout");
     const jle::DifferentiatorBank bank(settings.estimator.differentiator, 1);
     warmup_ = bank.warmup();
     delay_ = bank.config().delay;
