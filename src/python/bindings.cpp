@@ -85,8 +85,7 @@ void checkShape(const Array& a, long rows, long cols, const std::string& what) {
   const bool ok = a.ndim() == 2 && (rows < 0 || a.shape(0) == rows) && a.shape(1) == cols;
   if (ok) return;
   std::string shape = "(";
-  for (py::ssize_t d = 0; d < a.ndim(); ++d)
-    shape += (d ? ", " : "") + std::to_string(a.shape(d));
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(a.shape(d));
   throw std::invalid_argument(what + " must have shape (" +
                               (rows < 0 ? std::string("N") : std::to_string(rows)) + ", " +
                               std::to_string(cols) + "), it has " + shape + ")");
@@ -134,9 +133,8 @@ void takeBase(const jle::Model<double>& model, const py::dict& base, Batch& b,
   }
 }
 
-Batch takeBatch(const jle::Model<double>& model, const Array& q, const Array& qd,
-                const Array& qdd, const py::object& wrenches, const py::dict& base,
-                std::vector<Array>& keep) {
+Batch takeBatch(const jle::Model<double>& model, const Array& q, const Array& qd, const Array& qdd,
+                const py::object& wrenches, const py::dict& base, std::vector<Array>& keep) {
   Batch b;
   checkShape(q, -1, model.nq, "q");
   b.n = static_cast<long>(q.shape(0));
@@ -325,9 +323,8 @@ struct WrenchSeries {
 
 std::vector<WrenchSeries> wrenchSeries(const py::list& wrenches, int inputs) {
   if (static_cast<int>(py::len(wrenches)) > inputs)
-    throw std::invalid_argument("wrenches: " + std::to_string(py::len(wrenches)) +
-                                " series for " + std::to_string(inputs) +
-                                " wrench inputs of the config");
+    throw std::invalid_argument("wrenches: " + std::to_string(py::len(wrenches)) + " series for " +
+                                std::to_string(inputs) + " wrench inputs of the config");
   std::vector<WrenchSeries> series;
   for (std::size_t k = 0; k < py::len(wrenches); ++k) {
     const py::tuple pair = wrenches[k].cast<py::tuple>();
@@ -346,8 +343,8 @@ py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrench
   if (t.ndim() != 1) throw std::invalid_argument("t must be one-dimensional");
   const long n = static_cast<long>(t.shape(0));
   checkShape(q, n, model_.nq, "q");
-  std::vector<WrenchSeries> series = wrenchSeries(wrenches, static_cast<int>(
-                                                                settings_.estimator.wrenches.size()));
+  std::vector<WrenchSeries> series =
+      wrenchSeries(wrenches, static_cast<int>(settings_.estimator.wrenches.size()));
   const std::size_t m = segments_.size();
   std::vector<double> stamps, w, e;
   std::vector<std::string> status(static_cast<std::size_t>(n));
@@ -361,7 +358,8 @@ py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrench
              ++s.next) {
           const double* x = s.w.data() + 6 * s.next;
           estimator_->addWrench(static_cast<int>(k), s.t.data()[s.next],
-                                Eigen::Vector3d(x[0], x[1], x[2]), Eigen::Vector3d(x[3], x[4], x[5]));
+                                Eigen::Vector3d(x[0], x[1], x[2]),
+                                Eigen::Vector3d(x[3], x[4], x[5]));
         }
       const jle::SampleStatus st = estimator_->addJointSample(ti, q.data() + model_.nq * i);
       status[static_cast<std::size_t>(i)] = jle::toString(st);
@@ -548,7 +546,8 @@ void defineModel(py::module_& m) {
                   py::arg("keep_fixed_joints") = std::vector<std::string>(),
                   "Parses a URDF document (e.g. the robot_description parameter).")
       .def_property_readonly("nq", [](const PyModel& p) { return p.model.nq; })
-      .def_property_readonly("floating_base", [](const PyModel& p) { return p.model.floating_base; })
+      .def_property_readonly("floating_base",
+                             [](const PyModel& p) { return p.model.floating_base; })
       .def_property_readonly(
           "coordinate_names", [](const PyModel& p) { return p.model.coordinate_names; },
           "Names of the nq coordinates: the columns of q, qd, qdd.")
@@ -605,10 +604,9 @@ void defineEstimator(py::module_& m) {
                              [](const PyEstimator& e) {
                                return namesOf(e.estimator().model().link_name, e.segments());
                              })
-      .def_property_readonly("coordinate_names",
-                             [](const PyEstimator& e) {
-                               return e.estimator().model().coordinate_names;
-                             })
+      .def_property_readonly(
+          "coordinate_names",
+          [](const PyEstimator& e) { return e.estimator().model().coordinate_names; })
       .def_property_readonly("delay_samples",
                              [](const PyEstimator& e) { return e.estimator().delaySamples(); })
       .def_property_readonly("stamp", [](const PyEstimator& e) { return e.estimator().stamp(); })
@@ -622,9 +620,8 @@ void defineEstimator(py::module_& m) {
 PYBIND11_MODULE(_core, m) {
   m.doc() = "joint_load_estimator: per-segment 6x6 inverse dynamics (C++ core)";
   defineModel(m);
-  m.def("_inverse_dynamics", &inverseDynamicsBatch, py::arg("model"), py::arg("q"),
-        py::arg("qd"), py::arg("qdd"), py::arg("wrenches"), py::arg("frame"), py::arg("gravity"),
-        py::arg("base"));
+  m.def("_inverse_dynamics", &inverseDynamicsBatch, py::arg("model"), py::arg("q"), py::arg("qd"),
+        py::arg("qdd"), py::arg("wrenches"), py::arg("frame"), py::arg("gravity"), py::arg("base"));
   defineEstimator(m);
   m.def("_smooth_zero_phase", &smoothZeroPhase, py::arg("t"), py::arg("x"), py::arg("cutoff"),
         py::arg("rule"), py::arg("order"), py::arg("padding"));

@@ -390,14 +390,14 @@ void BagProcessor::summarize(double total_s) const {
   const double compute_s = std::chrono::duration<double>(compute_).count();
   const long joint_states = c.received(jle::InputKind::kJointState);
   const double samples = static_cast<double>(joint_states);
-  std::fprintf(
-      stderr,
-      "process_bag: %ld joint states, %ld wrenches, %ld plate samples -> %ld loads%s\n"
-      "process_bag: compute %.3f s (%.0f samples/s), total with I/O %.3f s "
-      "(%.0f samples/s)\n",
-      joint_states, c.received(jle::InputKind::kWrench), c.received(jle::InputKind::kPlate),
-      c.count(jle::Outcome::kPublished), sink_.destination().c_str(), compute_s,
-      compute_s > 0 ? samples / compute_s : 0.0, total_s, total_s > 0 ? samples / total_s : 0.0);
+  std::fprintf(stderr,
+               "process_bag: %ld joint states, %ld wrenches, %ld plate samples -> %ld loads%s\n"
+               "process_bag: compute %.3f s (%.0f samples/s), total with I/O %.3f s "
+               "(%.0f samples/s)\n",
+               joint_states, c.received(jle::InputKind::kWrench),
+               c.received(jle::InputKind::kPlate), c.count(jle::Outcome::kPublished),
+               sink_.destination().c_str(), compute_s, compute_s > 0 ? samples / compute_s : 0.0,
+               total_s, total_s > 0 ? samples / total_s : 0.0);
   printDrops();
 }
 
