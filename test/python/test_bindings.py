@@ -199,11 +199,14 @@ def test_zero_phase_is_joint_loads_positions_only(tmp_path):
     rng = np.random.default_rng(6)
     q = 0.4 * np.sin(2 * np.pi * np.outer(t, rng.uniform(0.2, 1.5, model.nq))) + \
         rng.normal(0, 1e-3, (n, model.nq))
-    header = ["t"] + [name + ".q" for name in model.coordinate_names]
+    wrench = 10 * np.sin(2 * np.pi * np.outer(t, rng.uniform(0.2, 1.5, 6))) + \
+        rng.normal(0, 0.5, (n, 6))
+    wrench_columns = ["wrench@panda_hand." + c for c in ("fx", "fy", "fz", "mx", "my", "mz")]
+    header = ["t"] + [name + ".q" for name in model.coordinate_names] + wrench_columns
     kinematics = str(tmp_path / "kinematics.csv")
     columns, stderr = joint_loads(tmp_path, ["--urdf", PANDA, "--cutoff", "auto",
                                              "--write-kinematics", kinematics],
-                                  header, np.column_stack([t, q]))
+                                  header, np.column_stack([t, q, wrench]))
     value, rate, accel, cutoff = jle.smooth_zero_phase(t, q)  # gcv, as joint_loads' default
     printed = float(re.search(r"cutoff (\S+) Hz", stderr).group(1))
     assert cutoff == pytest.approx(printed, rel=1e-15)
@@ -212,10 +215,16 @@ def test_zero_phase_is_joint_loads_positions_only(tmp_path):
         assert_same(value[:, k], smoothed[name + ".q"], name + ".q")
         assert_same(rate[:, k], smoothed[name + ".qd"], name + ".qd")
         assert_same(accel[:, k], smoothed[name + ".qdd"], name + ".qdd")
-    compare_with_columns(jle.inverse_dynamics(model, value, rate, accel), columns)
+    # The wrench columns: the same filter, the positions' cutoff, no derivatives.
+    filtered = jle.low_pass_zero_phase(t, wrench, cutoff)
+    for c, name in enumerate(wrench_columns):
+        assert_same(filtered[:, c], smoothed[name], name)
+    compare_with_columns(jle.inverse_dynamics(model, value, rate, accel,
+                                              wrenches={"panda_hand": filtered}), columns)
     fixed = jle.smooth_zero_phase(t, q, cutoff=cutoff)
     assert_same(fixed[2], accel, "a cutoff given")
-    assert_same(jle.low_pass_zero_phase(t, q, cutoff), value, "low_pass_zero_phase")
+    residual = jle.smooth_zero_phase(t, q, rule="residual")
+    assert residual[3] != cutoff and residual[3] > 0
     with pytest.raises(ValueError, match="cutoff"):
         jle.smooth_zero_phase(t, q, cutoff=-1.0)
 
@@ -290,6 +299,9 @@ def test_estimator_is_process_bag(tmp_path, example_bag):
     assert loads.joints == model.joint_names and len(loads) == len(columns["t"])
     assert np.abs(loads.t + t0 * 1e-9 - columns["t"]).max() < 1e-6
     compare_with_columns(loads, columns)
+    # The sensor's readings matter: without them the efforts are others.
+    unloaded = jle.estimate(jle.Estimator(model), seconds(joints[:, 0]), joints[:, 1:].astype(float))
+    assert np.abs(unloaded.effort - loads.effort).max() > 0.1
     # One sample at a time, from the start again: the same loads.
     estimator.reset()
     t, q = seconds(joints[:, 0]), joints[:, 1:].astype(float)
