@@ -8,6 +8,8 @@ hand, child-frame loads of every moving joint:
   cli      joint_loads --input STATES.csv --output LOADS.csv (parsing and writing the
            CSV files included: what a script calling the tool pays)
   python+csv  numpy.loadtxt of the same CSV, the bindings, numpy.savetxt of the loads
+  estimator   joint_load_estimator.estimate: the online Estimator with the node's
+           defaults (filters and loads) over the positions alone
 Each is timed REPEAT times, the best run counts. Prints samples per second and the
 ratio python / cli. Run in a sourced workspace:
   /usr/bin/python3 bench/python_throughput.py [--samples 100000] [--repeat 3]
@@ -78,13 +80,18 @@ def main():
                        np.column_stack([x[:, 0], r.wrench.reshape(n, -1), r.effort]),
                        delimiter=",", fmt="%.17g")
 
+        def estimator():
+            jle.estimate(jle.Estimator(model), 1e-3 * np.arange(n), q)
+
         t_python = best_of(args.repeat, python)
         t_cli = best_of(args.repeat, cli)
         t_python_csv = best_of(args.repeat, python_csv)
+        t_estimator = best_of(args.repeat, estimator)
     print("Panda, %d samples, %d joints, best of %d:" % (n, len(model.joint_names), args.repeat))
     print("  python inverse_dynamics (arrays in memory): %12.0f samples/s" % (n / t_python))
     print("  C++ joint_loads CLI (CSV in, CSV out):      %12.0f samples/s" % (n / t_cli))
     print("  python with numpy CSV in and out:           %12.0f samples/s" % (n / t_python_csv))
+    print("  python Estimator (node's defaults):         %12.0f samples/s" % (n / t_estimator))
     print("  ratio python / CLI: %.2f" % (t_cli / t_python))
 
 
