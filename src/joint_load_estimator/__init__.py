@@ -49,14 +49,17 @@ class Loads:
         except ValueError:
             raise KeyError("no loads for joint '%s' (joints: %s)" % (joint, ", ".join(self.joints)))
 
+    # The arrays with one column per joint (the others, t or base_residual, are kept whole).
+    PER_JOINT = ("wrench", "effort", "effort_stddev", "position", "velocity", "acceleration",
+                 "motor_effort", "measured_effort")
+
     def __getitem__(self, joint):
         i = self.index(joint)
-        picked = {}
-        for key, value in self.__dict__.items():
-            if hasattr(value, "ndim") and value.ndim >= 2 and value.shape[1] == len(self.joints):
+        picked = dict(self.__dict__)
+        for key in self.PER_JOINT:
+            value = picked.get(key)
+            if value is not None and value.ndim >= 2 and value.shape[1] == len(self.joints):
                 picked[key] = value[:, i]
-            else:
-                picked[key] = value
         picked["joints"], picked["links"] = [joint], [self.links[i]]
         return Loads(picked)
 

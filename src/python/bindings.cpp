@@ -339,7 +339,10 @@ std::vector<WrenchSeries> wrenchSeries(const py::list& wrenches, int inputs) {
 }
 
 py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrenches) {
-  if (model_.floating_base) throw std::invalid_argument("run(): a fixed-base model only");
+  if (model_.floating_base)
+    throw std::invalid_argument(
+        "estimate(): a fixed-base model only; feed a floating base sample by sample "
+        "(add_joint_sample with base_pose)");
   if (t.ndim() != 1) throw std::invalid_argument("t must be one-dimensional");
   const long n = static_cast<long>(t.shape(0));
   checkShape(q, n, model_.nq, "q");
