@@ -17,8 +17,11 @@ joint origin, in the child link frame by default; SI units. The generated messag
 where ROS puts them: ``from joint_load_estimator.msg import JointLoads``.
 """
 
-from ._core import Estimator, Model, default_gravity  # noqa: F401
+from ._core import Estimator, Model, default_gravity
 from . import _core
+
+__all__ = ["Model", "Estimator", "Loads", "inverse_dynamics", "estimate", "smooth_zero_phase",
+           "low_pass_zero_phase", "process_bag", "default_gravity"]
 
 
 class Loads:
