@@ -332,3 +332,30 @@ def test_estimator_defaults_are_the_nodes(tmp_path):
         bad = tmp_path / "bad.yaml"
         bad.write_text("decimation: 0\n")
         jle.Estimator(model, str(bad))
+
+
+def test_inverse_dynamics_releases_the_gil():
+    """While a long batch runs in one thread, another keeps running Python: its longest
+    pause is a fraction of the batch's time (with the GIL held it would be all of it)."""
+    import threading
+    import time
+    model = jle.Model(PANDA)
+    q, qd, qdd = random_states(model, 300000, 7)
+    span = {}
+
+    def batch():
+        span["start"] = time.perf_counter()
+        jle.inverse_dynamics(model, q, qd, qdd)
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=batch)
+    worker.start()
+    stamps = []
+    while worker.is_alive():
+        stamps.append(time.perf_counter())
+    worker.join()
+    inside = [s for s in stamps if span["start"] <= s <= span["end"]]
+    duration = span["end"] - span["start"]
+    edges = [span["start"]] + inside + [span["end"]]
+    longest = max(b - a for a, b in zip(edges, edges[1:]))
+    assert longest < 0.5 * duration, "longest pause %.3f s of a %.3f s batch" % (longest, duration)
