@@ -12,7 +12,9 @@ packages=(
   python3-rosbag python3-sensor-msgs python3-geometry-msgs python3-std-msgs
   liborocos-kdl-dev libkdl-parser-dev liburdf-dev
   ros-robot-state-publisher rosbash
-  python3-matplotlib
+  python3-matplotlib        # tools/examples/plot_loads.py, bench/plot_*.py
+  pybind11-dev python3-pybind11 python3-numpy   # the Python bindings (docs/python.md)
+  python3-pytest            # test/python (the bindings' tests)
   python3-scipy             # test/scripts/zero_phase_reference.py (the independent reference)
   clang libclang-rt-14-dev  # libFuzzer for test/fuzz/build_and_run.sh
   clang-format              # tools/format.sh (the style is tuned on Debian's 14)

@@ -1,0 +1,361 @@
+"""The Python bindings (joint_load_estimator) against the C++ tools on the same inputs
+(joint_loads on the same CSV, process_bag on the same bag: the same numbers to 1e-12)
+and against a closed form (a pendulum). Run by test/CMakeLists.txt under pytest, with
+the tools' paths in JLE_JOINT_LOADS, JLE_PROCESS_BAG, JLE_MAKE_EXAMPLE_BAG and the test
+data in JLE_TEST_DATA."""
+
+import csv
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+import joint_load_estimator as jle
+
+DATA = os.environ.get("JLE_TEST_DATA", os.path.join(os.path.dirname(__file__), "..", "data"))
+REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+PANDA = os.path.join(DATA, "urdf", "panda.urdf")
+BODY = os.path.join(DATA, "urdf", "body_75kg_175cm.urdf")
+# Same code on the same inputs: equal to rounding. The bound is relative to the size of
+# each number (at least 1 N or N m).
+TOLERANCE = 1e-12
+
+
+def tool(name):
+    path = os.environ.get("JLE_" + name.upper())
+    if not path:  # test/CMakeLists.txt sets them; a run without them must not pass
+        pytest.fail("JLE_%s (the path of the %s tool) is not set" % (name.upper(), name))
+    return path
+
+
+def assert_same(actual, expected, what):
+    actual, expected = np.asarray(actual, float), np.asarray(expected, float)
+    assert actual.shape == expected.shape, what
+    error = np.abs(actual - expected) / np.maximum(1.0, np.abs(expected))
+    assert error.max(initial=0.0) <= TOLERANCE, "%s: largest relative difference %g" % (
+        what, error.max())
+
+
+def write_csv(path, header, rows):
+    with open(path, "w") as f:
+        f.write(",".join(header) + "\n")
+        for row in rows:
+            f.write(",".join(repr(float(x)) for x in row) + "\n")  # repr: exact round trip
+
+
+def read_csv(path):
+    with open(path) as f:
+        reader = csv.reader(f)
+        header = [h.strip() for h in next(reader)]
+        values = np.array([[float(x) for x in row] for row in reader if row])
+    return {h: values[:, i] for i, h in enumerate(header)}
+
+
+def random_states(model, n, seed):
+    rng = np.random.default_rng(seed)
+    return (rng.uniform(-2.0, 2.0, (n, model.nq)), rng.uniform(-3.0, 3.0, (n, model.nq)),
+            rng.uniform(-20.0, 20.0, (n, model.nq)))
+
+
+# --- the package layout ------------------------------------------------------------
+def test_package_exposes_the_core_beside_the_messages():
+    assert jle.Model and jle.inverse_dynamics and jle.Estimator and jle.process_bag
+    from joint_load_estimator.msg import JointLoads  # the generated message still imports
+    assert "effort" in JointLoads.__slots__
+
+
+def test_model_names_and_errors():
+    model = jle.Model(PANDA)
+    assert model.nq == 8 and model.coordinate_names[0] == "panda_joint1"
+    assert model.joint_names[-1] == "panda_finger_joint2"  # a mimic joint's loads too
+    assert "panda_hand" in model.link_names and model.total_mass > 10
+    with open(PANDA) as f:
+        assert jle.Model.from_string(f.read()).joint_names == model.joint_names
+    with pytest.raises(ValueError, match="no_such.urdf"):
+        jle.Model("no_such.urdf")
+    with pytest.raises(ValueError, match="mass"):
+        jle.Model.from_string('<robot name="r"><link name="a"><inertial><mass value="-1"/>'
+                              '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'
+                              '</inertial></link></robot>')
+    q, qd, qdd = random_states(model, 3, 0)
+    with pytest.raises(ValueError, match=r"qd must have shape \(3, 8\)"):
+        jle.inverse_dynamics(model, q, qd[:, :7], qdd)
+    with pytest.raises(ValueError, match="unknown link 'nowhere'"):
+        jle.inverse_dynamics(model, q, qd, qdd, wrenches={"nowhere": np.zeros((3, 6))})
+    with pytest.raises(ValueError, match="frame"):
+        jle.inverse_dynamics(model, q, qd, qdd, frame="tool")
+
+
+# --- an independent reference: a pendulum in closed form ---------------------------
+PENDULUM = """<robot name="pendulum">
+  <link name="base"/>
+  <link name="bob"><inertial><origin xyz="0 0 -{l}"/><mass value="{m}"/>
+    <inertia ixx="0.01" iyy="{i}" izz="0.02" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="swing" type="continuous"><parent link="base"/><child link="bob"/>
+    <axis xyz="0 1 0"/></joint>
+</robot>"""
+
+
+def test_pendulum_against_its_closed_form():
+    m, l, i_yy, g = 1.7, 0.45, 0.03, 9.80665
+    model = jle.Model.from_string(PENDULUM.format(m=m, l=l, i=i_yy))
+    q, qd, qdd = (x[:, :1] for x in random_states(model, 200, 1))
+    world = jle.inverse_dynamics(model, q, qd, qdd, frame="world")
+    s, c = np.sin(q[:, 0]), np.cos(q[:, 0])
+    # Centre of mass at (-l sin q, 0, -l cos q) in the world; tau = (I + m l^2) q'' + m g l sin q.
+    tau = (i_yy + m * l * l) * qdd[:, 0] + m * g * l * s
+    a_com = np.stack([-l * c * qdd[:, 0] + l * s * qd[:, 0] ** 2, 0 * s,
+                      l * s * qdd[:, 0] + l * c * qd[:, 0] ** 2], axis=1)
+    force = m * (a_com - np.array([0.0, 0.0, -g]))
+    scale = 1e-12 * (1.0 + np.abs(tau).max())
+    np.testing.assert_allclose(world.effort[:, 0], tau, rtol=0, atol=scale)
+    np.testing.assert_allclose(world.force[:, 0], force, rtol=0, atol=scale)
+    np.testing.assert_allclose(world.moment[:, 0], np.stack([0 * s, tau, 0 * s], 1), atol=scale)
+    # The parent (base) frame is the world's; in the child frame the force turns by -q
+    # about y.
+    parent = jle.inverse_dynamics(model, q, qd, qdd, frame="parent")
+    np.testing.assert_allclose(parent.wrench, world.wrench, rtol=0, atol=scale)
+    child = jle.inverse_dynamics(model, q, qd, qdd)
+    fx = c * force[:, 0] - s * force[:, 2]
+    np.testing.assert_allclose(child["swing"].force[:, 0], fx, rtol=0, atol=scale)
+    assert child.joints == ["swing"] and child.links == ["bob"]
+    # Gravity given: none, the moment is the inertial one alone.
+    free = jle.inverse_dynamics(model, q, qd, qdd, gravity=[0, 0, 0])
+    np.testing.assert_allclose(free.effort[:, 0], (i_yy + m * l * l) * qdd[:, 0], atol=scale)
+
+
+# --- joint_loads on the same CSV -----------------------------------------------------
+def state_header(model, wrench_links=()):
+    header = ["t"]
+    for name in model.coordinate_names:
+        header += [name + ".q", name + ".qd", name + ".qdd"]
+    for link in wrench_links:
+        header += ["wrench@%s.%s" % (link, c) for c in ("fx", "fy", "fz", "mx", "my", "mz")]
+    return header
+
+
+def joint_loads(tmp_path, args, header, rows):
+    states, loads = str(tmp_path / "states.csv"), str(tmp_path / "loads.csv")
+    write_csv(states, header, rows)
+    run = subprocess.run([tool("joint_loads"), "--input", states, "--output", loads] + args,
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    return read_csv(loads), run.stderr
+
+
+def compare_with_columns(loads, columns):
+    for j, joint in enumerate(loads.joints):
+        for c, name in enumerate(("fx", "fy", "fz", "mx", "my", "mz")):
+            assert_same(loads.wrench[:, j, c], columns[joint + "." + name], joint + "." + name)
+        assert_same(loads.effort[:, j], columns[joint + ".effort"], joint + ".effort")
+
+
+@pytest.mark.parametrize("frame", ["child", "parent", "world"])
+def test_inverse_dynamics_is_joint_loads(tmp_path, frame):
+    model = jle.Model(PANDA)
+    n = 300
+    q, qd, qdd = random_states(model, n, 2)
+    wrench = np.random.default_rng(3).uniform(-30.0, 30.0, (n, 6))
+    t = 0.001 * np.arange(n)
+    rows = np.column_stack([t] + [np.stack([q[:, k], qd[:, k], qdd[:, k]], 1)
+                                  for k in range(model.nq)] + [wrench])
+    columns, _ = joint_loads(tmp_path, ["--urdf", PANDA, "--frame", frame],
+                             state_header(model, ["panda_hand"]), rows)
+    loads = jle.inverse_dynamics(model, q, qd, qdd, wrenches={"panda_hand": wrench}, frame=frame)
+    assert loads.joints == model.joint_names
+    compare_with_columns(loads, columns)
+
+
+def test_floating_base_is_joint_loads(tmp_path):
+    model = jle.Model(BODY, floating_base=True)
+    n = 100
+    q, qd, qdd = random_states(model, n, 4)
+    rng = np.random.default_rng(5)
+    quaternion = rng.normal(size=(n, 4))
+    quaternion /= np.linalg.norm(quaternion, axis=1)[:, None]
+    pose = np.column_stack([rng.uniform(-1, 1, (n, 3)), quaternion])
+    twist, acceleration = rng.uniform(-2, 2, (n, 6)), rng.uniform(-5, 5, (n, 6))
+    header = state_header(model) + ["base." + c for c in (
+        "x y z qx qy qz qw vx vy vz wx wy wz ax ay az alx aly alz".split())]
+    rows = np.column_stack([0.01 * np.arange(n)] + [np.stack([q[:, k], qd[:, k], qdd[:, k]], 1)
+                                                    for k in range(model.nq)] +
+                           [pose, twist, acceleration])
+    columns, _ = joint_loads(tmp_path, ["--urdf", BODY, "--floating-base"], header, rows)
+    loads = jle.inverse_dynamics(model, q, qd, qdd, base_pose=pose, base_twist=twist,
+                                 base_acceleration=acceleration)
+    compare_with_columns(loads, columns)
+    for c, name in enumerate(("fx", "fy", "fz", "mx", "my", "mz")):
+        assert_same(loads.base_residual[:, c], columns["base." + name], "base." + name)
+    with pytest.raises(ValueError, match="base_pose"):
+        jle.inverse_dynamics(model, q, qd, qdd)
+
+
+def test_zero_phase_is_joint_loads_positions_only(tmp_path):
+    model = jle.Model(PANDA)
+    n = 400
+    t = 0.002 * np.arange(n) + 0.0001 * np.sin(np.arange(n))  # irregular stamps
+    rng = np.random.default_rng(6)
+    q = 0.4 * np.sin(2 * np.pi * np.outer(t, rng.uniform(0.2, 1.5, model.nq))) + \
+        rng.normal(0, 1e-3, (n, model.nq))
+    wrench = 10 * np.sin(2 * np.pi * np.outer(t, rng.uniform(0.2, 1.5, 6))) + \
+        rng.normal(0, 0.5, (n, 6))
+    wrench_columns = ["wrench@panda_hand." + c for c in ("fx", "fy", "fz", "mx", "my", "mz")]
+    header = ["t"] + [name + ".q" for name in model.coordinate_names] + wrench_columns
+    kinematics = str(tmp_path / "kinematics.csv")
+    columns, stderr = joint_loads(tmp_path, ["--urdf", PANDA, "--cutoff", "auto",
+                                             "--write-kinematics", kinematics],
+                                  header, np.column_stack([t, q, wrench]))
+    value, rate, accel, cutoff = jle.smooth_zero_phase(t, q)  # gcv, as joint_loads' default
+    printed = float(re.search(r"cutoff (\S+) Hz", stderr).group(1))
+    assert cutoff == pytest.approx(printed, rel=1e-15)
+    smoothed = read_csv(kinematics)
+    for k, name in enumerate(model.coordinate_names):
+        assert_same(value[:, k], smoothed[name + ".q"], name + ".q")
+        assert_same(rate[:, k], smoothed[name + ".qd"], name + ".qd")
+        assert_same(accel[:, k], smoothed[name + ".qdd"], name + ".qdd")
+    # The wrench columns: the same filter, the positions' cutoff, no derivatives.
+    filtered = jle.low_pass_zero_phase(t, wrench, cutoff)
+    for c, name in enumerate(wrench_columns):
+        assert_same(filtered[:, c], smoothed[name], name)
+    compare_with_columns(jle.inverse_dynamics(model, value, rate, accel,
+                                              wrenches={"panda_hand": filtered}), columns)
+    fixed = jle.smooth_zero_phase(t, q, cutoff=cutoff)
+    assert_same(fixed[2], accel, "a cutoff given")
+    residual = jle.smooth_zero_phase(t, q, rule="residual")
+    assert residual[3] != cutoff and residual[3] > 0
+    with pytest.raises(ValueError, match="cutoff"):
+        jle.smooth_zero_phase(t, q, cutoff=-1.0)
+
+
+# --- process_bag on the same bag -----------------------------------------------------
+@pytest.fixture(scope="module")
+def example_bag(tmp_path_factory):
+    bag = str(tmp_path_factory.mktemp("bag") / "example.bag")
+    subprocess.run([tool("make_example_bag"), "--urdf", PANDA, "--output", bag, "--duration",
+                    "1.5"], check=True, capture_output=True)
+    return bag
+
+
+def process_bag(tmp_path, bag, args):
+    out = str(tmp_path / "loads.csv")
+    run = subprocess.run([tool("process_bag"), "--bag", bag, "--urdf", PANDA, "--csv", out,
+                          "--kinematics"] + args, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    return read_csv(out)
+
+
+@pytest.mark.parametrize("smoothing", [None, 4.0, "auto"])
+def test_process_bag_is_the_tool(tmp_path, example_bag, smoothing):
+    config = os.path.join(REPO, "config", "demo.yaml")
+    args = ["--config", config]
+    if smoothing is not None:
+        args += ["--zero-phase", str(smoothing)]
+    columns = process_bag(tmp_path, example_bag, args)
+    loads = jle.process_bag(example_bag, PANDA, config, zero_phase=smoothing)
+    assert len(loads) == len(columns["t"]) > 100
+    assert_same(loads.t, columns["t"], "t")
+    compare_with_columns(loads, columns)
+    for j, joint in enumerate(loads.joints):
+        for key, name in (("position", "q"), ("velocity", "qd"), ("acceleration", "qdd")):
+            assert_same(getattr(loads, key)[:, j], columns[joint + "." + name], joint + "." + name)
+    with pytest.raises(RuntimeError, match="no_such.bag"):
+        jle.process_bag(str(tmp_path / "no_such.bag"), PANDA)
+
+
+SENSOR_CONFIG = """wrenches:
+  - topic: /ft_sensor/wrench
+    link: panda_link8
+"""
+
+
+def test_estimator_is_process_bag(tmp_path, example_bag):
+    """The online estimator with the node's defaults, fed the bag's samples in the bag's
+    order, gives process_bag's loads (the node's message path around the same estimator)."""
+    import rosbag
+    config = str(tmp_path / "sensor.yaml")
+    with open(config, "w") as f:
+        f.write(SENSOR_CONFIG)  # the sensor's own frame: no transform in the message path
+    columns = process_bag(tmp_path, example_bag, ["--config", config])
+    model = jle.Model(PANDA)
+    joints, wrenches = [], []
+    with rosbag.Bag(example_bag) as bag:
+        for topic, msg, _ in bag.read_messages(["/joint_states", "/ft_sensor/wrench"]):
+            stamp = msg.header.stamp.to_nsec()
+            if topic == "/joint_states":
+                position = dict(zip(msg.name, msg.position))
+                joints.append([stamp] + [position[c] for c in model.coordinate_names])
+            else:
+                w = msg.wrench
+                wrenches.append([stamp, w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y,
+                                 w.torque.z])
+    joints, wrenches = np.array(joints, dtype=object), np.array(wrenches, dtype=object)
+    t0 = min(joints[0, 0], wrenches[0, 0])  # the message path's time origin: the first stamp
+    seconds = lambda stamps: np.array([(s - t0) * 1e-9 for s in stamps])
+    estimator = jle.Estimator(model, config)
+    loads = jle.estimate(estimator, seconds(joints[:, 0]), joints[:, 1:].astype(float),
+                         [(seconds(wrenches[:, 0]), wrenches[:, 1:].astype(float))])
+    assert loads.joints == model.joint_names and len(loads) == len(columns["t"])
+    assert np.abs(loads.t + t0 * 1e-9 - columns["t"]).max() < 1e-6
+    compare_with_columns(loads, columns)
+    # The sensor's readings matter: without them the efforts are others.
+    unloaded = jle.estimate(jle.Estimator(model), seconds(joints[:, 0]), joints[:, 1:].astype(float))
+    assert np.abs(unloaded.effort - loads.effort).max() > 0.1
+    # One sample at a time, from the start again: the same loads.
+    estimator.reset()
+    t, q = seconds(joints[:, 0]), joints[:, 1:].astype(float)
+    w, k = wrenches[:, 1:].astype(float), 0
+    tw = seconds(wrenches[:, 0])
+    published = []
+    for i in range(len(t)):
+        while k < len(tw) and tw[k] <= t[i]:
+            estimator.add_wrench(0, tw[k], w[k, :3], w[k, 3:])
+            k += 1
+        if estimator.add_joint_sample(t[i], q[i]) == "published":
+            published.append(estimator.loads()["effort"])
+    assert_same(np.array(published), loads.effort, "sample by sample")
+
+
+def test_estimator_defaults_are_the_nodes(tmp_path):
+    """Estimator(model) and Estimator(model, default.yaml) are one configuration."""
+    model = jle.Model(PANDA)
+    default = jle.Estimator(model)
+    from_file = jle.Estimator(model, os.path.join(REPO, "config", "default.yaml"))
+    assert default.delay_samples == from_file.delay_samples
+    t = 0.001 * np.arange(300)
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, model.nq + 1)))
+    a, b = jle.estimate(default, t, q), jle.estimate(from_file, t, q)
+    assert len(a) > 200
+    assert_same(a.wrench, b.wrench, "default.yaml")
+    with pytest.raises(ValueError, match="decimation"):
+        bad = tmp_path / "bad.yaml"
+        bad.write_text("decimation: 0\n")
+        jle.Estimator(model, str(bad))
+
+
+def test_inverse_dynamics_releases_the_gil():
+    """While a long batch runs in one thread, another keeps running Python: its longest
+    pause is a fraction of the batch's time (with the GIL held it would be all of it)."""
+    import threading
+    import time
+    model = jle.Model(PANDA)
+    q, qd, qdd = random_states(model, 300000, 7)
+    span = {}
+
+    def batch():
+        span["start"] = time.perf_counter()
+        jle.inverse_dynamics(model, q, qd, qdd)
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=batch)
+    worker.start()
+    stamps = []
+    while worker.is_alive():
+        stamps.append(time.perf_counter())
+    worker.join()
+    inside = [s for s in stamps if span["start"] <= s <= span["end"]]
+    duration = span["end"] - span["start"]
+    edges = [span["start"]] + inside + [span["end"]]
+    longest = max(b - a for a, b in zip(edges, edges[1:]))
+    assert longest < 0.5 * duration, "longest pause %.3f s of a %.3f s batch" % (longest, duration)
