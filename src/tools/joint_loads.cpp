@@ -77,33 +77,42 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    the end are accepted
   --output PATH    where the loads go (default: standard output); written to a
                    temporary file beside PATH and renamed onto it on success only
-  --gravity G      gravity in the world (root link) frame [m/s^2], default 0,0,-9.80665
+  --gravity G      gravity in the world (root link) frame [m/s^2], default 0,0,-9.80665;
+                   any three finite numbers (0,0,0: no gravity). With --plate it must
+                   point along -z (GX = GY = 0, GZ <= 0): the plates lie in the world's
+                   x-y plane with z up; a world with another up axis is refused (turn
+                   the data into a z-up world, or use the node, whose plate poses are
+                   free)
   --frame F        the frame of the output joint wrenches: child (the joint's child
                    link, default), parent (the joint's URDF parent link) or world
   --floating-base  the URDF's root link floats: its pose is read from base.* columns
   --plate NAME=LINK,X,Y,Z[,YAW_DEG]
                    a force plate (repeatable): its frame (z up, the contact surface
-                   through its origin) at X,Y,Z [m] in the world, turned by YAW_DEG
-                   about the world z axis; the foot LINK stands on it and receives the
-                   reaction at the centre of pressure
+                   through its origin) at X,Y,Z [m] in the world (finite), turned by
+                   YAW_DEG (finite, any sign) about the world z axis; the foot LINK
+                   stands on it and receives the reaction at the centre of pressure
   --contact-threshold N
-                   plate force [N] below which no centre of pressure is decoded and
-                   the plate is not in contact; the reading still acts on the foot
-                   as measured (default 20; 0: every pressing reading in contact)
+                   plate force [N], >= 0 (default 20), below which no centre of
+                   pressure is decoded and the plate is not in contact; a pressing
+                   reading still acts on the foot as measured. 0: every reading that
+                   presses into the plate (plate@NAME.fz < 0) is in contact; one that
+                   does not (fz >= 0) is never in contact and does not act at all
   --per-kg         also JOINT.effort_per_kg = effort / body mass [N m/kg, N/kg]
-  --body-mass KG   the body mass for --per-kg (default: the URDF's total mass)
+  --body-mass KG   the body mass for --per-kg, > 0 (default: the URDF's total mass)
   --kinematics     also JOINT.q, .qd, .qdd of every joint (what the loads were
                    computed from; a mimic joint's from its leader's)
   --friction       also JOINT.motor_effort = effort + damping qd + friction
                    tanh(qd / V), from each joint's URDF <dynamics damping friction>
                    (docs/outputs.md)
   --velocity-scale V
-                   [rad/s or m/s] width of the smooth sign of --friction (default 0.01)
+                   [rad/s or m/s] width of the smooth sign of --friction, > 0
+                   (default 0.01)
   --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
   --cutoff HZ|auto positions only (no JOINT.qd, JOINT.qdd column): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
                    Butterworth low-pass run forward and backward (zero phase), and
-                   q is differentiated (docs/zero_phase.md); the cutoff [Hz] given,
+                   q is differentiated (docs/zero_phase.md); the cutoff [Hz] given
+                   (> 0 and below half the sampling rate),
                    or chosen from the q columns by --cutoff-rule (default: auto).
                    The cutoff used is printed on standard error.
   --cutoff-rule R  gcv (generalised cross-validation, default) or residual
@@ -224,6 +233,20 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
   return plates;
 }
 
+// The --plate frames are z up in the world: gravity along +z, or off the z axis, would
+// put the plates on a wall or a ceiling without saying so.
+void checkPlatesUp(const Options& options) {
+  const Eigen::Vector3d& g = options.gravity_world;
+  const double tolerance = 1e-12 * g.norm();
+  if (options.plates.empty() || (std::abs(g.x()) <= tolerance && std::abs(g.y()) <= tolerance &&
+                                 g.z() <= 0.0))
+    return;
+  throw UsageError("--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) + "," +
+                   std::to_string(g.z()) + " with --plate " + options.plates.front().name +
+                   ": --plate frames are z up in the world, so --gravity must point along -z "
+                   "(0,0,-G); express the data in a z-up world");
+}
+
 // --cutoff, --cutoff-rule, --filter-order, --write-kinematics.
 void parseSmoothing(std::map<std::string, std::string>& v, Options& options) {
   jle::ZeroPhaseConfig& z = options.smoothing;
@@ -278,6 +301,7 @@ Options parseOptions(int argc, char** argv) {
     options.contact_threshold =
         parseNumber("--contact-threshold", v["--contact-threshold"], Sign::kNonNegative);
   options.plates = platesOf(plates, options.contact_threshold);
+  checkPlatesUp(options);
   options.per_kg = v.count("--per-kg") > 0;
   if (v.count("--body-mass")) {
     if (!options.per_kg) throw UsageError("--body-mass is only used with --per-kg");
