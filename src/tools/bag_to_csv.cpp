@@ -49,8 +49,8 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v = optionValues(
-      argc, argv, {"--bag", "--output", "--topic"}, {"--kinematics", "--per-kg"});
+  std::map<std::string, std::string> v =
+      optionValues(argc, argv, {"--bag", "--output", "--topic"}, {"--kinematics", "--per-kg"});
   Options o;
   o.bag = requiredValue(v, "--bag", "IN.bag");
   if (v.count("--output")) o.output = v["--output"];

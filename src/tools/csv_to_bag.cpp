@@ -119,18 +119,17 @@ Options parseOptions(int argc, char** argv) {
       rest.push_back(argv[i]);
     }
   }
-  std::map<std::string, std::string> v = optionValues(
-      static_cast<int>(rest.size()), rest.data(),
-      {"--input", "--output", "--world-frame", "--base-frame", "--time-offset", "--jitter",
-       "--seed"});
+  std::map<std::string, std::string> v =
+      optionValues(static_cast<int>(rest.size()), rest.data(),
+                   {"--input", "--output", "--world-frame", "--base-frame", "--time-offset",
+                    "--jitter", "--seed"});
   Options o;
   o.input = requiredValue(v, "--input", "STATES.csv");
   o.output = requiredValue(v, "--output", "OUT.bag");
   if (v.count("--world-frame")) o.world = v["--world-frame"];
   if (v.count("--base-frame")) o.base = v["--base-frame"];
   if (v.count("--time-offset")) o.time_offset = parseNumber("--time-offset", v["--time-offset"]);
-  if (v.count("--jitter"))
-    o.jitter = parseNumber("--jitter", v["--jitter"], Sign::kNonNegative);
+  if (v.count("--jitter")) o.jitter = parseNumber("--jitter", v["--jitter"], Sign::kNonNegative);
   if (v.count("--seed")) {
     if (!v.count("--jitter")) throw UsageError("--seed is only used with --jitter");
     o.seed = static_cast<std::uint32_t>(parseInteger("--seed", v["--seed"], 0, 4294967295ULL));
@@ -211,7 +210,8 @@ Columns bindColumns(const jle::CsvReader& r, const Options& o) {
   for (const PlatePose& p : o.plates) {
     bool known = false;
     for (const Columns::Wrench& w : c.wrenches) known = known || (w.plate && w.name == p.name);
-    if (!known) throw UsageError("--plate " + p.name + ": the CSV has no plate@" + p.name + " columns");
+    if (!known)
+      throw UsageError("--plate " + p.name + ": the CSV has no plate@" + p.name + " columns");
   }
   return c;
 }
@@ -261,8 +261,9 @@ class BagWriter {
                          " s is not a ROS time > 0 (give --time-offset)");
     const std::int64_t ns = std::llround(s * 1e9);
     if (ns <= last_[topic])
-      r.failAt(c_.t, "stamps do not increase" +
-                         std::string(o_.jitter > 0.0 ? " (--jitter exceeds the spacing of t)" : ""));
+      r.failAt(c_.t,
+               "stamps do not increase" +
+                   std::string(o_.jitter > 0.0 ? " (--jitter exceeds the spacing of t)" : ""));
     last_[topic] = ns;
     return jle_tools::stampOf(ns);
   }
@@ -271,7 +272,8 @@ class BagWriter {
     if (o_.plates.empty()) return;
     tf2_msgs::TFMessage tf;
     const ros::Time first = jle_tools::stampOf(std::llround((t + o_.time_offset) * 1e9));
-    if (!(t + o_.time_offset > 0.0)) r.failAt(c_.t, "the first stamp is not > 0 (give --time-offset)");
+    if (!(t + o_.time_offset > 0.0))
+      r.failAt(c_.t, "the first stamp is not > 0 (give --time-offset)");
     for (const PlatePose& p : o_.plates) {
       geometry_msgs::TransformStamped s;
       s.header.stamp = first;

@@ -83,8 +83,8 @@ names the key and the row; an unwritable output); 2 a usage error.
 )";
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kDefaultEffort = 1000.0;   // N m or N: URDF requires one
-constexpr double kDefaultVelocity = 10.0;   // rad/s or m/s
+constexpr double kDefaultEffort = 1000.0;  // N m or N: URDF requires one
+constexpr double kDefaultVelocity = 10.0;  // rad/s or m/s
 constexpr int kMaxLinks = 100;
 
 struct Options {
@@ -130,8 +130,9 @@ class TableReader {
       throw std::runtime_error(path_ + ": " + e.what());
     }
     if (!root.IsMap()) fail("", "the table is not a YAML map");
-    checkKeys(root, "", {"convention", "name", "base_link", "tip_link", "angle_unit",
-                         "inertia_about", "links"});
+    checkKeys(
+        root, "",
+        {"convention", "name", "base_link", "tip_link", "angle_unit", "inertia_about", "links"});
     Table t;
     const std::string convention = text(root, "", "convention", "");
     if (convention != "standard" && convention != "modified")
@@ -215,8 +216,9 @@ class TableReader {
 Row TableReader::row(const YAML::Node& node, int i, bool about_origin) const {
   std::string where = "links[" + std::to_string(i) + "]";
   if (!node.IsMap()) fail(where, "not a map");
-  checkKeys(node, where, {"joint", "link", "type", "a", "alpha", "d", "theta", "mass", "com",
-                          "inertia", "lower", "upper", "effort", "velocity"});
+  checkKeys(node, where,
+            {"joint", "link", "type", "a", "alpha", "d", "theta", "mass", "com", "inertia", "lower",
+             "upper", "effort", "velocity"});
   Row r;
   r.joint = name(node, where, "joint", "");
   where += " (" + r.joint + ")";
@@ -234,8 +236,7 @@ Row TableReader::row(const YAML::Node& node, int i, bool about_origin) const {
   const YAML::Node com = node["com"];
   if (com) {
     if (!com.IsSequence() || com.size() != 3) fail(where, "'com' must be [X, Y, Z]");
-    for (int k = 0; k < 3; ++k)
-      r.com[k] = number(com, where + " com", std::to_string(k), 0.0);
+    for (int k = 0; k < 3; ++k) r.com[k] = number(com, where + " com", std::to_string(k), 0.0);
   }
   inertia(node, where, r);
   // About the DH frame's origin: the parallel-axis theorem gives it about the COM.
@@ -243,9 +244,10 @@ Row TableReader::row(const YAML::Node& node, int i, bool about_origin) const {
     r.inertia -= r.mass * (r.com.squaredNorm() * Matrix3d::Identity() - r.com * r.com.transpose());
   const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(r.inertia);
   if (!(eig.eigenvalues().minCoeff() >= -1e-12 * std::max(1.0, r.inertia.norm())))
-    fail(where, "the inertia about the centre of mass is not positive semi-definite"
-                " (smallest principal moment " + std::to_string(eig.eigenvalues().minCoeff()) +
-                    " kg m^2)");
+    fail(where,
+         "the inertia about the centre of mass is not positive semi-definite"
+         " (smallest principal moment " +
+             std::to_string(eig.eigenvalues().minCoeff()) + " kg m^2)");
   limits(node, where, r);
   return r;
 }

@@ -169,7 +169,7 @@ struct Options {
   std::string write_kinematics;  // --write-kinematics FILE
   bool kinematics = false;
   bool friction = false;
-  double velocity_scale = 0.01;  // [rad/s or m/s], jle::FrictionConfig's default
+  double velocity_scale = 0.01;                    // [rad/s or m/s], jle::FrictionConfig's default
   jle::PlanarMode planar = jle::PlanarMode::kOff;  // --planar
 };
 
@@ -252,8 +252,8 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
 void checkPlatesUp(const Options& options) {
   const Eigen::Vector3d& g = options.gravity_world;
   const double tolerance = 1e-12 * g.norm();
-  if (options.plates.empty() || (std::abs(g.x()) <= tolerance && std::abs(g.y()) <= tolerance &&
-                                 g.z() <= 0.0))
+  if (options.plates.empty() ||
+      (std::abs(g.x()) <= tolerance && std::abs(g.y()) <= tolerance && g.z() <= 0.0))
     return;
   throw UsageError("--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) + "," +
                    std::to_string(g.z()) + " with --plate " + options.plates.front().name +

@@ -186,8 +186,8 @@ constexpr Range kSubtalarInversion{-15.0, 35.0};
 constexpr double kEffortLimit = 2000.0;  // N m
 constexpr double kVelocityLimit = 30.0;  // rad/s
 // --sagittal: the pelvis's planar coordinates (a walkway's length, any tilt a body has).
-constexpr double kWalkwayLimit = 1000.0;           // m, pelvis_tx and pelvis_tz
-constexpr Range kPelvisTilt{-90.0, 90.0};          // deg, anterior tilt positive
+constexpr double kWalkwayLimit = 1000.0;            // m, pelvis_tx and pelvis_tz
+constexpr Range kPelvisTilt{-90.0, 90.0};           // deg, anterior tilt positive
 constexpr double kPrismaticEffortLimit = 100000.0;  // N: bounds nothing
 
 // ----------------------------------------------------------------------- the options
@@ -300,8 +300,9 @@ class SegmentsReader {
         at("izz");
     o.sagittal_only = node.size() == 1 && node["iyy"];
     if (o.sagittal_only && !sagittal_)
-      fail(where, "iyy alone describes a sagittal (--sagittal) body; a 3-D body needs ixx, "
-                  "iyy and izz");
+      fail(where,
+           "iyy alone describes a sagittal (--sagittal) body; a 3-D body needs ixx, "
+           "iyy and izz");
     o.inertia = I;
   }
 
@@ -333,12 +334,11 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v =
-      optionValues(argc, argv,
-                   {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
-                    "--foot-height", "--pelvis-width", "--hat-length", "--name", "--output",
-                    "--segments"},
-                   {"--subtalar", "--sagittal"});
+  std::map<std::string, std::string> v = optionValues(
+      argc, argv,
+      {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length", "--foot-height",
+       "--pelvis-width", "--hat-length", "--name", "--output", "--segments"},
+      {"--subtalar", "--sagittal"});
   const std::string mass = requiredValue(v, "--mass", "KG");
   const std::string height = requiredValue(v, "--height", "M");
   Options o;
@@ -362,8 +362,8 @@ Options parseOptions(int argc, char** argv) {
     if (!(yaml->second >= 0.5 * table && yaml->second <= 2.0 * table))
       throw std::runtime_error(o.segments + ": the length of " + key + " (" +
                                std::to_string(yaml->second) + " m) is not within " +
-                               std::to_string(0.5 * table) + " .. " +
-                               std::to_string(2.0 * table) + " m (the table's value / 2 .. x 2)");
+                               std::to_string(0.5 * table) + " .. " + std::to_string(2.0 * table) +
+                               " m (the table's value / 2 .. x 2)");
     return yaml->second;
   };
   o.thigh_length = length("--thigh-length", kThighLength);
@@ -426,7 +426,8 @@ void applyOverride(const SegmentOverride& s, double& mass, Vector3d& com, Matrix
   if (s.mass) mass = *s.mass;
   if (s.com) com = *s.com;
   if (s.inertia) inertia = *s.inertia;
-  if (s.gyration) inertia = mass * s.gyration->cwiseProduct(*s.gyration).asDiagonal().toDenseMatrix();
+  if (s.gyration)
+    inertia = mass * s.gyration->cwiseProduct(*s.gyration).asDiagonal().toDenseMatrix();
   if (s.sagittal_only) {
     const double iyy = inertia(1, 1);
     inertia = Vector3d(0.5 * iyy, iyy, 0.5 * iyy).asDiagonal();
@@ -612,8 +613,7 @@ std::string makeUrdf(const Options& o) {
          (o.segments.empty() ? std::string()
                              : "\n     Segment parameters of " + o.segments +
                                    " replace the tables' where given.") +
-         (o.sagittal ? "\n     Sagittal plane: every joint turns about y (planar solver)."
-                     : "") +
+         (o.sagittal ? "\n     Sagittal plane: every joint turns about y (planar solver)." : "") +
          " -->");
   u.line("<robot name=\"" + o.name + "\">");
   u.line("  <material name=\"skin\"><color rgba=\"0.87 0.72 0.6 1\"/></material>");

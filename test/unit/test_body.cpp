@@ -24,8 +24,8 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -501,7 +501,8 @@ TEST_F(BodyTool, AsymmetricStanceBalancesTheBodyWeight) {
 
 // A lab's own sagittal-plane parameters (a 2-D study has the mass, the centre of mass
 // and the moment of inertia about the transverse axis only), as --segments reads them.
-const char* const kSagittalSegments = R"(thigh: {mass: 8.0, com: [0, 0, -0.19], inertia: {iyy: 0.15}}
+const char* const kSagittalSegments =
+    R"(thigh: {mass: 8.0, com: [0, 0, -0.19], inertia: {iyy: 0.15}}
 shank: {mass: 3.2, com: [0, 0, -0.18], gyration: 0.12, length: 0.42}
 foot: {mass: 1.1, com: [0.06, 0, -0.03], inertia: {iyy: 0.005}, height: 0.07}
 hat: {mass: 48.0, com: [0.01, 0, 0.30], inertia: {iyy: 2.1}}
@@ -510,13 +511,14 @@ constexpr double kSagittalMass = 48.0 + 2.0 * (8.0 + 3.2 + 1.1);  // kg
 
 // Joints of the sagittal body, and a CSV row of them: q, qd, qdd.
 const std::vector<std::string> kSagittalJoints = {
-    "pelvis_tx",      "pelvis_tz",       "pelvis_tilt",    "hip_flexion_r", "knee_flexion_r",
+    "pelvis_tx",       "pelvis_tz",     "pelvis_tilt",    "hip_flexion_r",  "knee_flexion_r",
     "ankle_flexion_r", "hip_flexion_l", "knee_flexion_l", "ankle_flexion_l"};
 
 std::string sagittalCsv(const std::vector<std::vector<double>>& rows) {
   std::string text = "t";
   for (const std::string& j : kSagittalJoints) text += "," + j + ".q," + j + ".qd," + j + ".qdd";
-  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) text += std::string(",wrench@foot_r.") + c;
+  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"})
+    text += std::string(",wrench@foot_r.") + c;
   text += "\n";
   for (const std::vector<double>& row : rows) {
     for (std::size_t i = 0; i < row.size(); ++i) {
@@ -536,7 +538,9 @@ TEST_F(BodyTool, SagittalBodyFromSegmentsIsPlanarWithTheGivenParameters) {
   EXPECT_FALSE(model.floating_base);
   EXPECT_EQ(model.nq, 9);
   EXPECT_NEAR(model.totalMass(), kSagittalMass, 1e-12);
-  const auto segment = [&](const char* link) { return model.frames[model.frameIndex(link)].segment; };
+  const auto segment = [&](const char* link) {
+    return model.frames[model.frameIndex(link)].segment;
+  };
   // The values of the YAML; the out-of-plane moments are iyy / 2 (documented).
   const struct {
     const char* link;
@@ -584,11 +588,12 @@ TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
   }
   write("sagittal.csv", sagittalCsv(rows));
   const auto loads = [&](const char* mode) {
-    const Result r = ToolTest::run(JLE_JOINT_LOADS, {"--urdf", path("out/body.urdf"), "--input",
-                                                     path("sagittal.csv"), "--planar", mode,
-                                                     "--output", path(std::string("out/") + mode)});
+    const Result r = ToolTest::run(
+        JLE_JOINT_LOADS, {"--urdf", path("out/body.urdf"), "--input", path("sagittal.csv"),
+                          "--planar", mode, "--output", path(std::string("out/") + mode)});
     EXPECT_EQ(r.status, 0) << r.err;
-    if (std::string(mode) == "on") EXPECT_NE(r.err.find("the 3x3 solver"), std::string::npos) << r.err;
+    if (std::string(mode) == "on")
+      EXPECT_NE(r.err.find("the 3x3 solver"), std::string::npos) << r.err;
     return jle_test::parseCsv(readFile(path(std::string("out/") + mode)));
   };
   const jle_test::Table on = loads("on"), off = loads("off");
@@ -612,8 +617,9 @@ TEST_F(BodyTool, SegmentsAreCheckedNamingTheKey) {
   const auto refused = [&](const std::string& yaml, std::vector<std::string> extra, int status,
                            const std::string& part) {
     write("bad.yaml", yaml);
-    std::vector<std::string> args{"--mass", "75", "--height", "1.75", "--segments",
-                                  path("bad.yaml"), "--output", path("out/x.urdf")};
+    std::vector<std::string> args{
+        "--mass",         "75",       "--height",        "1.75", "--segments",
+        path("bad.yaml"), "--output", path("out/x.urdf")};
     args.insert(args.end(), extra.begin(), extra.end());
     const Result r = run(args);
     EXPECT_EQ(r.status, status) << yaml << r.err;

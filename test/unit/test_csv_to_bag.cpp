@@ -56,7 +56,8 @@ class CsvToBag : public jle_test::ToolTest {
       std::snprintf(cell, sizeof cell, "%.17g", t);
       text += cell;
       for (std::size_t j = 0; j < joints_.size(); ++j) {
-        const double a = 0.1 * j - 0.3, b = 0.5 - 0.1 * j, c = 0.8 * std::cos(j), d = -1.5 + 0.4 * j;
+        const double a = 0.1 * j - 0.3, b = 0.5 - 0.1 * j, c = 0.8 * std::cos(j),
+                     d = -1.5 + 0.4 * j;
         const double q = a + t * (b + t * (c + t * d)), qd = b + t * (2 * c + 3 * d * t),
                      qdd = 2 * c + 6 * d * t;
         std::snprintf(cell, sizeof cell, ",%.17g,%.17g,%.17g", q, qd, qdd);
@@ -119,9 +120,9 @@ TEST_F(CsvToBag, TheBagHoldsTheCsvCellForCell) {
 TEST_F(CsvToBag, JitteredStampsAreSeededAndBounded) {
   write("trial.csv", trial());
   const auto stamps = [&](const char* seed, const char* name) {
-    const Result r = tool(JLE_CSV_TO_BAG, {"--input", path("trial.csv"), "--output", path(name),
-                                           "--time-offset", "100", "--jitter", "0.0004",
-                                           "--seed", seed});
+    const Result r =
+        tool(JLE_CSV_TO_BAG, {"--input", path("trial.csv"), "--output", path(name), "--time-offset",
+                              "100", "--jitter", "0.0004", "--seed", seed});
     EXPECT_EQ(r.status, 0) << r.err;
     std::vector<std::int64_t> out;
     rosbag::Bag bag(path(name));
@@ -130,7 +131,7 @@ TEST_F(CsvToBag, JitteredStampsAreSeededAndBounded) {
     return out;
   };
   const std::vector<std::int64_t> a = stamps("3", "out/a.bag"), b = stamps("3", "out/b.bag"),
-                                   c = stamps("4", "out/c.bag");
+                                  c = stamps("4", "out/c.bag");
   ASSERT_EQ(a.size(), static_cast<std::size_t>(kRows));
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
@@ -143,14 +144,14 @@ TEST_F(CsvToBag, JitteredStampsAreSeededAndBounded) {
   }
   EXPECT_GT(off_grid, kRows / 2);
   // A jitter beyond the spacing puts stamps out of order: refused, naming the line.
-  const Result r = tool(JLE_CSV_TO_BAG, {"--input", path("trial.csv"), "--output",
-                                         path("out/d.bag"), "--time-offset", "100", "--jitter",
-                                         "0.01"});
+  const Result r =
+      tool(JLE_CSV_TO_BAG, {"--input", path("trial.csv"), "--output", path("out/d.bag"),
+                            "--time-offset", "100", "--jitter", "0.01"});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("stamps do not increase"), std::string::npos) << r.err;
   // t = 0 without an offset is stamp 0, "unstamped" for ROS: refused.
-  const Result zero = tool(JLE_CSV_TO_BAG, {"--input", path("trial.csv"), "--output",
-                                            path("out/e.bag")});
+  const Result zero =
+      tool(JLE_CSV_TO_BAG, {"--input", path("trial.csv"), "--output", path("out/e.bag")});
   EXPECT_EQ(zero.status, 1);
   EXPECT_NE(zero.err.find("--time-offset"), std::string::npos) << zero.err;
 }
@@ -166,8 +167,8 @@ TEST_F(CsvToBag, TrialRoundTripsThroughTheNodesPath) {
                                   "--time-offset", "100"})
                 .status,
             0);
-  const std::vector<std::string> common{"--bag", path("out/in.bag"), "--urdf", kPanda,
-                                        "--config", path("config.yaml")};
+  const std::vector<std::string> common{"--bag", path("out/in.bag"), "--urdf",
+                                        kPanda,  "--config",         path("config.yaml")};
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = common;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -177,13 +178,13 @@ TEST_F(CsvToBag, TrialRoundTripsThroughTheNodesPath) {
   ASSERT_EQ(r.status, 0) << r.err;
   r = tool(JLE_PROCESS_BAG, with({"--csv", path("out/direct.csv"), "--kinematics"}));
   ASSERT_EQ(r.status, 0) << r.err;
-  r = tool(JLE_BAG_TO_CSV, {"--bag", path("out/loads.bag"), "--output", path("out/back.csv"),
-                            "--kinematics"});
+  r = tool(JLE_BAG_TO_CSV,
+           {"--bag", path("out/loads.bag"), "--output", path("out/back.csv"), "--kinematics"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(jle_test::readFile(path("out/back.csv")), jle_test::readFile(path("out/direct.csv")));
 
-  r = tool(JLE_JOINT_LOADS, {"--urdf", kPanda, "--input", path("trial.csv"), "--output",
-                             path("out/reference.csv")});
+  r = tool(JLE_JOINT_LOADS,
+           {"--urdf", kPanda, "--input", path("trial.csv"), "--output", path("out/reference.csv")});
   ASSERT_EQ(r.status, 0) << r.err;
   const Table back = jle_test::parseCsv(jle_test::readFile(path("out/back.csv")));
   const Table ref = jle_test::parseCsv(jle_test::readFile(path("out/reference.csv")));
@@ -214,7 +215,8 @@ TEST_F(CsvToBag, HelpAndBadInput) {
     EXPECT_EQ(tool(program, {"--bogus"}).status, 2);
   }
   write("bad.csv", "t,a.q,a.qd,b.q\n1,0,0,0\n");
-  const Result r = tool(JLE_CSV_TO_BAG, {"--input", path("bad.csv"), "--output", path("out/x.bag")});
+  const Result r =
+      tool(JLE_CSV_TO_BAG, {"--input", path("bad.csv"), "--output", path("out/x.bag")});
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("JOINT.qd"), std::string::npos) << r.err;
   const Result none = tool(JLE_BAG_TO_CSV, {"--bag", path("out/x.bag")});

@@ -150,8 +150,8 @@ Eigen::VectorXd craigNewtonEuler(const DhTable& t, const Eigen::VectorXd& q,
 // frame i, whose origin O_i is at the link's distal end; joint i acts about z_{i-1}.
 // p = O_i from O_{i-1} in frame i; the force and moment on link i from link i-1 act at
 // O_{i-1}: n_i = R n_{i+1} + p x R f_{i+1} + (p + r_i) x F_i + N_i.
-Eigen::VectorXd luhWalkerPaul(const DhTable& t, const Eigen::VectorXd& q,
-                              const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+Eigen::VectorXd luhWalkerPaul(const DhTable& t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                              const Eigen::VectorXd& qdd) {
   const std::size_t n = t.rows.size();
   const Vector3d z0 = Vector3d::UnitZ();
   std::vector<Matrix3d> R(n + 1, Matrix3d::Identity());  // R[i]: frame i+1 in frame i
@@ -215,10 +215,10 @@ std::string yamlOf(const DhTable& t) {
       << "\n    a: " << number(r.a) << "\n    alpha: " << number(r.alpha)
       << "\n    d: " << number(r.d) << "\n    theta: " << number(r.theta)
       << "\n    mass: " << number(r.mass) << "\n    com: [" << number(r.com.x()) << ", "
-      << number(r.com.y()) << ", " << number(r.com.z()) << "]\n    inertia: {ixx: "
-      << number(I(0, 0)) << ", iyy: " << number(I(1, 1)) << ", izz: " << number(I(2, 2))
-      << ", ixy: " << number(I(0, 1)) << ", ixz: " << number(I(0, 2))
-      << ", iyz: " << number(I(1, 2)) << "}\n";
+      << number(r.com.y()) << ", " << number(r.com.z())
+      << "]\n    inertia: {ixx: " << number(I(0, 0)) << ", iyy: " << number(I(1, 1))
+      << ", izz: " << number(I(2, 2)) << ", ixy: " << number(I(0, 1))
+      << ", ixz: " << number(I(0, 2)) << ", iyz: " << number(I(1, 2)) << "}\n";
     if (r.prismatic) y << "    lower: -1\n    upper: 1\n";
   }
   return y.str();
@@ -406,8 +406,8 @@ TEST_F(DhToUrdf, BadTablesAreRefusedNamingTheRow) {
   EXPECT_EQ(usage.status, 2);
   const Result help = run({"--help"});
   EXPECT_EQ(help.status, 0);
-  for (const char* part : {"standard", "modified", "Rx(alpha_i-1) Tx(a_i-1)", "inertia_about",
-                           "Exit status"})
+  for (const char* part :
+       {"standard", "modified", "Rx(alpha_i-1) Tx(a_i-1)", "inertia_about", "Exit status"})
     EXPECT_NE(help.out.find(part), std::string::npos) << part;
 }
 
