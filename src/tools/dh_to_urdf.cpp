@@ -14,6 +14,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -194,13 +195,17 @@ class TableReader {
   double number(const YAML::Node& node, const std::string& where, const std::string& key,
                 double fallback) const {
     const YAML::Node v = node[key];
-    if (!v) return fallback;
+    return v ? value(v, where, "'" + key + "'") : fallback;
+  }
+
+  // A scalar as a finite number; `what` names it in the message.
+  double value(const YAML::Node& v, const std::string& where, const std::string& what) const {
     double x = 0.0;
     const std::string s = v.IsScalar() ? v.as<std::string>() : std::string();
     const char* end = s.data() + s.size();
     const std::from_chars_result r = std::from_chars(s.data(), end, x);
     if (s.empty() || r.ec != std::errc() || r.ptr != end || !std::isfinite(x))
-      fail(where, "'" + key + "' must be a finite number (is '" + s + "')");
+      fail(where, what + " must be a finite number (is '" + s + "')");
     return x;
   }
 
@@ -236,7 +241,8 @@ Row TableReader::row(const YAML::Node& node, int i, bool about_origin) const {
   const YAML::Node com = node["com"];
   if (com) {
     if (!com.IsSequence() || com.size() != 3) fail(where, "'com' must be [X, Y, Z]");
-    for (int k = 0; k < 3; ++k) r.com[k] = number(com, where + " com", std::to_string(k), 0.0);
+    for (std::size_t k = 0; k < 3; ++k)
+      r.com[static_cast<int>(k)] = value(com[k], where, "'com'[" + std::to_string(k) + "]");
   }
   inertia(node, where, r);
   // About the DH frame's origin: the parallel-axis theorem gives it about the COM.
@@ -249,6 +255,11 @@ Row TableReader::row(const YAML::Node& node, int i, bool about_origin) const {
          " (smallest principal moment " +
              std::to_string(eig.eigenvalues().minCoeff()) + " kg m^2)");
   limits(node, where, r);
+  if (r.mass == 0.0 && !r.inertia.isZero(0.0))
+    std::fprintf(stderr,
+                 "dh_to_urdf: %s: warning: mass 0 with a non-zero inertia; the package treats a "
+                 "link without mass as massless (no inertia), KDL keeps the inertia\n",
+                 where.c_str());
   return r;
 }
 
