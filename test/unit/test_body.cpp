@@ -592,8 +592,9 @@ TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
         JLE_JOINT_LOADS, {"--urdf", path("out/body.urdf"), "--input", path("sagittal.csv"),
                           "--planar", mode, "--output", path(std::string("out/") + mode)});
     EXPECT_EQ(r.status, 0) << r.err;
-    if (std::string(mode) == "on")
+    if (std::string(mode) == "on") {
       EXPECT_NE(r.err.find("the 3x3 solver"), std::string::npos) << r.err;
+    }
     return jle_test::parseCsv(readFile(path(std::string("out/") + mode)));
   };
   const jle_test::Table on = loads("on"), off = loads("off");
