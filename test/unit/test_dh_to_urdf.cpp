@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -317,7 +318,17 @@ Eigen::VectorXd kdlEfforts(const std::string& urdf, const Eigen::VectorXd& q,
 
 // The table through the tool, at random states: FK, efforts against the DH reference
 // and KDL.
-void expectAgreement(const DhTable& table, const std::string& urdf, std::mt19937& gen) {
+// The worst differences seen, printed by each test (the figures docs/dh_to_urdf.md quotes).
+struct Worst {
+  double effort = 0.0, kdl = 0.0, pose = 0.0;
+  void print(const char* what) const {
+    std::printf("%s: worst |effort - reference| %.3g, |KDL - reference| %.3g, pose %.3g\n", what,
+                effort, kdl, pose);
+  }
+};
+
+void expectAgreement(const DhTable& table, const std::string& urdf, std::mt19937& gen,
+                     Worst& worst) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const std::size_t n = table.rows.size();
   const jle::Model<double> model = jle::modelFromUrdfString(urdf);
@@ -330,10 +341,13 @@ void expectAgreement(const DhTable& table, const std::string& urdf, std::mt19937
     const PackageResult ours = packageRun(model, q, qd, qdd);
     const Matrix4d fk = forwardKinematics(table, q);
     EXPECT_LE((ours.flange - fk).cwiseAbs().maxCoeff(), kPoseTol) << "sample " << sample;
+    worst.pose = std::max(worst.pose, (ours.flange - fk).cwiseAbs().maxCoeff());
     const Eigen::VectorXd reference = referenceEfforts(table, q, qd, qdd);
     const Eigen::VectorXd kdl = kdlEfforts(urdf, q, qd, qdd);
     for (std::size_t i = 0; i < n; ++i) {
       EXPECT_NEAR(ours.effort[i], reference[i], kEffortTol) << "sample " << sample << " j" << i + 1;
+      worst.effort = std::max(worst.effort, std::abs(ours.effort[i] - reference[i]));
+      worst.kdl = std::max(worst.kdl, std::abs(kdl[i] - reference[i]));
       EXPECT_NEAR(kdl[i], reference[i], kKdlTol * std::max(1.0, std::abs(reference[i])))
           << "KDL, sample " << sample << " j" << i + 1;
     }
@@ -342,18 +356,22 @@ void expectAgreement(const DhTable& table, const std::string& urdf, std::mt19937
 
 TEST_F(DhToUrdf, RandomStandardTablesMatchNewtonEulerInDhFrames) {
   std::mt19937 gen(7);
+  Worst worst;
   for (int trial = 0; trial < 5; ++trial) {
     const DhTable table = randomTable(false, 6, gen);
-    expectAgreement(table, convert(yamlOf(table)), gen);
+    expectAgreement(table, convert(yamlOf(table)), gen, worst);
   }
+  worst.print("standard");
 }
 
 TEST_F(DhToUrdf, RandomModifiedTablesMatchCraigsNewtonEuler) {
   std::mt19937 gen(11);
+  Worst worst;
   for (int trial = 0; trial < 5; ++trial) {
     const DhTable table = randomTable(true, 6, gen);
-    expectAgreement(table, convert(yamlOf(table)), gen);
+    expectAgreement(table, convert(yamlOf(table)), gen, worst);
   }
+  worst.print("modified");
 }
 
 // The bundled examples (README, docs/dh_to_urdf.md) convert and load.
