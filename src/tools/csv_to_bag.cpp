@@ -49,7 +49,10 @@ node or process_bag (docs/data_in_out.md):
   base.x .. base.qw      /tf, world -> base frame (the floating base's pose); base
                          twist and acceleration columns are not carried (the node
                          estimates them)
-One message per row and topic, header.seq counting from 0.
+One message per row and topic, header.seq counting from 0; bag time = the stamp, the
+inputs of a row 1 us before its joint state (a reader in bag order, as the node under
+rosbag play or process_bag, has an instant's inputs when its joint state comes), and
+every message at its own stamp with --jitter (its reception).
 
   --input PATH       the CSV (joint_loads' input; t [s] increasing)
   --output PATH      the bag; written beside PATH and renamed onto it on success only
@@ -224,16 +227,12 @@ class BagWriter {
       : o_(o), c_(c), bag_(o.output), random_(o.seed), last_(c.wrenches.size() + 2, -1) {}
 
   // One record, the row's time t [s].
+  // One record, the row's time t [s]: its wrenches, plates and base pose first, then its
+  // joint state, so that a reader in bag order has an instant's inputs before its joint
+  // state (without --jitter they are written 1 us before it in bag time).
   void row(const jle::CsvReader& r, const std::vector<double>& x, long n) {
     const double t = x[c_.t];
     if (n == 0) staticPlates(r, t);
-    sensor_msgs::JointState js;
-    js.header.seq = static_cast<std::uint32_t>(n);
-    js.header.stamp = stamp(r, t, 0);
-    js.name = c_.joints;
-    for (int k : c_.q) js.position.push_back(x[k]);
-    for (int k : c_.qd) js.velocity.push_back(x[k]);
-    bag_.bag().write("/joint_states", js.header.stamp, js);
     for (std::size_t w = 0; w < c_.wrenches.size(); ++w) {
       const Columns::Wrench& cw = c_.wrenches[w];
       geometry_msgs::WrenchStamped m;
@@ -243,9 +242,17 @@ class BagWriter {
       const auto at = [&](int k) { return x[cw.c[k]]; };
       jle_tools::setWrench(m, Eigen::Vector3d(at(0), at(1), at(2)),
                            Eigen::Vector3d(at(3), at(4), at(5)));
-      bag_.bag().write((cw.plate ? "/force_plate/" : "/wrench/") + cw.name, m.header.stamp, m);
+      bag_.bag().write((cw.plate ? "/force_plate/" : "/wrench/") + cw.name,
+                       inputTime(m.header.stamp), m);
     }
     if (c_.base[0] >= 0) basePose(r, x, n, t);
+    sensor_msgs::JointState js;
+    js.header.seq = static_cast<std::uint32_t>(n);
+    js.header.stamp = stamp(r, t, 0);
+    js.name = c_.joints;
+    for (int k : c_.q) js.position.push_back(x[k]);
+    for (int k : c_.qd) js.velocity.push_back(x[k]);
+    bag_.bag().write("/joint_states", js.header.stamp, js);
   }
 
   void commit() { bag_.commit(); }
@@ -268,6 +275,12 @@ class BagWriter {
     return jle_tools::stampOf(ns);
   }
 
+  // The bag time of an input message stamped `stamp`: 1 us before it without --jitter
+  // (ahead of the joint state of its instant), the stamp (its reception) with it.
+  ros::Time inputTime(const ros::Time& stamp) const {
+    return o_.jitter > 0.0 ? stamp : stamp - ros::Duration(0, 1000);
+  }
+
   void staticPlates(const jle::CsvReader& r, double t) {
     if (o_.plates.empty()) return;
     tf2_msgs::TFMessage tf;
@@ -286,7 +299,7 @@ class BagWriter {
       s.transform.rotation.w = std::cos(0.5 * p.yaw);
       tf.transforms.push_back(s);
     }
-    bag_.bag().write("/tf_static", first, tf);
+    bag_.bag().write("/tf_static", first - ros::Duration(0, 1000), tf);
   }
 
   void basePose(const jle::CsvReader& r, const std::vector<double>& x, long n, double t) {
@@ -310,7 +323,7 @@ class BagWriter {
     s.transform.rotation.w = q.w();
     tf2_msgs::TFMessage tf;
     tf.transforms.push_back(s);
-    bag_.bag().write("/tf", s.header.stamp, tf);
+    bag_.bag().write("/tf", inputTime(s.header.stamp), tf);
   }
 
   const Options& o_;

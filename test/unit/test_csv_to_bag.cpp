@@ -52,7 +52,7 @@ class CsvToBag : public jle_test::ToolTest {
     text += "\n";
     for (int k = 0; k < kRows; ++k) {
       const double t = k / 1000.0;
-      char cell[64];
+      char cell[128];
       std::snprintf(cell, sizeof cell, "%.17g", t);
       text += cell;
       for (std::size_t j = 0; j < joints_.size(); ++j) {
