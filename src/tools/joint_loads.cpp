@@ -2,11 +2,13 @@
 // states (and applied wrenches), one output row per input row. docs/joint_loads.md.
 #include <joint_load_estimator/base_motion.hpp>
 #include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/planar.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
@@ -35,7 +37,7 @@ const char* const kUsage =
                    [--floating-base] [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
                    [--contact-threshold N] [--per-kg [--body-mass KG]]
                    [--kinematics] [--friction [--velocity-scale V]]
-                   [--format csv|sto]
+                   [--planar off|auto|on] [--format csv|sto]
                    [--cutoff HZ|auto] [--cutoff-rule residual|gcv]
                    [--filter-order N] [--write-kinematics STATES.csv]
 
@@ -77,33 +79,53 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    the end are accepted
   --output PATH    where the loads go (default: standard output); written to a
                    temporary file beside PATH and renamed onto it on success only
-  --gravity G      gravity in the world (root link) frame [m/s^2], default 0,0,-9.80665
+  --gravity G      gravity in the world (root link) frame [m/s^2], default 0,0,-9.80665;
+                   any three finite numbers (0,0,0: no gravity). With --plate it must
+                   point along -z (GX = GY = 0, GZ <= 0): the plates lie in the world's
+                   x-y plane with z up; a world with another up axis is refused (turn
+                   the data into a z-up world, or use the node, whose plate poses are
+                   free)
   --frame F        the frame of the output joint wrenches: child (the joint's child
                    link, default), parent (the joint's URDF parent link) or world
   --floating-base  the URDF's root link floats: its pose is read from base.* columns
   --plate NAME=LINK,X,Y,Z[,YAW_DEG]
                    a force plate (repeatable): its frame (z up, the contact surface
-                   through its origin) at X,Y,Z [m] in the world, turned by YAW_DEG
-                   about the world z axis; the foot LINK stands on it and receives the
-                   reaction at the centre of pressure
+                   through its origin) at X,Y,Z [m] in the world (finite), turned by
+                   YAW_DEG (finite, any sign) about the world z axis; the foot LINK
+                   stands on it and receives the reaction at the centre of pressure
   --contact-threshold N
-                   plate force [N] below which no centre of pressure is decoded and
-                   the plate is not in contact; the reading still acts on the foot
-                   as measured (default 20; 0: every pressing reading in contact)
+                   plate force [N], >= 0 (default 20), below which no centre of
+                   pressure is decoded and the plate is not in contact; a pressing
+                   reading still acts on the foot as measured. 0: every reading that
+                   presses into the plate (plate@NAME.fz < 0) is in contact; one that
+                   does not (fz >= 0) is never in contact and does not act at all
   --per-kg         also JOINT.effort_per_kg = effort / body mass [N m/kg, N/kg]
-  --body-mass KG   the body mass for --per-kg (default: the URDF's total mass)
+  --body-mass KG   the body mass for --per-kg, > 0 (default: the URDF's total mass)
   --kinematics     also JOINT.q, .qd, .qdd of every joint (what the loads were
                    computed from; a mimic joint's from its leader's)
   --friction       also JOINT.motor_effort = effort + damping qd + friction
                    tanh(qd / V), from each joint's URDF <dynamics damping friction>
                    (docs/outputs.md)
   --velocity-scale V
-                   [rad/s or m/s] width of the smooth sign of --friction (default 0.01)
+                   [rad/s or m/s] width of the smooth sign of --friction, > 0
+                   (default 0.01)
+  --planar M       the planar solver (the 3x3 system per segment of a model moving in a
+                   plane, e.g. make_body_urdf --sagittal; the same loads within 1e-12
+                   relative): off (default), auto (when the model is detected planar:
+                   fixed base, every revolute axis along one normal n, prismatic axes
+                   and gravity perpendicular to n, n a principal axis of every
+                   inertia; a row whose wrench@ columns leave the plane takes the 6x6
+                   path) or on (the user asserts planarity: out-of-plane parts are
+                   dropped; refused for a floating base or a model without a
+                   revolute joint). The choice and its reason are printed on standard
+                   error. Not with --plate, --frame parent|world, --kinematics,
+                   --friction (the 6x6 path's outputs)
   --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
   --cutoff HZ|auto positions only (no JOINT.qd, JOINT.qdd column): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
                    Butterworth low-pass run forward and backward (zero phase), and
-                   q is differentiated (docs/zero_phase.md); the cutoff [Hz] given,
+                   q is differentiated (docs/zero_phase.md); the cutoff [Hz] given
+                   (> 0 and below half the sampling rate),
                    or chosen from the q columns by --cutoff-rule (default: auto).
                    The cutoff used is printed on standard error.
   --cutoff-rule R  gcv (generalised cross-validation, default) or residual
@@ -147,7 +169,8 @@ struct Options {
   std::string write_kinematics;  // --write-kinematics FILE
   bool kinematics = false;
   bool friction = false;
-  double velocity_scale = 0.01;  // [rad/s or m/s], jle::FrictionConfig's default
+  double velocity_scale = 0.01;                    // [rad/s or m/s], jle::FrictionConfig's default
+  jle::PlanarMode planar = jle::PlanarMode::kOff;  // --planar
 };
 
 Eigen::Vector3d parseGravity(const std::string& text) {
@@ -224,6 +247,20 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
   return plates;
 }
 
+// The --plate frames are z up in the world: gravity along +z, or off the z axis, would
+// put the plates on a wall or a ceiling without saying so.
+void checkPlatesUp(const Options& options) {
+  const Eigen::Vector3d& g = options.gravity_world;
+  const double tolerance = 1e-12 * g.norm();
+  if (options.plates.empty() ||
+      (std::abs(g.x()) <= tolerance && std::abs(g.y()) <= tolerance && g.z() <= 0.0))
+    return;
+  throw UsageError("--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) + "," +
+                   std::to_string(g.z()) + " with --plate " + options.plates.front().name +
+                   ": --plate frames are z up in the world, so --gravity must point along -z "
+                   "(0,0,-G); express the data in a z-up world");
+}
+
 // --cutoff, --cutoff-rule, --filter-order, --write-kinematics.
 void parseSmoothing(std::map<std::string, std::string>& v, Options& options) {
   jle::ZeroPhaseConfig& z = options.smoothing;
@@ -255,6 +292,20 @@ void parseOutputOptions(std::map<std::string, std::string>& v, Options& options)
   }
   if (options.sto && (options.kinematics || options.friction))
     throw UsageError("--kinematics and --friction are columns of the csv format only");
+  if (v.count("--planar")) {
+    const std::string& m = v["--planar"];
+    if (m != "off" && m != "auto" && m != "on")
+      throw UsageError("--planar: '" + m + "' is not off, auto or on");
+    options.planar = m == "on" ? jle::PlanarMode::kOn
+                               : (m == "auto" ? jle::PlanarMode::kAuto : jle::PlanarMode::kOff);
+  }
+  if (options.planar != jle::PlanarMode::kOff &&
+      (options.kinematics || options.friction || !options.plates.empty() ||
+       options.frame != jle::WrenchFrame::kChild))
+    throw UsageError(
+        "--planar " + v["--planar"] +
+        " is not for --plate, --frame parent|world, --kinematics or --friction (the 6x6 "
+        "path's outputs; give plates as wrench@FOOT columns)");
 }
 
 Options parseOptions(int argc, char** argv) {
@@ -265,7 +316,7 @@ Options parseOptions(int argc, char** argv) {
       optionValues(static_cast<int>(rest.size()), rest.data(),
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
                     "--body-mass", "--format", "--cutoff", "--cutoff-rule", "--filter-order",
-                    "--write-kinematics", "--velocity-scale"},
+                    "--write-kinematics", "--velocity-scale", "--planar"},
                    {"--floating-base", "--per-kg", "--kinematics", "--friction"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
@@ -278,6 +329,7 @@ Options parseOptions(int argc, char** argv) {
     options.contact_threshold =
         parseNumber("--contact-threshold", v["--contact-threshold"], Sign::kNonNegative);
   options.plates = platesOf(plates, options.contact_threshold);
+  checkPlatesUp(options);
   options.per_kg = v.count("--per-kg") > 0;
   if (v.count("--body-mass")) {
     if (!options.per_kg) throw UsageError("--body-mass is only used with --per-kg");
@@ -385,6 +437,7 @@ class Processor {
     }
     names_ = jle::jointLoadColumns(model, layout);
     loads_.resize(names_.size());
+    setUpPlanar();
   }
 
   const std::vector<std::string>& names() const { return names_; }
@@ -442,15 +495,57 @@ class Processor {
       qd_[k] = cells[columns_.qd[k]];
       qdd_[k] = cells[columns_.qdd[k]];
     }
-    const jle::BaseState<double> base =
-        model_.floating_base ? baseState(index, m) : jle::BaseState<double>();
-    jle::forwardKinematics(model_, data_, q_, qd_, qdd_, options_.gravity_world, base);
-    for (const jle::StateColumns::WrenchColumns& w : columns_.wrenches)
-      jle::addExternalWrench(model_, data_, w.frame, triple(cells, w.column, 0),
-                             triple(cells, w.column, 3), jle::WrenchFrame::kLocal);
-    applyPlates(cells);
-    jle::inverseDynamics(model_, data_);
+    if (!(planar_ && planarLoads(cells))) {
+      const jle::BaseState<double> base =
+          model_.floating_base ? baseState(index, m) : jle::BaseState<double>();
+      jle::forwardKinematics(model_, data_, q_, qd_, qdd_, options_.gravity_world, base);
+      for (const jle::StateColumns::WrenchColumns& w : columns_.wrenches)
+        jle::addExternalWrench(model_, data_, w.frame, triple(cells, w.column, 0),
+                               triple(cells, w.column, 3), jle::WrenchFrame::kLocal);
+      applyPlates(cells);
+      jle::inverseDynamics(model_, data_);
+    }
     writeLoads(cells, out);
+  }
+
+  // --planar: the planar solver is set up if the model is planar (auto) or asserted (on),
+  // as the estimator does for savings/planar.
+  void setUpPlanar() {
+    if (options_.planar == jle::PlanarMode::kOff) return;
+    const jle::PlanarCheck<double> check = jle::detectPlanar(model_, options_.gravity_world);
+    planar_ = check.planar;
+    if (!planar_ && options_.planar == jle::PlanarMode::kOn) {
+      if (model_.floating_base || check.normal.isZero())
+        throw std::runtime_error("--planar on: " + check.reason);
+      planar_ = true;  // the user's assertion: out-of-plane parts are dropped
+    }
+    if (planar_) {
+      planar_model_ = jle::planarModel(model_, check.normal);
+      planar_data_ = jle::PlanarData<double>(model_.nsegments());
+      for (int i = 0; i < model_.nsegments(); ++i) segments_.push_back(i);
+    }
+    const Eigen::Vector3d& n = check.normal;
+    std::fprintf(stderr, "joint_loads: planar %s: %s (normal %.17g %.17g %.17g)%s%s\n",
+                 options_.planar == jle::PlanarMode::kOn ? "on" : "auto",
+                 planar_ ? "the 3x3 solver" : "the 6x6 solver", n.x(), n.y(), n.z(),
+                 check.reason.empty() ? "" : ": ", check.reason.c_str());
+  }
+
+  // The loads of a row by the planar solver; false (nothing done) when --planar auto
+  // meets a wrench out of the plane.
+  bool planarLoads(const std::vector<double>& cells) {
+    if (options_.planar == jle::PlanarMode::kAuto)
+      for (const jle::StateColumns::WrenchColumns& w : columns_.wrenches)
+        if (!jle::planarWrenchInPlane(planar_model_, w.frame, triple(cells, w.column, 0),
+                                      triple(cells, w.column, 3)))
+          return false;
+    jle::planarKinematics(model_, planar_model_, planar_data_, q_, qd_, qdd_,
+                          options_.gravity_world, segments_);
+    for (const jle::StateColumns::WrenchColumns& w : columns_.wrenches)
+      jle::planarAddExternalWrench(model_, planar_model_, planar_data_, w.frame,
+                                   triple(cells, w.column, 0), triple(cells, w.column, 3));
+    jle::planarInverseDynamics(model_, planar_model_, planar_data_, data_, segments_);
+    return true;
   }
 
   // The root's motion at row `index`: its pose, and its twist and acceleration from the
@@ -562,6 +657,10 @@ class Processor {
   bool estimate_;  // the base twist or acceleration estimated from the neighbouring rows
   Row window_[3];
   std::vector<int> plate_frames_;
+  bool planar_ = false;  // --planar: the 3x3 solver is used
+  jle::PlanarModel<double> planar_model_;
+  jle::PlanarData<double> planar_data_;
+  std::vector<int> segments_;  // every segment, for the planar passes
   std::vector<std::string> names_;
   std::vector<double> loads_, cop_;
 };

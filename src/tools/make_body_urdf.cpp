@@ -4,6 +4,8 @@
 // is documented here and in docs/body_model.md.
 #include <joint_load_estimator/command_line.hpp>
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Core>
 
 #include <sys/stat.h>
@@ -17,6 +19,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -26,7 +30,8 @@ namespace {
 using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the parsers
 
 const char* const kUsage =
-    R"(usage: make_body_urdf --mass KG --height M [--subtalar] [--name NAME] [--output FILE]
+    R"(usage: make_body_urdf --mass KG --height M [--subtalar | --sagittal]
+                      [--segments SEGMENTS.yaml] [--name NAME] [--output FILE]
                       [--thigh-length M] [--shank-length M] [--foot-length M]
                       [--foot-height M] [--pelvis-width M] [--hat-length M]
 
@@ -48,6 +53,39 @@ mirrored), so that each effort is the net moment on the distal segment in that s
   --mass KG          body mass, 1 .. 500 (required)
   --height M         body height, 0.5 .. 2.7 (required)
   --subtalar         add a subtalar inversion joint (talus_s, massless) at each ankle
+  --sagittal         a sagittal-plane (2-D) body: a root link `world` and the pelvis on
+                     pelvis_tx (prismatic, +x forward), pelvis_tz (prismatic, +z up) and
+                     pelvis_tilt (revolute about +y: anterior tilt); per side only
+                     hip_flexion_s, knee_flexion_s and ankle_flexion_s. Every axis is
+                     along y, so the package's planar solver (3x3 per segment) detects
+                     it: joint_loads --planar on. Out-of-plane moments of inertia never
+                     enter its loads; a segment given only iyy (below) gets ixx = izz =
+                     iyy / 2, which satisfies the model's inertia check
+  --segments PATH    a YAML map of the lab's own segment parameters, each overriding
+                     the tables: keys thigh, shank, foot, hat (the pelvis link), each a
+                     map of
+                       mass: KG          > 0
+                       com: [X, Y, Z]    [m] centre of mass in the link frame (thigh,
+                                         shank: from the proximal joint, z down is
+                                         negative; foot: from the ankle; hat: from the
+                                         hip joint centres' midpoint)
+                       inertia: {ixx, iyy, izz, ixy, ixz, iyz}
+                                         [kg m^2] about the centre of mass, link axes;
+                                         absent entries 0; with --sagittal iyy alone
+                                         is enough (the sagittal moment)
+                       gyration: [KX, KY, KZ]
+                                         [m] radii of gyration about the centre of mass
+                                         along the link axes, inertia m k^2 (or
+                                         gyration: K with --sagittal: iyy = m K^2);
+                                         not with inertia
+                       length: M         thigh, shank, hat: as --thigh-length,
+                                         --shank-length, --hat-length; foot: as
+                                         --foot-length; foot also height: M (as
+                                         --foot-height); and a map pelvis: {width: M}
+                                         (as --pelvis-width); each within a factor of
+                                         2 of the table's value, not with the option
+                     a segment or value not given keeps the table's (the tables'
+                     masses scale with --mass; the model's mass is then the sum)
   --thigh-length M   hip to knee joint centre (default 0.245 x height)
   --shank-length M   knee to ankle joint centre (default 0.246 x height)
   --foot-length M    heel to toe (default 0.152 x height)
@@ -147,35 +185,186 @@ constexpr Range kSubtalarInversion{-15.0, 35.0};
 // not a strength model) so that no tool clips a computed load.
 constexpr double kEffortLimit = 2000.0;  // N m
 constexpr double kVelocityLimit = 30.0;  // rad/s
+// --sagittal: the pelvis's planar coordinates (a walkway's length, any tilt a body has).
+constexpr double kWalkwayLimit = 1000.0;            // m, pelvis_tx and pelvis_tz
+constexpr Range kPelvisTilt{-90.0, 90.0};           // deg, anterior tilt positive
+constexpr double kPrismaticEffortLimit = 100000.0;  // N: bounds nothing
 
 // ----------------------------------------------------------------------- the options
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// A segment's parameters from --segments, each overriding the table's.
+struct SegmentOverride {
+  std::optional<double> mass;
+  std::optional<Vector3d> com;
+  std::optional<Matrix3d> inertia;   // about the COM, link axes
+  std::optional<Vector3d> gyration;  // [m] along the link axes
+  bool sagittal_only = false;        // only iyy (or a scalar gyration) was given
+};
+
+// What --segments holds: per segment, and the lengths (option name -> metres).
+struct Segments {
+  std::map<std::string, SegmentOverride> segment;  // thigh, shank, foot, hat
+  std::map<std::string, double> length;            // "--thigh-length" -> m
+};
+
+class SegmentsReader {
+ public:
+  SegmentsReader(const std::string& path, bool sagittal) : path_(path), sagittal_(sagittal) {}
+
+  Segments read() const {
+    YAML::Node root;
+    try {
+      root = YAML::LoadFile(path_);
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error(path_ + ": " + e.what());
+    }
+    if (!root.IsMap()) fail("", "not a YAML map of segments");
+    Segments out;
+    for (const auto& entry : root) {
+      const std::string name = entry.first.as<std::string>();
+      if (name == "pelvis") {
+        keys(entry.second, name, {"width"});
+        out.length["--pelvis-width"] = number(entry.second["width"], name + ".width");
+      } else if (name == "thigh" || name == "shank" || name == "foot" || name == "hat") {
+        out.segment[name] = segment(entry.second, name, out);
+      } else {
+        fail(name, "unknown segment (thigh, shank, foot, hat, pelvis)");
+      }
+    }
+    return out;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+    throw std::runtime_error(path_ + ": " + (where.empty() ? "" : where + ": ") + what);
+  }
+
+  void keys(const YAML::Node& node, const std::string& where,
+            const std::set<std::string>& known) const {
+    if (!node.IsMap()) fail(where, "not a map");
+    for (const auto& entry : node)
+      if (!known.count(entry.first.as<std::string>()))
+        fail(where, "unknown key '" + entry.first.as<std::string>() + "'");
+  }
+
+  double number(const YAML::Node& v, const std::string& where) const {
+    const std::string s = v && v.IsScalar() ? v.as<std::string>() : std::string();
+    double x = 0.0;
+    const std::from_chars_result r = std::from_chars(s.data(), s.data() + s.size(), x);
+    if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(x))
+      fail(where, "must be a finite number (is '" + s + "')");
+    return x;
+  }
+
+  Vector3d triple(const YAML::Node& v, const std::string& where) const {
+    if (!v.IsSequence() || v.size() != 3) fail(where, "must be [X, Y, Z]");
+    return Vector3d(number(v[0], where + "[0]"), number(v[1], where + "[1]"),
+                    number(v[2], where + "[2]"));
+  }
+
+  SegmentOverride segment(const YAML::Node& node, const std::string& name, Segments& out) const {
+    keys(node, name, {"mass", "com", "inertia", "gyration", "length", "height"});
+    SegmentOverride o;
+    if (node["mass"]) {
+      o.mass = number(node["mass"], name + ".mass");
+      if (!(*o.mass > 0.0)) fail(name + ".mass", "must be > 0 [kg]");
+    }
+    if (node["com"]) o.com = triple(node["com"], name + ".com");
+    if (node["inertia"] && node["gyration"]) fail(name, "give inertia or gyration, not both");
+    if (node["inertia"]) inertia(node["inertia"], name + ".inertia", o);
+    if (node["gyration"]) gyration(node["gyration"], name + ".gyration", o);
+    if (node["length"]) {
+      static const std::map<std::string, std::string> option{{"thigh", "--thigh-length"},
+                                                             {"shank", "--shank-length"},
+                                                             {"foot", "--foot-length"},
+                                                             {"hat", "--hat-length"}};
+      out.length[option.at(name)] = number(node["length"], name + ".length");
+    }
+    if (node["height"]) {
+      if (name != "foot") fail(name, "'height' is a key of foot only (the ankle's height)");
+      out.length["--foot-height"] = number(node["height"], "foot.height");
+    }
+    return o;
+  }
+
+  void inertia(const YAML::Node& node, const std::string& where, SegmentOverride& o) const {
+    keys(node, where, {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"});
+    const auto at = [&](const char* key) {
+      return node[key] ? number(node[key], where + "." + key) : 0.0;
+    };
+    Matrix3d I;
+    I << at("ixx"), at("ixy"), at("ixz"), at("ixy"), at("iyy"), at("iyz"), at("ixz"), at("iyz"),
+        at("izz");
+    o.sagittal_only = node.size() == 1 && node["iyy"];
+    if (o.sagittal_only && !sagittal_)
+      fail(where,
+           "iyy alone describes a sagittal (--sagittal) body; a 3-D body needs ixx, "
+           "iyy and izz");
+    o.inertia = I;
+  }
+
+  void gyration(const YAML::Node& node, const std::string& where, SegmentOverride& o) const {
+    if (node.IsScalar()) {
+      if (!sagittal_) fail(where, "one radius is the sagittal one (--sagittal); give [KX, KY, KZ]");
+      o.gyration = Vector3d(0.0, number(node, where), 0.0);
+      o.sagittal_only = true;
+    } else {
+      o.gyration = triple(node, where);
+    }
+    if (!(o.gyration->minCoeff() >= 0.0)) fail(where, "radii of gyration must be >= 0 [m]");
+  }
+
+  std::string path_;
+  bool sagittal_;
+};
 
 struct Options {
   double mass = 0.0, height = 0.0;
   bool subtalar = false;
+  bool sagittal = false;
+  std::string segments;  // --segments PATH, "" none
   double thigh_length = 0.0, shank_length = 0.0, foot_length = 0.0, foot_height = 0.0,
          pelvis_width = 0.0, hat_length = 0.0;
+  Segments overrides;  // from --segments
   std::string name = "human_lower_body", output;
   std::string command;  // how the file was made, for its header comment
 };
 
 Options parseOptions(int argc, char** argv) {
-  std::map<std::string, std::string> v =
-      optionValues(argc, argv,
-                   {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length",
-                    "--foot-height", "--pelvis-width", "--hat-length", "--name", "--output"},
-                   {"--subtalar"});
+  std::map<std::string, std::string> v = optionValues(
+      argc, argv,
+      {"--mass", "--height", "--thigh-length", "--shank-length", "--foot-length", "--foot-height",
+       "--pelvis-width", "--hat-length", "--name", "--output", "--segments"},
+      {"--subtalar", "--sagittal"});
   const std::string mass = requiredValue(v, "--mass", "KG");
   const std::string height = requiredValue(v, "--height", "M");
   Options o;
   o.mass = parseNumberIn("--mass", mass, 1.0, 500.0);
   o.height = parseNumberIn("--height", height, 0.5, 2.7);
   o.subtalar = v.count("--subtalar") > 0;
+  o.sagittal = v.count("--sagittal") > 0;
+  if (o.subtalar && o.sagittal) throw UsageError("--subtalar and --sagittal exclude each other");
+  if (v.count("--segments")) {
+    o.segments = v["--segments"];
+    o.overrides = SegmentsReader(o.segments, o.sagittal).read();
+  }
   const double h = o.height;
   const auto length = [&](const char* key, double fraction) {
     // A measured length may differ from the table's by a factor of 2 either way.
     const double table = fraction * h;
-    return v.count(key) ? parseNumberIn(key, v[key], 0.5 * table, 2.0 * table) : table;
+    const auto yaml = o.overrides.length.find(key);
+    if (yaml == o.overrides.length.end())
+      return v.count(key) ? parseNumberIn(key, v[key], 0.5 * table, 2.0 * table) : table;
+    if (v.count(key)) throw UsageError(std::string(key) + " is also given by --segments");
+    if (!(yaml->second >= 0.5 * table && yaml->second <= 2.0 * table))
+      throw std::runtime_error(o.segments + ": the length of " + key + " (" +
+                               std::to_string(yaml->second) + " m) is not within " +
+                               std::to_string(0.5 * table) + " .. " + std::to_string(2.0 * table) +
+                               " m (the table's value / 2 .. x 2)");
+    return yaml->second;
   };
   o.thigh_length = length("--thigh-length", kThighLength);
   o.shank_length = length("--shank-length", kShankLength);
@@ -196,13 +385,12 @@ Options parseOptions(int argc, char** argv) {
                           "--foot-height", "--pelvis-width", "--hat-length", "--name"})
     if (v.count(key)) o.command += std::string(" ") + key + " " + v[key];
   if (o.subtalar) o.command += " --subtalar";
+  if (o.sagittal) o.command += " --sagittal";
+  if (!o.segments.empty()) o.command += " --segments " + o.segments;
   return o;
 }
 
 // ------------------------------------------------------------------------- the model
-
-using Eigen::Matrix3d;
-using Eigen::Vector3d;
 
 // Shortest text that reads back as the same double (deterministic, locale-free).
 std::string num(double x) {
@@ -231,6 +419,21 @@ Matrix3d segmentInertia(double m, double l, const SegmentTable& t, const Vector3
   return transverse * (Matrix3d::Identity() - uu) + longitudinal * uu;
 }
 
+// A segment's table values replaced by what --segments gives. A sagittal-only inertia
+// (iyy) gets ixx = izz = iyy / 2: the least that meets the triangle inequality; a planar
+// body turning about y never multiplies them.
+void applyOverride(const SegmentOverride& s, double& mass, Vector3d& com, Matrix3d& inertia) {
+  if (s.mass) mass = *s.mass;
+  if (s.com) com = *s.com;
+  if (s.inertia) inertia = *s.inertia;
+  if (s.gyration)
+    inertia = mass * s.gyration->cwiseProduct(*s.gyration).asDiagonal().toDenseMatrix();
+  if (s.sagittal_only) {
+    const double iyy = inertia(1, 1);
+    inertia = Vector3d(0.5 * iyy, iyy, 0.5 * iyy).asDiagonal();
+  }
+}
+
 Body makeBody(const Options& o) {
   Body b;
   const double m = o.mass;
@@ -252,6 +455,15 @@ Body makeBody(const Options& o) {
   b.foot_segment_length = metatarsal.norm();
   b.com_foot = kFoot.com_fraction * metatarsal;
   b.i_foot = segmentInertia(b.m_foot, b.foot_segment_length, kFoot, metatarsal.normalized());
+  const std::map<std::string, SegmentOverride>& given = o.overrides.segment;
+  const auto apply = [&](const char* name, double& mass, Vector3d& com, Matrix3d& inertia) {
+    const auto it = given.find(name);
+    if (it != given.end()) applyOverride(it->second, mass, com, inertia);
+  };
+  apply("thigh", b.m_thigh, b.com_thigh, b.i_thigh);
+  apply("shank", b.m_shank, b.com_shank, b.i_shank);
+  apply("foot", b.m_foot, b.com_foot, b.i_foot);
+  apply("hat", b.m_hat, b.com_hat, b.i_hat);
   return b;
 }
 
@@ -302,6 +514,18 @@ class UrdfText {
     line("  </joint>");
   }
   void emptyLink(const std::string& name) { line("  <link name=\"" + name + "\"/>"); }
+  // A prismatic joint at the parent's origin, limits [m].
+  void prismatic(const std::string& name, const std::string& parent, const std::string& child,
+                 const Vector3d& axis, double limit) {
+    line("  <joint name=\"" + name + "\" type=\"prismatic\">");
+    line("    <parent link=\"" + parent + "\"/>");
+    line("    <child link=\"" + child + "\"/>");
+    line("    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>");
+    line("    <axis xyz=\"" + vec(axis) + "\"/>");
+    line("    <limit lower=\"" + num(-limit) + "\" upper=\"" + num(limit) + "\" effort=\"" +
+         num(kPrismaticEffortLimit) + "\" velocity=\"" + num(kVelocityLimit) + "\"/>");
+    line("  </joint>");
+  }
 };
 
 std::string cylinder(double radius, double length) {
@@ -322,13 +546,17 @@ void writeLeg(UrdfText& u, const Options& o, const Body& b, const std::string& s
   const Vector3d minus_y(0.0, -1.0, 0.0), plus_y(0.0, 1.0, 0.0);
   const Vector3d mirrored_x(side, 0.0, 0.0), mirrored_z(0.0, 0.0, side);
 
-  u.revolute("hip_flexion_" + s, "pelvis", "hip_flexion_link_" + s, hip, minus_y, kHipFlexion);
-  u.emptyLink("hip_flexion_link_" + s);
-  u.revolute("hip_adduction_" + s, "hip_flexion_link_" + s, "hip_adduction_link_" + s,
-             Vector3d::Zero(), mirrored_x, kHipAdduction);
-  u.emptyLink("hip_adduction_link_" + s);
-  u.revolute("hip_rotation_" + s, "hip_adduction_link_" + s, "femur_" + s, Vector3d::Zero(),
-             mirrored_z, kHipRotation);
+  if (o.sagittal) {  // flexion only: every axis along y
+    u.revolute("hip_flexion_" + s, "pelvis", "femur_" + s, hip, minus_y, kHipFlexion);
+  } else {
+    u.revolute("hip_flexion_" + s, "pelvis", "hip_flexion_link_" + s, hip, minus_y, kHipFlexion);
+    u.emptyLink("hip_flexion_link_" + s);
+    u.revolute("hip_adduction_" + s, "hip_flexion_link_" + s, "hip_adduction_link_" + s,
+               Vector3d::Zero(), mirrored_x, kHipAdduction);
+    u.emptyLink("hip_adduction_link_" + s);
+    u.revolute("hip_rotation_" + s, "hip_adduction_link_" + s, "femur_" + s, Vector3d::Zero(),
+               mirrored_z, kHipRotation);
+  }
 
   u.line("  <link name=\"femur_" + s + "\">");
   u.inertial(b.m_thigh, b.com_thigh, b.i_thigh);
@@ -375,18 +603,34 @@ std::string makeUrdf(const Options& o) {
   UrdfText u;
   u.line("<?xml version=\"1.0\"?>");
   // No double hyphen may appear inside an XML comment: the options are spelled out.
-  std::string command = o.command;
+  std::string command = o.command, segments = o.segments;
   for (std::size_t p; (p = command.find("--")) != std::string::npos;) command.replace(p, 2, "");
+  for (std::size_t p; (p = segments.find("--")) != std::string::npos;) segments.replace(p, 2, "-");
   u.line("<!-- Generated by make_body_urdf (" + command + "); do not edit.");
   u.line("     Human lower body, Dempster's segment parameters via Winter (2009) Table 4.1,");
   u.line("     Drillis and Contini's lengths via Winter Fig. 4.1: docs/body_model.md.");
   u.line("     Body mass " + num(o.mass) + " kg, height " + num(o.height) +
-         " m; the pelvis carries head, arms and trunk. -->");
+         " m; the pelvis carries head, arms and trunk." +
+         (o.segments.empty()
+              ? std::string()
+              : "\n     Segment parameters of " + segments + " replace the tables' where given.") +
+         (o.sagittal ? "\n     Sagittal plane: every joint turns about y (planar solver)." : "") +
+         " -->");
   u.line("<robot name=\"" + o.name + "\">");
   u.line("  <material name=\"skin\"><color rgba=\"0.87 0.72 0.6 1\"/></material>");
   u.line("  <material name=\"shoe\"><color rgba=\"0.2 0.2 0.25 1\"/></material>");
   u.line("  <material name=\"cloth\"><color rgba=\"0.25 0.4 0.65 1\"/></material>");
 
+  if (o.sagittal) {
+    // A 2-D body: the pelvis moves in the x-z plane of a fixed root.
+    u.emptyLink("world");
+    u.prismatic("pelvis_tx", "world", "pelvis_tx_link", Vector3d::UnitX(), kWalkwayLimit);
+    u.emptyLink("pelvis_tx_link");
+    u.prismatic("pelvis_tz", "pelvis_tx_link", "pelvis_tz_link", Vector3d::UnitZ(), kWalkwayLimit);
+    u.emptyLink("pelvis_tz_link");
+    u.revolute("pelvis_tilt", "pelvis_tz_link", "pelvis", Vector3d::Zero(), Vector3d::UnitY(),
+               kPelvisTilt);
+  }
   u.line("  <link name=\"pelvis\">");
   u.inertial(b.m_hat, b.com_hat, b.i_hat);
   const double h = o.height;

@@ -7,6 +7,7 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/planar.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include "tool_test.hpp"
@@ -23,8 +24,10 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -492,6 +495,148 @@ TEST_F(BodyTool, AsymmetricStanceBalancesTheBodyWeight) {
   // 10.665 N at 0.0665 m: effort = 0.25 lf m_f g - cx P = 0.709205 - 16.438360 =
   // -15.729156 N m, a plantar-flexor moment (negative dorsiflexion).
   EXPECT_NEAR(st.effort("ankle_flexion_r"), -15.729156, 1e-6);  // 7 digits worked
+}
+
+// ------------------------------------------------------------------ --sagittal, --segments
+
+// A lab's own sagittal-plane parameters (a 2-D study has the mass, the centre of mass
+// and the moment of inertia about the transverse axis only), as --segments reads them.
+const char* const kSagittalSegments =
+    R"(thigh: {mass: 8.0, com: [0, 0, -0.19], inertia: {iyy: 0.15}}
+shank: {mass: 3.2, com: [0, 0, -0.18], gyration: 0.12, length: 0.42}
+foot: {mass: 1.1, com: [0.06, 0, -0.03], inertia: {iyy: 0.005}, height: 0.07}
+hat: {mass: 48.0, com: [0.01, 0, 0.30], inertia: {iyy: 2.1}}
+)";
+constexpr double kSagittalMass = 48.0 + 2.0 * (8.0 + 3.2 + 1.1);  // kg
+
+// Joints of the sagittal body, and a CSV row of them: q, qd, qdd.
+const std::vector<std::string> kSagittalJoints = {
+    "pelvis_tx",       "pelvis_tz",     "pelvis_tilt",    "hip_flexion_r",  "knee_flexion_r",
+    "ankle_flexion_r", "hip_flexion_l", "knee_flexion_l", "ankle_flexion_l"};
+
+std::string sagittalCsv(const std::vector<std::vector<double>>& rows) {
+  std::string text = "t";
+  for (const std::string& j : kSagittalJoints) text += "," + j + ".q," + j + ".qd," + j + ".qdd";
+  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"})
+    text += std::string(",wrench@foot_r.") + c;
+  text += "\n";
+  for (const std::vector<double>& row : rows) {
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      char cell[40];
+      std::snprintf(cell, sizeof cell, "%s%.17g", i ? "," : "", row[i]);
+      text += cell;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+TEST_F(BodyTool, SagittalBodyFromSegmentsIsPlanarWithTheGivenParameters) {
+  write("segments.yaml", kSagittalSegments);
+  const jle::Model<double> model = generate(
+      {"--mass", "75", "--height", "1.75", "--sagittal", "--segments", path("segments.yaml")});
+  EXPECT_FALSE(model.floating_base);
+  EXPECT_EQ(model.nq, 9);
+  EXPECT_NEAR(model.totalMass(), kSagittalMass, 1e-12);
+  const auto segment = [&](const char* link) {
+    return model.frames[model.frameIndex(link)].segment;
+  };
+  // The values of the YAML; the out-of-plane moments are iyy / 2 (documented).
+  const struct {
+    const char* link;
+    double mass, iyy;
+    Vector3d com;
+  } expected[] = {{"femur_r", 8.0, 0.15, Vector3d(0, 0, -0.19)},
+                  {"tibia_l", 3.2, 3.2 * 0.12 * 0.12, Vector3d(0, 0, -0.18)},
+                  {"foot_r", 1.1, 0.005, Vector3d(0.06, 0, -0.03)},
+                  {"pelvis", 48.0, 2.1, Vector3d(0.01, 0, 0.30)}};
+  for (const auto& e : expected) {
+    const int s = segment(e.link);
+    EXPECT_DOUBLE_EQ(model.mass[s], e.mass) << e.link;
+    EXPECT_LE((model.com[s] - e.com).norm(), 1e-15) << e.link;
+    EXPECT_NEAR(model.inertia_com[s](1, 1), e.iyy, 1e-15) << e.link;
+    EXPECT_NEAR(model.inertia_com[s](0, 0), 0.5 * e.iyy, 1e-15) << e.link;
+    EXPECT_NEAR(model.inertia_com[s](2, 2), 0.5 * e.iyy, 1e-15) << e.link;
+  }
+  // The lengths of the YAML: the ankle 0.42 m below the knee, the sole 0.07 m below it.
+  EXPECT_LE((model.p_parent_joint[segment("foot_r")] - Vector3d(0, 0, -0.42)).norm(), 1e-15);
+  EXPECT_NEAR(model.frames[model.frameIndex("heel_l")].p_segment_frame.z(), -0.07, 1e-15);
+  // The planar solver's own detection accepts it, plane normal along y.
+  const jle::PlanarCheck<double> check = jle::detectPlanar(model, Vector3d(0, 0, -kG));
+  EXPECT_TRUE(check.planar) << check.reason;
+  EXPECT_NEAR(std::abs(check.normal.y()), 1.0, 1e-15);
+}
+
+// The sagittal body through joint_loads with the planar solver on: standing still its
+// pelvis joints carry the weight (pelvis_tz: M g; pelvis_tilt: the weights' moment about
+// the pelvis origin, only the feet's COMs lying ahead of it), and moving with a ground
+// reaction in the plane the 3x3 solver gives the 6x6 solver's loads.
+TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
+  write("segments.yaml", kSagittalSegments);
+  generate({"--mass", "75", "--height", "1.75", "--sagittal", "--segments", path("segments.yaml")});
+  std::vector<std::vector<double>> rows;
+  rows.push_back(std::vector<double>(1 + 3 * kSagittalJoints.size() + 6, 0.0));  // still
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int r = 1; r < 6; ++r) {
+    std::vector<double> row{0.01 * r};
+    for (std::size_t k = 0; k < 3 * kSagittalJoints.size(); ++k) row.push_back(2.0 * u(gen));
+    // A ground reaction in the plane: force (x, z), moment about y.
+    for (double c : {100.0 * u(gen), 0.0, 700.0 + 50.0 * u(gen), 0.0, 10.0 * u(gen), 0.0})
+      row.push_back(c);
+    rows.push_back(row);
+  }
+  write("sagittal.csv", sagittalCsv(rows));
+  const auto loads = [&](const char* mode) {
+    const Result r = ToolTest::run(
+        JLE_JOINT_LOADS, {"--urdf", path("out/body.urdf"), "--input", path("sagittal.csv"),
+                          "--planar", mode, "--output", path(std::string("out/") + mode)});
+    EXPECT_EQ(r.status, 0) << r.err;
+    if (std::string(mode) == "on") {
+      EXPECT_NE(r.err.find("the 3x3 solver"), std::string::npos) << r.err;
+    }
+    return jle_test::parseCsv(readFile(path(std::string("out/") + mode)));
+  };
+  const jle_test::Table on = loads("on"), off = loads("off");
+  ASSERT_EQ(on.rows.size(), rows.size());
+  EXPECT_NEAR(on.number(0, "pelvis_tz.effort"), kSagittalMass * kG, 1e-10);
+  EXPECT_NEAR(on.number(0, "pelvis_tx.effort"), 0.0, 1e-10);
+  EXPECT_NEAR(on.number(0, "pelvis_tilt.effort"), -kG * 2.0 * 1.1 * 0.06 - kG * 48.0 * 0.01, 1e-10);
+  // Every column of every row: planar = 6x6 within 1e-12 of the row's largest load.
+  ASSERT_EQ(on.header, off.header);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    double scale = 1.0;
+    for (std::size_t c = 1; c < on.header.size(); ++c)
+      scale = std::max(scale, std::abs(off.number(r, off.header[c])));
+    for (std::size_t c = 1; c < on.header.size(); ++c)
+      EXPECT_NEAR(on.number(r, on.header[c]), off.number(r, off.header[c]), 1e-12 * scale)
+          << "row " << r << " " << on.header[c];
+  }
+}
+
+TEST_F(BodyTool, SegmentsAreCheckedNamingTheKey) {
+  const auto refused = [&](const std::string& yaml, std::vector<std::string> extra, int status,
+                           const std::string& part) {
+    write("bad.yaml", yaml);
+    std::vector<std::string> args{
+        "--mass",         "75",       "--height",        "1.75", "--segments",
+        path("bad.yaml"), "--output", path("out/x.urdf")};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Result r = run(args);
+    EXPECT_EQ(r.status, status) << yaml << r.err;
+    EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("out/x.urdf")));
+  };
+  // A 3-D body needs all three moments; one radius is the sagittal one.
+  refused("thigh: {inertia: {iyy: 0.1}}\n", {}, 1, "thigh.inertia");
+  refused("thigh: {gyration: 0.1}\n", {}, 1, "--sagittal");
+  refused("thigh: {mass: -2}\n", {}, 1, "thigh.mass");
+  refused("elbow: {mass: 2}\n", {}, 1, "elbow");
+  refused("thigh: {colour: red}\n", {}, 1, "'colour'");
+  refused("thigh: {inertia: {iyy: 1}, gyration: 0.1}\n", {"--sagittal"}, 1, "not both");
+  refused("shank: {length: 4}\n", {}, 1, "--shank-length");
+  refused("shank: {length: 0.4}\n", {"--shank-length", "0.4"}, 2, "also given by --segments");
+  refused("thigh: {mass: 7}\n", {"--sagittal", "--subtalar"}, 2, "exclude");
 }
 
 }  // namespace

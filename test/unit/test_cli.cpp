@@ -586,6 +586,15 @@ TEST_F(CliBadInputTest, BadOptionsAreUsageErrors) {
   expectRefusedArgs(with({"--gravity", "0,0,nan"}), {"nan gravity", 2, {"--gravity", "'0,0,nan'"}});
   expectRefusedArgs(with({"--gravity", "0,0,-9.8,1"}), {"four numbers", 2, {"--gravity"}});
   expectRefusedArgs(with({"--gravity", "0,zero,-9.8"}), {"word", 2, {"--gravity"}});
+  expectRefusedArgs(with({"--planar", "maybe"}), {"bad planar", 2, {"--planar", "'maybe'"}});
+  expectRefusedArgs(with({"--planar", "auto", "--kinematics"}),
+                    {"planar kinematics", 2, {"--planar auto", "--kinematics"}});
+  expectRefusedArgs(with({"--planar", "on", "--frame", "world"}),
+                    {"planar world frame", 2, {"--planar on", "--frame"}});
+  // The --plate frames are z up: gravity off -z with a plate is refused, naming both.
+  for (const char* g : {"0,-9.81,0", "0,0,9.81", "0.5,0,-9.8"})
+    expectRefusedArgs(with({"--gravity", g, "--plate", "p1=panda_link7,0,0,0"}),
+                      {g, 2, {"--gravity", "--plate p1", "along -z"}});
   expectRefusedArgs(with({"--bogus", "1"}), {"unknown option", 2, {"'--bogus'"}});
   expectRefusedArgs(with({"stray"}), {"positional", 2, {"'stray'"}});
   expectRefusedArgs(with({"--frame"}), {"no value", 2, {"--frame"}});
