@@ -12,14 +12,10 @@ namespace {
 
 const char* typeName(DifferentiatorType type) {
   switch (type) {
-    case DifferentiatorType::kFiniteDifference:
-      return "finite_difference";
-    case DifferentiatorType::kSavitzkyGolay:
-      return "savitzky_golay";
-    case DifferentiatorType::kKalman:
-      return "kalman";
-    case DifferentiatorType::kAdaptive:
-      return "adaptive";
+    case DifferentiatorType::kFiniteDifference: return "finite_difference";
+    case DifferentiatorType::kSavitzkyGolay: return "savitzky_golay";
+    case DifferentiatorType::kKalman: return "kalman";
+    case DifferentiatorType::kAdaptive: return "adaptive";
   }
   return "kalman";
 }
@@ -79,13 +75,11 @@ XmlRpc::XmlRpcValue withConfig(XmlRpc::XmlRpcValue params,
 void EstimatorNode::setUpReconfigure() {
   reconfigure_ =
       std::make_unique<dynamic_reconfigure::Server<joint_load_estimator::EstimatorConfig>>(
-          ros::NodeHandle(private_nh_, "reconfigure"));
+          reconfigure_mutex_, ros::NodeHandle(private_nh_, "reconfigure"));
   joint_load_estimator::EstimatorConfig current = toConfig(settings_);
   reconfigure_->updateConfig(current);  // the node's settings, not the .cfg's defaults
-  reconfigure_->setCallback(
-      [this](joint_load_estimator::EstimatorConfig& config, std::uint32_t level) {
-        onReconfigure(config, level);
-      });
+  reconfigure_->setCallback([this](joint_load_estimator::EstimatorConfig& config,
+                                   std::uint32_t level) { onReconfigure(config, level); });
 }
 
 void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
@@ -93,17 +87,19 @@ void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
   try {
     XmlRpc::XmlRpcValue params = withConfig(params_, config);
     const Settings next = parseSettings(params);  // throws naming the key
-    const bool kept =
-        pipeline_->retune(next.estimator.differentiator, next.estimator.decimation);
+    const bool same = next.estimator.decimation == settings_.estimator.decimation &&
+                      next.base_residual_threshold == settings_.base_residual_threshold &&
+                      next.still_velocity == settings_.still_velocity;
+    const bool kept = pipeline_->retune(next.estimator.differentiator, next.estimator.decimation);
     settings_.estimator.differentiator = next.estimator.differentiator;
     settings_.estimator.decimation = next.estimator.decimation;
     settings_.base_residual_threshold = next.base_residual_threshold;
     settings_.still_velocity = next.still_velocity;
     params_ = params;
-    if (kept)
+    if (kept && !same)
       ROS_INFO("reconfigure: decimation %d, thresholds applied (filters kept)",
                settings_.estimator.decimation);
-    else
+    else if (!kept)
       ROS_WARN("reconfigure: differentiator '%s' applied: the filters restart",
                typeName(settings_.estimator.differentiator.type));
   } catch (const std::exception& e) {

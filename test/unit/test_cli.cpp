@@ -852,8 +852,8 @@ TEST_F(CliTest, EveryExecutableHasHelpAndVersion) {
   for (const std::string& program : programs) {
     const std::string name = fs::path(program).filename().string();
     for (const char* option : {"--help", "--version"}) {
-      const Result r = run("env", {"ROS_MASTER_URI=http://127.0.0.1:9", "timeout", "10", program,
-                                   option});
+      const Result r =
+          run("env", {"ROS_MASTER_URI=http://127.0.0.1:9", "timeout", "10", program, option});
       EXPECT_EQ(r.status, 0) << name << " " << option << ": " << r.err;
       EXPECT_EQ(r.err, "") << name << " " << option;
       if (std::string(option) == "--help")
@@ -888,7 +888,8 @@ TEST_F(CliTest, RvizConfigForTheUr5) {
   const double weight = model.totalMass() * 9.80665;
   for (std::size_t k = 0; k < moving.size(); ++k) {
     EXPECT_EQ(wrenches[k]["Class"].as<std::string>(), "rviz/WrenchStamped");
-    EXPECT_EQ(wrenches[k]["Topic"].as<std::string>(), "/arm/joint_load_estimator/wrench/" + moving[k]);
+    EXPECT_EQ(wrenches[k]["Topic"].as<std::string>(),
+              "/arm/joint_load_estimator/wrench/" + moving[k]);
     // 6 significant digits printed.
     EXPECT_NEAR(wrenches[k]["Torque Arrow Scale"].as<double>() * 2.0 * weight, 1.0, 1e-5);
   }

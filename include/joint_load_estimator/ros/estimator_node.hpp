@@ -120,7 +120,7 @@ class EstimatorNode {
   ros::Publisher loads_pub_, residual_pub_;
   std::vector<ros::Publisher> wrench_pubs_;
   joint_load_estimator::JointLoads loads_msg_;
-  ros::Publisher efforts_pub_;          // ~joint_efforts (sensor_msgs/JointState)
+  ros::Publisher efforts_pub_;           // ~joint_efforts (sensor_msgs/JointState)
   sensor_msgs::JointState efforts_msg_;  // the JointLoads' names, q, q-dot, efforts
   geometry_msgs::WrenchStamped wrench_msg_;
   geometry_msgs::PointStamped cop_msg_;
@@ -156,6 +156,7 @@ class EstimatorNode {
   // ~reconfigure: the parameters as read at start, with every change applied since (the
   // one reader, parseSettings, maps and checks them), and the server.
   XmlRpc::XmlRpcValue params_;
+  boost::recursive_mutex reconfigure_mutex_;  // the server's, held by updateConfig() too
   std::unique_ptr<dynamic_reconfigure::Server<joint_load_estimator::EstimatorConfig>> reconfigure_;
 };
 
