@@ -137,8 +137,9 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
     const auto sample = stamps_.find(e.header.stamp.toNSec());
     ASSERT_NE(sample, stamps_.end());
     const Eigen::VectorXd q = position(sample->second * kPeriod);
-    if (i > 50)
+    if (i > 50) {
       for (int j = 0; j < 6; ++j) EXPECT_NEAR(e.position[j], q[j], 1e-3) << kJoints[j];
+    }
   }
   // The URDF from a file (arm1) and from an existing parameter (arm2): the same loads.
   for (const auto& m : loads1_.msgs()) {
