@@ -904,14 +904,19 @@ TEST_F(CliTest, RvizConfigForTheUr5) {
     ASSERT_EQ(shapes.joints_.count(name), 1u) << name;
     EXPECT_EQ(shapes.joints_.at(name)->type, joint->type) << name;
     EXPECT_EQ(shapes.joints_.at(name)->parent_link_name, joint->parent_link_name) << name;
-    EXPECT_EQ(shapes.joints_.at(name)->parent_to_joint_origin_transform.position.x,
-              joint->parent_to_joint_origin_transform.position.x);
+    const urdf::Vector3& a = shapes.joints_.at(name)->parent_to_joint_origin_transform.position;
+    const urdf::Vector3& b = joint->parent_to_joint_origin_transform.position;
+    EXPECT_EQ(a.x, b.x) << name;  // the joint elements are copied as they are
+    EXPECT_EQ(a.y, b.y) << name;
+    EXPECT_EQ(a.z, b.z) << name;
   }
   // Every link with a child joint away from its origin has a cylinder to it.
   for (const auto& [name, link] : shapes.links_) {
     int away = 0, cylinders = 0;
-    for (const auto& joint : link->child_joints)
-      away += joint->parent_to_joint_origin_transform.position.norm() > 1e-6;
+    for (const auto& joint : link->child_joints) {
+      const urdf::Vector3& p = joint->parent_to_joint_origin_transform.position;
+      away += std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z) > 1e-6;
+    }
     for (const auto& visual : link->visual_array)
       cylinders += visual->geometry->type == urdf::Geometry::CYLINDER;
     EXPECT_EQ(cylinders, away) << name;
