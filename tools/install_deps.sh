@@ -7,6 +7,8 @@ packages=(
   ros-base-dev libroscpp-dev ros-message-generation libstd-msgs-dev
   libsensor-msgs-dev libgeometry-msgs-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev
   libdiagnostic-updater-dev librosbag-dev libnodelet-dev pluginlib-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure  # ~reconfigure (.cfg: python at build time)
+  python3-diagnostic-msgs python3-rostopic python3-rosnode python3-rosservice python3-rosparam python3-yaml rospack-tools  # README's rostopic/rosservice commands
   libeigen3-dev libtinyxml2-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch
   python3-rosbag python3-sensor-msgs python3-geometry-msgs python3-std-msgs

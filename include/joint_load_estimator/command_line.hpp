@@ -122,7 +122,17 @@ inline bool parseNumberList(const std::string& text, int count, double* out) {
   return true;
 }
 
-/// The main() of a tool: --help/-h prints `usage`; then run(parse(argc, argv)). A
+/// The package's version (package.xml), which CMakeLists.txt defines as JLE_VERSION.
+inline const char* version() {
+#ifdef JLE_VERSION
+  return JLE_VERSION;
+#else
+  return "(built outside catkin)";
+#endif
+}
+
+/// The main() of a tool: --help/-h prints `usage`, --version the tool's name and
+/// version(), each exiting 0 before anything else; then run(parse(argc, argv)). A
 /// UsageError exits 2 and any other error 1, each with one line on stderr that starts
 /// with the tool's name.
 template <typename Parse, typename Run>
@@ -130,6 +140,9 @@ int runTool(int argc, char** argv, const char* name, const char* usage, Parse pa
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
       std::fputs(usage, stdout);
+      return 0;
+    } else if (std::string(argv[i]) == "--version") {
+      std::printf("%s %s\n", name, version());
       return 0;
     }
   try {

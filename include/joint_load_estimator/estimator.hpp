@@ -71,6 +71,15 @@ class Estimator {
   /// Forgets all history (a backward jump of time).
   void reset();
 
+  /// Live tuning (the node's ~reconfigure). `decimation` (>= 1) applies in place: the
+  /// filters and the decimation phase are kept, so the loads are those of an estimator
+  /// started with it (exact). A `differentiator` other than the current one replaces
+  /// the bank of filters, which starts empty (its warm-up follows): one filter's state
+  /// means nothing to another. The wrench and plate buffers (raw samples) are kept.
+  /// Returns false when the filters were restarted. Throws std::invalid_argument
+  /// naming the parameter, changing nothing, on a bad value.
+  bool retune(const DifferentiatorConfig& differentiator, int decimation);
+
   /// A sample of force plate k at time t [s] as the plate measures it: the force [N]
   /// and moment [N m] the foot applies to the plate, plate frame, moment about the plate
   /// origin. A sample below the contact threshold is taken as zero. Samples not newer

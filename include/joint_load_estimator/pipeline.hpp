@@ -151,6 +151,11 @@ class Pipeline {
   /// The sensor offset of wrench input k in the reading's own frame and sign,
   /// subtracted from every later reading (bias_file, ~calibrate_bias).
   void setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
+  /// Live tuning of the differentiator and the decimation (Estimator::retune: the
+  /// decimation in place, a new differentiator restarts the filters); settings() follows.
+  /// Returns false when the filters were restarted. Throws std::invalid_argument naming
+  /// the parameter, changing nothing, on a bad value.
+  bool retune(const DifferentiatorConfig& differentiator, int decimation);
   const Eigen::Vector3d& sensorBiasForce(int k) const { return wrenches_[ix(k)].bias_force; }
   const Eigen::Vector3d& sensorBiasTorque(int k) const { return wrenches_[ix(k)].bias_torque; }
 

@@ -175,6 +175,34 @@ void Estimator::reset() {
   sample_count_ = 0;
 }
 
+namespace {
+
+bool sameDifferentiator(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
+  return a.type == b.type && a.window == b.window && a.order == b.order && a.delay == b.delay &&
+         a.kalman_model == b.kalman_model && a.process_noise == b.process_noise &&
+         a.measurement_noise == b.measurement_noise && a.min_bandwidth == b.min_bandwidth &&
+         a.max_bandwidth == b.max_bandwidth && a.noise == b.noise && a.memory == b.memory &&
+         a.max_gap == b.max_gap;
+}
+
+}  // namespace
+
+bool Estimator::retune(const DifferentiatorConfig& differentiator, int decimation) {
+  EstimatorConfig config = config_;
+  config.differentiator = differentiator;
+  config.decimation = decimation;
+  validate(config);  // throws naming the key; nothing changed yet
+  config_.decimation = decimation;
+  if (sameDifferentiator(differentiator, config_.differentiator)) return true;
+  bank_ = DifferentiatorBank(differentiator, bank_.channels());
+  config_.differentiator = differentiator;
+  covariance_.history = 0;
+  have_last_ = false;
+  have_result_ = false;
+  sample_count_ = 0;
+  return false;
+}
+
 bool Estimator::addPlateSample(int k, double t, const Eigen::Vector3d& force_plate,
                                const Eigen::Vector3d& moment_plate) {
   return plates_.add(k, t, force_plate, moment_plate);

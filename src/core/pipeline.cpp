@@ -515,6 +515,13 @@ void Pipeline::fillCoordinates(std::size_t i, std::size_t segment) {
                                            record_.velocity[i], settings_.friction.velocity_scale);
 }
 
+bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation) {
+  const bool kept = estimator_.retune(differentiator, decimation);
+  settings_.estimator.differentiator = differentiator;
+  settings_.estimator.decimation = decimation;
+  return kept;
+}
+
 void Pipeline::setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
   wrenches_.at(ix(k)).bias_force = force;
   wrenches_[ix(k)].bias_torque = torque;

@@ -100,6 +100,21 @@ void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg)
   msg.motor_effort = record.motor_effort;
 }
 
+void prepare(const LoadsRecord& record, sensor_msgs::JointState& msg) {
+  const std::size_t n = record.joint.size();
+  msg.name = record.joint;
+  msg.position.resize(n);
+  msg.velocity.resize(n);
+  msg.effort.resize(n);
+}
+
+void toJointState(const LoadsRecord& record, sensor_msgs::JointState& msg) {
+  msg.header.stamp = toRosTime(record.stamp);
+  msg.position = record.position;  // equal sizes: copies, no allocation
+  msg.velocity = record.velocity;
+  msg.effort = record.effort;
+}
+
 void toWrenchMessage(const LoadsRecord& record, std::size_t i, geometry_msgs::WrenchStamped& msg) {
   msg.header.stamp = toRosTime(record.stamp);
   msg.header.frame_id = record.link[i];

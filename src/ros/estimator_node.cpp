@@ -21,17 +21,20 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       tf_listener_(tf_buffer_),
       frames_(tf_buffer_),
       updater_(nh, private_nh) {
-  XmlRpc::XmlRpcValue params;
-  if (!private_nh_.getParam(private_nh_.getNamespace(), params)) params = XmlRpc::XmlRpcValue();
-  settings_ = parseSettings(params);
+  // ~reconfigure/* belong to the server of the last run: it starts from these settings.
+  private_nh_.deleteParam("reconfigure");
+  if (!private_nh_.getParam(private_nh_.getNamespace(), params_)) params_ = XmlRpc::XmlRpcValue();
+  settings_ = parseSettings(params_);
   const Model<double> model = loadModel();
   pipeline_ = std::make_unique<Pipeline>(model, settings_, &frames_);
   settings_ = pipeline_->settings();  // with the sensors' links and the base frame filled in
   prepare(pipeline_->record(), loads_msg_);
+  prepare(pipeline_->record(), efforts_msg_);
   advertise();
   setUpConsistency();
   applyBiasFile(*pipeline_);  // before the first wrench can arrive
   subscribe();
+  setUpReconfigure();
   updater_.setHardwareID(model.link_name[0]);
   updater_.add("joint loads", this, &EstimatorNode::diagnose);
   if (!sensor_topics_.empty() || model.floating_base)
@@ -72,6 +75,7 @@ Model<double> EstimatorNode::loadModel() {
 void EstimatorNode::advertise() {
   const LoadsRecord& record = pipeline_->record();
   loads_pub_ = private_nh_.advertise<joint_load_estimator::JointLoads>("joint_loads", 100);
+  efforts_pub_ = private_nh_.advertise<sensor_msgs::JointState>("joint_efforts", 100);
   if (settings_.publish_wrench_topics)
     for (const std::string& joint : record.joint)
       wrench_pubs_.push_back(
@@ -207,6 +211,10 @@ void EstimatorNode::publish(const ros::Time& received) {
   const ros::Time stamp = loads_msg_.header.stamp;
   publishPlates(stamp);
   loads_pub_.publish(loads_msg_);
+  if (efforts_pub_.getNumSubscribers() > 0) {
+    toJointState(record, efforts_msg_);
+    efforts_pub_.publish(efforts_msg_);
+  }
   const Data<double>& data = pipeline_->estimator().data();
   if (residual_pub_ && residual_pub_.getNumSubscribers() > 0) {
     wrench_msg_.header.stamp = stamp;

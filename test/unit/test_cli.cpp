@@ -10,6 +10,8 @@
 #include "tool_test.hpp"
 
 #include <gtest/gtest.h>
+#include <urdf/model.h>
+#include <yaml-cpp/yaml.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -830,6 +832,108 @@ TEST_F(CliTest, ToolsReportTheSharedMessages) {
             "joint_loads: --body-mass: '0' is not a finite number > 0 "
             "(see joint_loads --help)\n");
   EXPECT_EQ(outEntries(), std::vector<std::string>{});
+}
+
+// ------------------------------------------------- --help and --version of every executable
+
+// The version in package.xml, read here (the tools get it from CMake).
+std::string packageVersion() {
+  const std::string xml = readFile(JLE_PACKAGE_XML);
+  const std::size_t begin = xml.find("<version>"), end = xml.find("</version>");
+  EXPECT_NE(begin, std::string::npos);
+  return xml.substr(begin + 9, end - begin - 9);
+}
+
+// Every executable of the package (the node, src/tools/*, scripts/rviz_config) prints
+// its usage for --help and its version for --version, exiting 0 without touching ROS:
+// the master named here does not exist, and a program that tried to reach it would
+// hang until `timeout` kills it (status 124).
+TEST_F(CliTest, EveryExecutableHasHelpAndVersion) {
+  const std::string version = packageVersion();
+  ASSERT_FALSE(version.empty());
+  std::vector<std::string> programs;
+  for (std::size_t begin = 0, end;; begin = end + 1) {
+    end = std::string(JLE_EXECUTABLES).find('|', begin);
+    programs.push_back(std::string(JLE_EXECUTABLES).substr(begin, end - begin));
+    if (end == std::string::npos) break;
+  }
+  ASSERT_EQ(programs.size(), 9u);  // the node, 7 tools, rviz_config
+  for (const std::string& program : programs) {
+    const std::string name = fs::path(program).filename().string();
+    for (const char* option : {"--help", "--version"}) {
+      const Result r =
+          run("env", {"ROS_MASTER_URI=http://127.0.0.1:9", "timeout", "10", program, option});
+      EXPECT_EQ(r.status, 0) << name << " " << option << ": " << r.err;
+      EXPECT_EQ(r.err, "") << name << " " << option;
+      if (std::string(option) == "--help")
+        EXPECT_EQ(r.out.compare(0, 6, "usage:"), 0) << name << ": " << r.out.substr(0, 80);
+      else
+        EXPECT_EQ(r.out, name + " " + version + "\n");
+    }
+  }
+}
+
+// -------------------------------------------------------------------------- rviz_config
+
+// rviz_config on the UR5 (its meshes are in a package that is not installed): a Wrench
+// display per moving joint on the node's topics, the torque scale 1 / (2 W) with W the
+// weight of the model as the package's C++ reader finds it, and a shapes URDF that
+// liburdf reads with the same joints.
+TEST_F(CliTest, RvizConfigForTheUr5) {
+  const std::string urdf = kData + "/urdf/ur5_robot.urdf";
+  const Result r = run(JLE_RVIZ_CONFIG, {"--urdf", urdf, "--output", path("ur5.rviz"), "--node",
+                                         "/arm/joint_load_estimator"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const jle::Model<double> model = jle::modelFromUrdfFile(urdf);
+  const YAML::Node config = YAML::LoadFile(path("ur5.rviz"));
+  const YAML::Node displays = config["Visualization Manager"]["Displays"];
+  ASSERT_TRUE(displays.IsSequence());
+  std::vector<std::string> moving;
+  for (int i = 1; i < model.nsegments(); ++i)
+    if (model.joint_type[i] != jle::JointType::kFixed) moving.push_back(model.joint_name[i]);
+  ASSERT_EQ(moving.size(), 6u);
+  const YAML::Node wrenches = displays[2]["Displays"];
+  ASSERT_EQ(wrenches.size(), moving.size());
+  const double weight = model.totalMass() * 9.80665;
+  for (std::size_t k = 0; k < moving.size(); ++k) {
+    EXPECT_EQ(wrenches[k]["Class"].as<std::string>(), "rviz/WrenchStamped");
+    EXPECT_EQ(wrenches[k]["Topic"].as<std::string>(),
+              "/arm/joint_load_estimator/wrench/" + moving[k]);
+    // 6 significant digits printed.
+    EXPECT_NEAR(wrenches[k]["Torque Arrow Scale"].as<double>() * 2.0 * weight, 1.0, 1e-5);
+  }
+  EXPECT_EQ(displays[1]["Robot Description"].as<std::string>(), "robot_description_shapes");
+  EXPECT_EQ(config["Visualization Manager"]["Global Options"]["Fixed Frame"].as<std::string>(),
+            "world");
+  urdf::Model original, shapes;
+  ASSERT_TRUE(original.initFile(urdf));
+  ASSERT_TRUE(shapes.initFile(path("ur5.shapes.urdf")));
+  ASSERT_EQ(shapes.joints_.size(), original.joints_.size());
+  for (const auto& [name, joint] : original.joints_) {
+    ASSERT_EQ(shapes.joints_.count(name), 1u) << name;
+    EXPECT_EQ(shapes.joints_.at(name)->type, joint->type) << name;
+    EXPECT_EQ(shapes.joints_.at(name)->parent_link_name, joint->parent_link_name) << name;
+    const urdf::Vector3& a = shapes.joints_.at(name)->parent_to_joint_origin_transform.position;
+    const urdf::Vector3& b = joint->parent_to_joint_origin_transform.position;
+    EXPECT_EQ(a.x, b.x) << name;  // the joint elements are copied as they are
+    EXPECT_EQ(a.y, b.y) << name;
+    EXPECT_EQ(a.z, b.z) << name;
+  }
+  // Every link with a child joint away from its origin has a cylinder to it.
+  for (const auto& [name, link] : shapes.links_) {
+    int away = 0, cylinders = 0;
+    for (const auto& joint : link->child_joints) {
+      const urdf::Vector3& p = joint->parent_to_joint_origin_transform.position;
+      away += std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z) > 1e-6;
+    }
+    for (const auto& visual : link->visual_array)
+      cylinders += visual->geometry->type == urdf::Geometry::CYLINDER;
+    EXPECT_EQ(cylinders, away) << name;
+  }
+  const Result bad = run(JLE_RVIZ_CONFIG, {"--urdf", urdf, "--output", path("x.rviz"), "--joints",
+                                           "elbow_joint,no_such_joint"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("'no_such_joint' is not a joint"), std::string::npos) << bad.err;
 }
 
 }  // namespace

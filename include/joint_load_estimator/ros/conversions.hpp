@@ -49,6 +49,12 @@ Outcome feedPlate(Pipeline& pipeline, int k, const geometry_msgs::WrenchStamped&
 void prepare(const LoadsRecord& record, joint_load_estimator::JointLoads& msg);
 /// The record as a JointLoads message (prepare()d), no allocation.
 void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg);
+/// Sizes `msg` (~joint_efforts) for `record`'s joints (once).
+void prepare(const LoadsRecord& record, sensor_msgs::JointState& msg);
+/// The record as a sensor_msgs/JointState (prepare()d), no allocation: name, the
+/// position and velocity the loads were computed from, and the estimated effort; the
+/// stamp of the JointLoads message of the same record.
+void toJointState(const LoadsRecord& record, sensor_msgs::JointState& msg);
 /// Joint i of the record as a wrench message in its child link frame.
 void toWrenchMessage(const LoadsRecord& record, std::size_t i, geometry_msgs::WrenchStamped& msg);
 

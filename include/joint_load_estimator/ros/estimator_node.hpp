@@ -3,6 +3,7 @@
 #pragma once
 
 #include <joint_load_estimator/CalibrateBias.h>
+#include <joint_load_estimator/EstimatorConfig.h>
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
@@ -12,6 +13,7 @@
 #include <joint_load_estimator/sensor_bias.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/callback_queue.h>
@@ -102,6 +104,9 @@ class EstimatorNode {
   void waitForCalibration(std::unique_lock<std::mutex>& lock);
   std::vector<BiasFileEntry> applyCalibration(joint_load_estimator::CalibrateBias::Response& res);
   void applyPendingBias();
+  // ~reconfigure (reconfigure.cpp): live tuning through dynamic_reconfigure.
+  void setUpReconfigure();
+  void onReconfigure(joint_load_estimator::EstimatorConfig& config, std::uint32_t level);
 
   ros::NodeHandle nh_, private_nh_;
   Settings settings_;
@@ -115,6 +120,8 @@ class EstimatorNode {
   ros::Publisher loads_pub_, residual_pub_;
   std::vector<ros::Publisher> wrench_pubs_;
   joint_load_estimator::JointLoads loads_msg_;
+  ros::Publisher efforts_pub_;           // ~joint_efforts (sensor_msgs/JointState)
+  sensor_msgs::JointState efforts_msg_;  // the JointLoads' names, q, q-dot, efforts
   geometry_msgs::WrenchStamped wrench_msg_;
   geometry_msgs::PointStamped cop_msg_;
   diagnostic_updater::Updater updater_;
@@ -146,6 +153,11 @@ class EstimatorNode {
   ros::CallbackQueue service_queue_;
   ros::ServiceServer calibrate_srv_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
+  // ~reconfigure: the parameters as read at start, with every change applied since (the
+  // one reader, parseSettings, maps and checks them), and the server.
+  XmlRpc::XmlRpcValue params_;
+  boost::recursive_mutex reconfigure_mutex_;  // the server's, held by updateConfig() too
+  std::unique_ptr<dynamic_reconfigure::Server<joint_load_estimator::EstimatorConfig>> reconfigure_;
 };
 
 }  // namespace jle
