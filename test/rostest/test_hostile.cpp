@@ -266,8 +266,9 @@ void hostileStream(const std::vector<const Kind*>& cycle, const ros::Time& start
   ASSERT_TRUE(pair.connect());
   NodeUnderTest &clean = pair.clean, &hostile = pair.hostile;
   DiagnosticsLog& diag = diagnosticsLog();
-  // What came before (another stream) has been taken: the counters from here on.
-  ASSERT_TRUE(waitFor([&] {
+  // What came before (another stream) has been taken: the counters from here on (not
+  // fatal: the stream's own checks then say what differs).
+  EXPECT_TRUE(waitFor([&] {
     return diag.latest(hostile.status(), "joint states received") == hostile.sent() &&
            diag.latest(clean.status(), "joint states received") == clean.sent();
   }));
