@@ -1,6 +1,7 @@
 // The workspace of the algorithms: every buffer sized once from the model.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>

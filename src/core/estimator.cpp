@@ -306,8 +306,10 @@ void Estimator::computeLoads(const Model<Scalar>& model, Data<Scalar>& data,
                              const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
                              const VectorX<Scalar>& qdd, const BaseState<Scalar>& base) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  forwardKinematics(model, data, q, qd, qdd, Vector3(config_.gravity_world.template cast<Scalar>()),
-                    base, kinematics_segments_, static_);
+  localKinematics(model, data, q, qd, qdd, Vector3(config_.gravity_world.template cast<Scalar>()),
+                  base, kinematics_segments_, static_);
+  // World poses: only the force plates read them (the feet's positions).
+  if (plates_.size() > 0) worldPoses(model, data, kinematics_segments_);
   for (std::size_t k = 0; k < inputs_.size(); ++k) {
     const WrenchInput& input = inputs_[k];
     if (!input.needed || sensors_.segment(static_cast<int>(k)) >= 0) continue;  // sensors: below
@@ -339,6 +341,7 @@ void Estimator::computeInFloat(const BaseState<double>& base_state) {
     data_.moment[i] = d.moment[i].cast<double>();
     data_.effort[i] = d.effort[i];
   }
+  if (plates_.size() == 0) return;  // no world poses computed (computeLoads)
   for (int i : kinematics_segments_) {
     data_.R_world[i] = d.R_world[i].cast<double>();
     data_.p_world[i] = d.p_world[i].cast<double>();
