@@ -18,8 +18,28 @@ using jle::Data;
 using jle::JointType;
 using jle::Model;
 using jle::VectorX;
-using jle::axisRotation;
 using jle::checkCoordinates;
+
+/// Rotation by angle q [rad] about the unit vector u (Rodrigues).
+template <typename Scalar>
+Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, Scalar q) {
+  using std::cos;
+  using std::sin;
+  const Scalar s = sin(q);
+  const Scalar c = cos(q);
+  const Scalar t = Scalar(1) - c;
+  Eigen::Matrix<Scalar, 3, 3> R;
+  R(0, 0) = t * u.x() * u.x() + c;
+  R(0, 1) = t * u.x() * u.y() - s * u.z();
+  R(0, 2) = t * u.x() * u.z() + s * u.y();
+  R(1, 0) = t * u.x() * u.y() + s * u.z();
+  R(1, 1) = t * u.y() * u.y() + c;
+  R(1, 2) = t * u.y() * u.z() - s * u.x();
+  R(2, 0) = t * u.x() * u.z() - s * u.y();
+  R(2, 1) = t * u.y() * u.z() + s * u.x();
+  R(2, 2) = t * u.z() * u.z() + c;
+  return R;
+}
 
 namespace detail {
 

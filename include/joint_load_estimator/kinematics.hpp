@@ -5,6 +5,7 @@
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/trig.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -47,13 +48,11 @@ struct BaseState {
   }
 };
 
-/// Rotation by angle q [rad] about the unit vector u (Rodrigues).
+/// Rotation by angle q [rad] about the unit vector u (Rodrigues; sin and cos by sinCos).
 template <typename Scalar>
 Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, Scalar q) {
-  using std::cos;
-  using std::sin;
-  const Scalar s = sin(q);
-  const Scalar c = cos(q);
+  Scalar s, c;
+  sinCos(q, s, c);
   const Scalar t = Scalar(1) - c;
   Eigen::Matrix<Scalar, 3, 3> R;
   R(0, 0) = t * u.x() * u.x() + c;
@@ -119,16 +118,15 @@ void forwardRoot(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_
 template <typename Scalar>
 JLE_ALWAYS_INLINE void jointRotation(const Model<Scalar>& model, int i, Scalar q,
                                      Eigen::Matrix<Scalar, 3, 3>& R) {
-  using std::cos;
-  using std::sin;
   const Eigen::Matrix<Scalar, 3, 3>& R0 = model.R_parent_joint[i];
   const int k = model.axis_index[i];
   if (k < 0) {
     R.noalias() = R0 * axisRotation(model.axis[i], q);
     return;
   }
-  const Scalar c = cos(q);
-  const Scalar s = model.axis[i][k] * sin(q);
+  Scalar s, c;
+  sinCos(q, s, c);
+  s *= model.axis[i][k];
   const int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;  // (k, a, b) cyclic
   R.col(k) = R0.col(k);
   for (int r = 0; r < 3; ++r) {
