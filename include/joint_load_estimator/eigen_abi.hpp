@@ -14,8 +14,10 @@
 
 #include <Eigen/Core>
 
-#if EIGEN_MAX_ALIGN_BYTES != 16 || EIGEN_MAX_STATIC_ALIGN_BYTES != 16 || !EIGEN_MALLOC_ALREADY_ALIGNED
-#error "joint_load_estimator: Eigen's alignment differs from the core library's; compile with \
+#if EIGEN_MAX_ALIGN_BYTES != 16 || EIGEN_MAX_STATIC_ALIGN_BYTES != 16 || \
+    !EIGEN_MALLOC_ALREADY_ALIGNED
+#error \
+    "joint_load_estimator: Eigen's alignment differs from the core library's; compile with \
 -DEIGEN_MAX_ALIGN_BYTES=16 -DEIGEN_MAX_STATIC_ALIGN_BYTES=16 -DEIGEN_MALLOC_ALREADY_ALIGNED=1 \
 (link the CMake target joint_load_estimator_core or find_package the catkin package)"
 #endif

@@ -36,8 +36,8 @@ TEST(LinkClient, OtherCompilerFlagsGiveTheSameLoads) {
   char line[64];
   while (std::fgets(line, sizeof line, pipe)) got.push_back(std::strtod(line, nullptr));
   const int status = pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status)) << JLE_LINK_CLIENT_FLAGS
-                                 << " client killed by signal " << WTERMSIG(status);
+  ASSERT_TRUE(WIFEXITED(status)) << JLE_LINK_CLIENT_FLAGS << " client killed by signal "
+                                 << WTERMSIG(status);
   ASSERT_EQ(WEXITSTATUS(status), 0) << command;
   ASSERT_EQ(got.size(), expected.size());
   // The client's inline code (the header templates) may contract a * b + c into fused
