@@ -10,6 +10,9 @@
 
 #include <jle_testing/random_models.hpp>
 
+#include "legacy_filter.hpp"
+#include "legacy_passes.hpp"
+
 #include <benchmark/benchmark.h>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
@@ -44,8 +47,14 @@ States randomStates(int nq) {
   return s;
 }
 
+// What a pass computes: kLocal all 6-D joint wrenches over the segment-frame kinematics
+// (what KDL's recursive Newton-Euler computes, plus the 5 components it drops), kWorld
+// with every segment's world pose as well (forwardKinematics), kLegacy the passes as
+// they were before the leaner ones (legacy_passes.hpp, world poses included).
+enum class Pass { kLocal, kWorld, kLegacy };
+
 template <typename Scalar>
-void coreLoads(benchmark::State& state, const std::string& file) {
+void coreLoads(benchmark::State& state, const std::string& file, Pass pass = Pass::kLocal) {
   const jle::Model<Scalar> model = jle::modelFromUrdfFile(kData + file).cast<Scalar>();
   jle::Data<Scalar> data(model);
   const States s = randomStates(model.nq);
@@ -58,12 +67,32 @@ void coreLoads(benchmark::State& state, const std::string& file) {
   const Eigen::Matrix<Scalar, 3, 1> g(0, 0, Scalar(-9.80665));
   int k = 0;
   for (auto _ : state) {
-    jle::forwardKinematics(model, data, q[k], qd[k], qdd[k], g);
-    jle::inverseDynamics(model, data);
+    switch (pass) {
+      case Pass::kLocal:
+        jle::localKinematics(model, data, q[k], qd[k], qdd[k], g);
+        jle::inverseDynamics(model, data);
+        break;
+      case Pass::kWorld:
+        jle::forwardKinematics(model, data, q[k], qd[k], qdd[k], g);
+        jle::inverseDynamics(model, data);
+        break;
+      case Pass::kLegacy:
+        jle_legacy::forwardKinematics(model, data, q[k], qd[k], qdd[k], g);
+        jle_legacy::inverseDynamics(model, data);
+        break;
+    }
     benchmark::DoNotOptimize(data.moment.data());
+    benchmark::ClobberMemory();
     k = (k + 1) % kStates;
   }
   state.counters["segments"] = model.nsegments();
+}
+
+void coreDoubleWorld(benchmark::State& state, const std::string& file) {
+  coreLoads<double>(state, file, Pass::kWorld);
+}
+void legacyDouble(benchmark::State& state, const std::string& file) {
+  coreLoads<double>(state, file, Pass::kLegacy);
 }
 
 void coreDouble(benchmark::State& state, const std::string& file) {
@@ -81,7 +110,7 @@ void coreKinematicsOnly(benchmark::State& state, const std::string& file) {
   const Eigen::Vector3d g(0, 0, -9.80665);
   int k = 0;
   for (auto _ : state) {
-    jle::forwardKinematics(model, data, s.q[k], s.qd[k], s.qdd[k], g);
+    jle::localKinematics(model, data, s.q[k], s.qd[k], s.qdd[k], g);
     benchmark::DoNotOptimize(data.acc.data());
     k = (k + 1) % kStates;
   }
@@ -172,34 +201,58 @@ void kdlChain(benchmark::State& state, const std::string& file, const std::strin
   }
 }
 
-// A bank of `c` over a 7-joint arm with two wrench inputs, sampled every 1 ms.
-void runBank(benchmark::State& state, const jle::DifferentiatorConfig& c) {
-  const int channels = 7 + 12;
-  jle::DifferentiatorBank bank(c, channels);
-  std::vector<double> x(channels, 0.0);
+// The filter bank per sample, per filter type and channel count (state.range(0)): 6, 7
+// (the arms' joints), 19 (7 joints and two wrench inputs), 50. Sampled every 1 ms, so
+// the gains settle and the steady per-sample cost is what is measured. Bank is the
+// package's DifferentiatorBank or the frozen one of legacy_filter.hpp; Config its
+// configuration type.
+template <typename Bank, typename Config>
+void runBank(benchmark::State& state, const Config& c) {
+  const int channels = static_cast<int>(state.range(0));
+  Bank bank(c, channels);
+  // The samples made beforehand (4096, cycled on a continuous time axis): the loop
+  // times the filter, not the signal's sin.
+  const int n = 4096;
+  std::vector<double> x(static_cast<std::size_t>(n * channels));
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i < channels; ++i) x[k * channels + i] = std::sin(2.0 * M_PI * k / n + i);
   double t = 0.0;
+  int k = 0;
   for (auto _ : state) {
     t += 1e-3;
-    for (int i = 0; i < channels; ++i) x[i] = std::sin(t + i);
-    benchmark::DoNotOptimize(bank.update(t, x.data()));
+    benchmark::DoNotOptimize(bank.update(t, &x[k * channels]));
+    benchmark::DoNotOptimize(bank.value(0));
+    k = (k + 1) % n;
   }
 }
 
-void differentiation(benchmark::State& state, jle::DifferentiatorType type, int window) {
-  jle::DifferentiatorConfig c;
-  c.type = type;
-  c.window = window;
-  c.kalman_model = jle::KalmanModel::kConstantAcceleration;  // for kKalman
-  c.process_noise = 1e3;
-  runBank(state, c);
+// "kalman_cj" is the default (constant-jerk Kalman, config.hpp); "kalman_ca" constant
+// acceleration (q = 1e3); "savitzky_golay_9" causal, order 2; "finite_difference" 3 points;
+// "adaptive" the bank of Kalman filters with its defaults.
+template <typename Config>
+Config filterConfig(const std::string& name) {
+  Config c;
+  using Type = decltype(c.type);
+  using Kalman = decltype(c.kalman_model);
+  if (name == "kalman_ca") {
+    c.kalman_model = Kalman::kConstantAcceleration;
+    c.process_noise = 1e3;
+  } else if (name == "savitzky_golay_9") {
+    c.type = Type::kSavitzkyGolay;
+  } else if (name == "finite_difference") {
+    c.type = Type::kFiniteDifference;
+  } else if (name == "adaptive") {
+    c.type = Type::kAdaptive;
+  }
+  return c;
 }
 
-// The filters as configured by default: the adaptive bank (the node's), against the old
-// default, the constant-jerk Kalman filter (q = 1e4, r = 1e-4), on the same channels.
-void differentiationDefault(benchmark::State& state, jle::DifferentiatorType type) {
-  jle::DifferentiatorConfig c;
-  c.type = type;
-  runBank(state, c);
+void filterBank(benchmark::State& state, const std::string& name) {
+  runBank<jle::DifferentiatorBank>(state, filterConfig<jle::DifferentiatorConfig>(name));
+}
+void legacyFilterBank(benchmark::State& state, const std::string& name) {
+  runBank<jle_legacy_filter::DifferentiatorBank>(
+      state, filterConfig<jle_legacy_filter::DifferentiatorConfig>(name));
 }
 
 // Scaling: random serial chains and random trees of n moving joints (seeded), all 6-D
@@ -216,7 +269,7 @@ void scaling(benchmark::State& state, bool tree) {
   const Eigen::Vector3d g(0, 0, -9.80665);
   int k = 0;
   for (auto _ : state) {
-    jle::forwardKinematics(model, data, s.q[k], s.qd[k], s.qdd[k], g);
+    jle::localKinematics(model, data, s.q[k], s.qd[k], s.qdd[k], g);
     jle::inverseDynamics(model, data);
     benchmark::DoNotOptimize(data.moment.data());
     k = (k + 1) % kStates;
@@ -275,11 +328,9 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
 
 // The estimator per joint sample (filter + kinematics + dynamics) as the node runs it,
 // over 4096 samples of a smooth trajectory (or of a still robot), cycled.
-void estimatorStep(benchmark::State& state, const std::string& file, const std::string& joints,
-                   bool still, const std::string& variant) {
+void runEstimator(benchmark::State& state, const std::string& file,
+                  const jle::EstimatorConfig& config, bool still) {
   const jle::Model<double> model = jle::modelFromUrdfFile(kData + file);
-  jle::EstimatorConfig config = savingsVariant(variant);
-  if (!joints.empty()) config.joints = {joints};
   jle::Estimator estimator(model, config);
   const int n = 4096;
   std::vector<Eigen::VectorXd> q(n, Eigen::VectorXd(model.nq));
@@ -294,6 +345,20 @@ void estimatorStep(benchmark::State& state, const std::string& file, const std::
   }
   state.counters["computed_segments"] = static_cast<double>(estimator.dynamicsSegments().size());
   state.counters["planar"] = estimator.lastWasPlanar();
+}
+
+void estimatorStep(benchmark::State& state, const std::string& file, const std::string& joints,
+                   bool still, const std::string& variant) {
+  jle::EstimatorConfig config = savingsVariant(variant);
+  if (!joints.empty()) config.joints = {joints};
+  runEstimator(state, file, config, still);
+}
+
+// The node's step with every default (EstimatorConfig{}: the constant-jerk Kalman filter,
+// the exact savings) on a moving arm: the "full step" tools/speed.sh sets against
+// coreDouble, the loads alone, on the same arm.
+void fullStep(benchmark::State& state, const std::string& file) {
+  runEstimator(state, file, jle::EstimatorConfig(), false);
 }
 
 }  // namespace
@@ -367,18 +432,23 @@ BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_auto, "/urdf/chains/p
 BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/panda_chain.urdf", "",
                   false, "planar_off");
 
-BENCHMARK_CAPTURE(coreDouble, panda_chain, "/urdf/chains/panda_chain.urdf");
+#define JLE_PASSES(name, file)                    \
+  BENCHMARK_CAPTURE(coreDouble, name, file);      \
+  BENCHMARK_CAPTURE(coreDoubleWorld, name, file); \
+  BENCHMARK_CAPTURE(legacyDouble, name, file);    \
+  BENCHMARK_CAPTURE(fullStep, name, file)
+JLE_PASSES(panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",
                   "panda_hand_tcp");
 BENCHMARK_CAPTURE(kdlTree, panda_chain, "/urdf/chains/panda_chain.urdf");
-BENCHMARK_CAPTURE(coreDouble, ur5_chain, "/urdf/chains/ur5_chain.urdf");
+JLE_PASSES(ur5_chain, "/urdf/chains/ur5_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, ur5_chain, "/urdf/chains/ur5_chain.urdf", "base_link", "tool0");
-BENCHMARK_CAPTURE(coreDouble, kinova_chain, "/urdf/chains/kinova_chain.urdf");
+JLE_PASSES(kinova_chain, "/urdf/chains/kinova_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, kinova_chain, "/urdf/chains/kinova_chain.urdf", "base",
                   "j2s6s200_end_effector");
-BENCHMARK_CAPTURE(coreDouble, panda, "/urdf/panda.urdf");
+JLE_PASSES(panda, "/urdf/panda.urdf");
 BENCHMARK_CAPTURE(kdlTree, panda, "/urdf/panda.urdf");
-BENCHMARK_CAPTURE(coreDouble, talos, "/urdf/talos_reduced.urdf");
+JLE_PASSES(talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreFloat, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreLongDouble, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(kdlTree, talos, "/urdf/talos_reduced.urdf");
@@ -386,11 +456,13 @@ BENCHMARK_CAPTURE(coreKinematicsOnly, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreDynamicsOnly, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreKinematicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(coreDynamicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
-BENCHMARK_CAPTURE(differentiation, finite_difference, jle::DifferentiatorType::kFiniteDifference,
-                  3);
-BENCHMARK_CAPTURE(differentiation, savitzky_golay_9, jle::DifferentiatorType::kSavitzkyGolay, 9);
-BENCHMARK_CAPTURE(differentiation, kalman, jle::DifferentiatorType::kKalman, 1);
-BENCHMARK_CAPTURE(differentiationDefault, kalman_cj, jle::DifferentiatorType::kKalman);
-BENCHMARK_CAPTURE(differentiationDefault, adaptive, jle::DifferentiatorType::kAdaptive);
+#define JLE_FILTER(name)                                                        \
+  BENCHMARK_CAPTURE(filterBank, name, #name)->Arg(6)->Arg(7)->Arg(19)->Arg(50); \
+  BENCHMARK_CAPTURE(legacyFilterBank, name, #name)->Arg(6)->Arg(7)->Arg(19)->Arg(50)
+JLE_FILTER(kalman_cj);
+JLE_FILTER(kalman_ca);
+JLE_FILTER(savitzky_golay_9);
+JLE_FILTER(finite_difference);
+JLE_FILTER(adaptive);
 
 BENCHMARK_MAIN();

@@ -4,6 +4,8 @@
 // prediction). ROS-free, allocation-free after construction.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
+
 #include <Eigen/Core>
 
 #include <algorithm>

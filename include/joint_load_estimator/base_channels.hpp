@@ -4,6 +4,7 @@
 #pragma once
 
 #include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 
 #include <Eigen/Core>

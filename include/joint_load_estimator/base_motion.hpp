@@ -16,6 +16,7 @@
 // quaternion and its negative give the same R: sign flips in the input do not matter.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 
 #include <Eigen/Core>

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 
 #include <Eigen/Core>

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>

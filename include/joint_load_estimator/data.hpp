@@ -1,6 +1,7 @@
 // The workspace of the algorithms: every buffer sized once from the model.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>
@@ -39,10 +40,11 @@ struct Data {
   std::vector<Scalar> q, qd, qdd;       ///< joint coordinate of the segment (mimics expanded)
   std::vector<Matrix3> R_parent_child;  ///< segment orientation in its parent segment
   std::vector<Vector3> p_parent_child;  ///< segment origin in its parent segment [m]
-  std::vector<Matrix3> R_world;         ///< segment orientation in the world
-  std::vector<Vector3> p_world;         ///< segment origin in the world [m]
-  std::vector<Vector3> omega;           ///< angular velocity, segment frame [rad/s]
-  std::vector<Vector3> alpha;           ///< angular acceleration, segment frame [rad/s^2]
+  /// World poses: forwardKinematics or worldPoses() (localKinematics sets the root's only).
+  std::vector<Matrix3> R_world;  ///< segment orientation in the world
+  std::vector<Vector3> p_world;  ///< segment origin in the world [m]
+  std::vector<Vector3> omega;    ///< angular velocity, segment frame [rad/s]
+  std::vector<Vector3> alpha;    ///< angular acceleration, segment frame [rad/s^2]
   /// Acceleration of the segment origin minus gravity, segment frame [m/s^2]. Gravity
   /// enters as an upward acceleration of the base, so no segment needs its weight added.
   std::vector<Vector3> acc;

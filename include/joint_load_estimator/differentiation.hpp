@@ -6,6 +6,7 @@
 #pragma once
 
 #include <joint_load_estimator/bandwidth_selection.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Householder>
@@ -394,7 +395,6 @@ class DifferentiatorBank {
     else
       kalmanChannels<4>(x);
     stamp_ = t;
-    out_ = state_.topRows(3);
     if (count_ < n) ++count_;
     return count_ >= n;
   }
@@ -476,18 +476,31 @@ class DifferentiatorBank {
     S_ = S;
   }
 
-  // x <- F x + K (measurement - (F x)_0) for every channel, at fixed size N.
+  // x <- F x + K (measurement - (F x)_0) for every channel, at fixed size N, and the
+  // estimate (x, x', x'') into out_ in the same pass. F = exp(A dt) of the integrator
+  // chain is upper triangular with F(i, i + d) = dt^d / d!: the products by its zeros
+  // and ones are skipped, the other terms added in the full product's order.
   template <int N>
   void kalmanChannels(const double* x) {
-    const Eigen::Matrix<double, N, N> F = F_;
-    const Eigen::Matrix<double, N, 1> K = K_;
-    for (int c = 0; c < channels_; ++c) {
-      Eigen::Map<Eigen::Matrix<double, N, 1>> state(state_.col(c).data());
-      Eigen::Matrix<double, N, 1> s = F * state;
-      const double innovation = x[c] - s[0];
-      innovation_[c] = innovation;
-      s += K * innovation;
-      state = s;
+    double f[N], k[N];
+    for (int d = 0; d < N; ++d) {
+      f[d] = F_(0, d);
+      k[d] = K_[d];
+    }
+    double* state = state_.data();
+    double* out = out_.data();
+    double* innovation = innovation_.data();
+    for (int c = 0; c < channels_; ++c, state += N, out += 3) {
+      double s[N];
+      for (int i = 0; i < N; ++i) {
+        double v = state[i];
+        for (int j = i + 1; j < N; ++j) v += f[j - i] * state[j];
+        s[i] = v;
+      }
+      const double e = x[c] - s[0];
+      innovation[c] = e;
+      for (int i = 0; i < N; ++i) state[i] = s[i] + k[i] * e;
+      for (int i = 0; i < 3; ++i) out[i] = state[i];
     }
   }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
 
@@ -32,7 +33,8 @@ struct Wrench {
 
 /// Adds a wrench applied TO the robot at the origin of frame `frame` (an index into
 /// model.frames), expressed in that frame (kLocal) or in the world (kWorld). Call after
-/// forwardKinematics (which clears the previous ones) and before inverseDynamics.
+/// forwardKinematics (which clears the previous ones; localKinematics does too, but a
+/// kWorld wrench needs worldPoses() as well) and before inverseDynamics.
 template <typename Scalar>
 void addExternalWrench(const Model<Scalar>& model, Data<Scalar>& data, int frame,
                        const Eigen::Matrix<Scalar, 3, 1>& force,
@@ -62,12 +64,19 @@ namespace detail {
 
 // One segment of the backward pass in two halves: solveSegment adds its own inertial
 // terms to what its children and the applied wrenches left in force/moment (and sets
-// its effort); passToParent hands the result to its parent.
+// its effort); passToParent hands the result to its parent. The sums start from the
+// applied wrenches, reversed: at a leaf in solveSegment, elsewhere when the first of
+// the children (the highest-numbered, Model::opens_parent) passes its wrench up, so no
+// separate pass clears them. The order of the additions is that of a clear-then-add.
 template <typename Scalar>
-inline void solveSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+JLE_ALWAYS_INLINE void solveSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   Vector3& f = data.force[i];
   Vector3& m = data.moment[i];
+  if (!model.has_children[i]) {
+    f = -data.f_ext[i];
+    m = -data.n_ext[i];
+  }
   if (model.has_inertia[i]) {
     const Vector3& c = model.com[i];
     const Vector3& w = data.omega[i];
@@ -81,16 +90,21 @@ inline void solveSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) 
       m += w.cross(Jw);
     }
   }
+  const int k = model.axis_index[i];  // u = +-e_k: the projection is one component
   switch (model.joint_type[i]) {
-    case JointType::kRevolute: data.effort[i] = model.axis[i].dot(m); break;
-    case JointType::kPrismatic: data.effort[i] = model.axis[i].dot(f); break;
+    case JointType::kRevolute:
+      data.effort[i] = k >= 0 ? model.axis[i][k] * m[k] : model.axis[i].dot(m);
+      break;
+    case JointType::kPrismatic:
+      data.effort[i] = k >= 0 ? model.axis[i][k] * f[k] : model.axis[i].dot(f);
+      break;
     default: data.effort[i] = Scalar(0); break;
   }
 }
 
 // The second half of a segment's step: its joint wrench handed to its parent.
 template <typename Scalar>
-inline void passToParent(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+JLE_ALWAYS_INLINE void passToParent(const Model<Scalar>& model, Data<Scalar>& data, int i) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   const Vector3& f = data.force[i];
   const Vector3& m = data.moment[i];
@@ -98,37 +112,41 @@ inline void passToParent(const Model<Scalar>& model, Data<Scalar>& data, int i) 
   if (p < 0) return;
   // The child's joint wrench acts on the parent reversed; in the parent's sum it
   // enters with a plus sign (F = m a - F_0 with F_0 holding -F_child).
-  const Vector3 f_p = data.R_parent_child[i] * f;
-  data.force[p] += f_p;
-  data.moment[p].noalias() += data.R_parent_child[i] * m;
+  const Eigen::Matrix<Scalar, 3, 3>& R = data.R_parent_child[i];
+  const Vector3 f_p = R * f;
+  if (model.opens_parent[i]) {
+    data.force[p] = f_p - data.f_ext[p];
+    data.moment[p].noalias() = R * m - data.n_ext[p];
+  } else {
+    data.force[p] += f_p;
+    data.moment[p].noalias() += R * m;
+  }
   data.moment[p] += data.p_parent_child[i].cross(f_p);
 }
 
 template <typename Scalar>
-inline void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+JLE_ALWAYS_INLINE void backwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
   solveSegment(model, data, i);
   passToParent(model, data, i);
 }
 
 }  // namespace detail
 
-/// Backward pass over the kinematics in data (forwardKinematics) and the external
-/// wrenches added since. For each segment, in its own frame (the paper's equations are
-/// frame-independent; in the segment frame J'_G is constant and no world offset enters),
+/// Backward pass over the kinematics in data (forwardKinematics or localKinematics) and
+/// the external wrenches added since. For each segment, in its own frame (the paper's
+/// equations are frame-independent; in the segment frame J'_G is constant and no world
+/// offset enters),
 ///   F = m (a_G - g) - F_0
 ///   M = J_G alpha + omega x J_G omega - xi_n x F - M_0,
 /// with F_0, M_0 the resultants of the applied wrenches and of the children's joint
 /// wrenches (reversed), and xi_n = joint origin - x_G. The moment is accumulated directly
 /// about the joint origin, which is the same sum rearranged: no large lever arm cancels.
-/// Fills data.force, data.moment (child frame, about the joint origin) and data.effort.
+/// Fills data.force, data.moment (child frame, about the joint origin) and data.effort;
+/// reads no world pose.
 template <typename Scalar>
 void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data) {
-  const int n = model.nsegments();
-  for (int i = 0; i < n; ++i) {
-    data.force[i] = -data.f_ext[i];
-    data.moment[i] = -data.n_ext[i];
-  }
-  for (int i = n - 1; i >= 0; --i) detail::backwardSegment(model, data, i);
+  detail::checkAnalyzed(model);
+  for (int i = model.nsegments() - 1; i >= 0; --i) detail::backwardSegment(model, data, i);
 }
 
 /// The backward pass over `segments` only: increasing indices, closed under children
@@ -137,10 +155,7 @@ void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data) {
 template <typename Scalar>
 void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data,
                      const std::vector<int>& segments) {
-  for (int i : segments) {
-    data.force[i] = -data.f_ext[i];
-    data.moment[i] = -data.n_ext[i];
-  }
+  detail::checkAnalyzed(model);
   for (auto it = segments.rbegin(); it != segments.rend(); ++it)
     detail::backwardSegment(model, data, *it);
 }
@@ -155,10 +170,7 @@ void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data,
 template <typename Scalar, typename AtJoint>
 void inverseDynamics(const Model<Scalar>& model, Data<Scalar>& data,
                      const std::vector<int>& segments, AtJoint&& at_joint) {
-  for (int i : segments) {
-    data.force[i] = -data.f_ext[i];
-    data.moment[i] = -data.n_ext[i];
-  }
+  detail::checkAnalyzed(model);
   for (auto it = segments.rbegin(); it != segments.rend(); ++it) {
     detail::solveSegment(model, data, *it);
     at_joint(*it);

@@ -9,6 +9,7 @@
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/input_buffer.hpp>
 #include <joint_load_estimator/model.hpp>
@@ -106,7 +107,9 @@ class Estimator {
   double stamp() const { return stamp_; }
   /// Kinematics and loads of the last published sample (dynamics.hpp conventions).
   /// After a planar sample (lastWasPlanar()) only the loads (force, moment, effort) are
-  /// updated: the planar pass has no 3-D kinematics to store.
+  /// updated: the planar pass has no 3-D kinematics to store. World poses (R_world,
+  /// p_world) beyond the root's are computed only with force plates, which need them:
+  /// jle::worldPoses() on a copy fills them otherwise.
   const Data<double>& data() const { return data_; }
   /// The estimated coordinates of the last published sample.
   const VectorX<double>& q() const { return q_; }

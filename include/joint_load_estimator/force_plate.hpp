@@ -13,6 +13,7 @@
 
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>

@@ -2,6 +2,7 @@
 // one segment, and a wrench carried between two such frames.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
 
 #include <Eigen/Core>

@@ -5,6 +5,7 @@
 
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 
 #include <Eigen/Core>
 

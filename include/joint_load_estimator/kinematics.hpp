@@ -3,7 +3,9 @@
 #pragma once
 
 #include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/trig.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -46,13 +48,11 @@ struct BaseState {
   }
 };
 
-/// Rotation by angle q [rad] about the unit vector u (Rodrigues).
+/// Rotation by angle q [rad] about the unit vector u (Rodrigues; sin and cos by sinCos).
 template <typename Scalar>
 Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, Scalar q) {
-  using std::cos;
-  using std::sin;
-  const Scalar s = sin(q);
-  const Scalar c = cos(q);
+  Scalar s, c;
+  sinCos(q, s, c);
   const Scalar t = Scalar(1) - c;
   Eigen::Matrix<Scalar, 3, 3> R;
   R(0, 0) = t * u.x() * u.x() + c;
@@ -79,6 +79,24 @@ void checkCoordinates(const Model<Scalar>& model, const VectorX<Scalar>& q,
 
 namespace detail {
 
+// Force inlining of the per-segment steps: the loops over segments are the whole of the
+// algorithms, and a call per segment costs more than its bookkeeping saves.
+#if defined(__GNUC__)
+#define JLE_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define JLE_ALWAYS_INLINE inline
+#endif
+
+// The algorithms read the flags Model::analyze() derives; a model built by hand must call it.
+template <typename Scalar>
+void checkAnalyzed(const Model<Scalar>& model) {
+  const std::size_t n = static_cast<std::size_t>(model.nsegments());
+  if (model.axis_index.size() != n || model.opens_parent.size() != n ||
+      model.has_children.size() != n || model.has_inertia.size() != n ||
+      model.gyroscopic.size() != n)
+    throw std::invalid_argument("the model was not analyzed: call Model::analyze() once built");
+}
+
 // Root of the forward pass: the base state, gravity as an upward acceleration.
 template <typename Scalar>
 void forwardRoot(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
@@ -93,13 +111,59 @@ void forwardRoot(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_
   data.n_ext[0].setZero();
 }
 
-// One segment of the forward pass (its parent done). kStatic: the caller guarantees
-// zero joint velocities and accelerations and a base at rest (angular), so every
-// omega and alpha is zero and only the pose and the origin acceleration remain.
+// R = R_parent_joint * (rotation by q about axis u): for u = +-e_k (sign = u_k) the
+// rotation leaves column k and mixes the other two, 12 products instead of Rodrigues'
+// and a 3x3 product's 39. Equal to the general product but for its rounding of
+// (1 - cos q) + cos q, which is exactly 1 here.
+template <typename Scalar>
+JLE_ALWAYS_INLINE void jointRotation(const Model<Scalar>& model, int i, Scalar q,
+                                     Eigen::Matrix<Scalar, 3, 3>& R) {
+  const Eigen::Matrix<Scalar, 3, 3>& R0 = model.R_parent_joint[i];
+  const int k = model.axis_index[i];
+  if (k < 0) {
+    R.noalias() = R0 * axisRotation(model.axis[i], q);
+    return;
+  }
+  Scalar s, c;
+  sinCos(q, s, c);
+  s *= model.axis[i][k];
+  const int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;  // (k, a, b) cyclic
+  R.col(k) = R0.col(k);
+  for (int r = 0; r < 3; ++r) {
+    R(r, a) = R0(r, a) * c + R0(r, b) * s;
+    R(r, b) = R0(r, b) * c - R0(r, a) * s;
+  }
+}
+
+// The joint's own terms added to omega and alpha (revolute, rate qd, acceleration qdd):
+// omega += u qd, alpha += u qdd + omega x u qd, with u's zeros skipped when u = +-e_k.
+template <typename Scalar>
+JLE_ALWAYS_INLINE void revoluteRates(const Model<Scalar>& model, int i, Scalar qd, Scalar qdd,
+                                     Eigen::Matrix<Scalar, 3, 1>& w,
+                                     Eigen::Matrix<Scalar, 3, 1>& al) {
+  const Eigen::Matrix<Scalar, 3, 1>& u = model.axis[i];
+  const int k = model.axis_index[i];
+  if (k < 0) {
+    w += u * qd;
+    al += u * qdd + w.cross(u * qd);
+    return;
+  }
+  const int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
+  const Scalar sqd = u[k] * qd;
+  w[k] += sqd;
+  al[k] += u[k] * qdd;
+  al[a] += w[b] * sqd;
+  al[b] -= w[a] * sqd;
+}
+
+// One segment of the forward pass (its parent done), in the segment frames only.
+// kStatic: the caller guarantees zero joint velocities and accelerations and a base at
+// rest (angular), so every omega and alpha is zero and only the pose and the origin
+// acceleration remain.
 template <typename Scalar, bool kStatic>
-inline void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i,
-                           const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
-                           const VectorX<Scalar>& qdd) {
+JLE_ALWAYS_INLINE void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i,
+                                      const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                                      const VectorX<Scalar>& qdd) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   const int p = model.parent[i];
   const int k = model.coordinate[i];
@@ -115,15 +179,15 @@ inline void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i
   data.qd[i] = qdi;
   data.qdd[i] = qddi;
 
-  const Vector3& u = model.axis[i];
+  const JointType type = model.joint_type[i];
   Eigen::Matrix<Scalar, 3, 3>& R = data.R_parent_child[i];
   Vector3& r = data.p_parent_child[i];
   r = model.p_parent_joint[i];
-  if (model.joint_type[i] == JointType::kRevolute)
-    R.noalias() = model.R_parent_joint[i] * axisRotation(u, qi);
+  if (type == JointType::kRevolute)
+    jointRotation(model, i, qi, R);
   else
     R = model.R_parent_joint[i];
-  if (model.joint_type[i] == JointType::kPrismatic) r.noalias() += R * (u * qi);
+  if (type == JointType::kPrismatic) r.noalias() += R * (model.axis[i] * qi);
 
   if (kStatic) {
     data.omega[i].setZero();
@@ -137,48 +201,58 @@ inline void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i
     w.noalias() = R.transpose() * w_p;
     data.alpha[i].noalias() = R.transpose() * data.alpha[p];
     data.acc[i].noalias() = R.transpose() * a_point;
-    if (model.joint_type[i] == JointType::kRevolute) {
-      w += u * qdi;
-      data.alpha[i] += u * qddi + w.cross(u * qdi);
-    } else if (model.joint_type[i] == JointType::kPrismatic) {
+    if (type == JointType::kRevolute) {
+      revoluteRates(model, i, qdi, qddi, w, data.alpha[i]);
+    } else if (type == JointType::kPrismatic) {
+      const Vector3& u = model.axis[i];
       data.acc[i] += u * qddi + Scalar(2) * w.cross(u * qdi);
     }
   }
-
-  data.R_world[i].noalias() = data.R_world[p] * R;
-  data.p_world[i] = data.p_world[p];
-  data.p_world[i].noalias() += data.R_world[p] * r;
   data.f_ext[i].setZero();
   data.n_ext[i].setZero();
 }
 
+// Segment i's pose in the world from its parent's.
+template <typename Scalar>
+JLE_ALWAYS_INLINE void worldPose(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+  const int p = model.parent[i];
+  data.R_world[i].noalias() = data.R_world[p] * data.R_parent_child[i];
+  data.p_world[i] = data.p_world[p];
+  data.p_world[i].noalias() += data.R_world[p] * data.p_parent_child[i];
+}
+
 }  // namespace detail
 
-/// Forward pass. q, qd, qdd: size model.nq, in the order of model.coordinate_names
-/// [rad, rad/s, rad/s^2 or m, m/s, m/s^2]. gravity_world [m/s^2]. Fills the kinematic
-/// fields of data and clears its external wrenches.
+/// The forward pass in the segment frames: fills data.q, qd, qdd, R_parent_child,
+/// p_parent_child, omega, alpha, acc (segment frames) and the root's world pose, and
+/// clears the external wrenches; the other segments' world poses (R_world, p_world) are
+/// left as they were: worldPoses() fills them when a world-frame input or output needs
+/// them. q, qd, qdd: size model.nq, in the order of model.coordinate_names [rad, rad/s,
+/// rad/s^2 or m, m/s, m/s^2]. gravity_world [m/s^2].
 template <typename Scalar>
-void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
-                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
-                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                       const BaseState<Scalar>& base = BaseState<Scalar>()) {
+void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                     const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                     const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                     const BaseState<Scalar>& base = BaseState<Scalar>()) {
   checkCoordinates(model, q, qd, qdd);
+  detail::checkAnalyzed(model);
   detail::forwardRoot(data, gravity_world, base);
   const int n = model.nsegments();
   for (int i = 1; i < n; ++i) detail::forwardSegment<Scalar, false>(model, data, i, q, qd, qdd);
 }
 
-/// The forward pass over `segments` only: indices in increasing order, closed under
+/// localKinematics over `segments` only: indices in increasing order, closed under
 /// parents (every listed segment's parent is listed), starting with 0. With `statics`
 /// the caller asserts zero joint velocities and accelerations and a base that does
 /// not rotate, and the velocity terms are skipped.
 template <typename Scalar>
-void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
-                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
-                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                       const BaseState<Scalar>& base, const std::vector<int>& segments,
-                       bool statics) {
+void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                     const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                     const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                     const BaseState<Scalar>& base, const std::vector<int>& segments,
+                     bool statics) {
   checkCoordinates(model, q, qd, qdd);
+  detail::checkAnalyzed(model);
   detail::forwardRoot(data, gravity_world, base);
   if (statics) {
     data.omega[0].setZero();
@@ -189,6 +263,41 @@ void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const Vec
     for (std::size_t j = 1; j < segments.size(); ++j)
       detail::forwardSegment<Scalar, false>(model, data, segments[j], q, qd, qdd);
   }
+}
+
+/// Every segment's world pose (data.R_world, data.p_world [m]) from the segment-frame
+/// poses of localKinematics (the root's is the base pose it was given).
+template <typename Scalar>
+void worldPoses(const Model<Scalar>& model, Data<Scalar>& data) {
+  const int n = model.nsegments();
+  for (int i = 1; i < n; ++i) detail::worldPose(model, data, i);
+}
+
+/// worldPoses over `segments` only (increasing, closed under parents, starting with 0).
+template <typename Scalar>
+void worldPoses(const Model<Scalar>& model, Data<Scalar>& data, const std::vector<int>& segments) {
+  for (std::size_t j = 1; j < segments.size(); ++j) detail::worldPose(model, data, segments[j]);
+}
+
+/// Forward pass: localKinematics and worldPoses, every field of data's kinematics.
+template <typename Scalar>
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                       const BaseState<Scalar>& base = BaseState<Scalar>()) {
+  localKinematics(model, data, q, qd, qdd, gravity_world, base);
+  worldPoses(model, data);
+}
+
+/// The forward pass over `segments` only (see localKinematics), world poses included.
+template <typename Scalar>
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
+                       const BaseState<Scalar>& base, const std::vector<int>& segments,
+                       bool statics) {
+  localKinematics(model, data, q, qd, qdd, gravity_world, base, segments, statics);
+  worldPoses(model, data, segments);
 }
 
 /// Angular velocity of segment i in the world frame [rad/s].

@@ -1,8 +1,11 @@
 // The immutable multibody model: a tree of rigid segments joined by 1-DOF joints.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
+
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -82,6 +85,15 @@ struct Model {
   /// gyroscopic[i] == 0: omega x J_G omega is identically zero for this segment, because
   /// its angular velocity always lies along a principal axis of J_G (or is zero).
   std::vector<char> gyroscopic;
+  /// axis_index[i] == k (0, 1, 2): the joint axis is exactly +-e_k of the segment frame
+  /// (axis[i][k] is the sign), so the joint's rotation mixes two columns only; -1 for
+  /// any other axis and for a joint that does not move.
+  std::vector<signed char> axis_index;
+  /// has_children[i]: some segment has i as its parent. opens_parent[i]: i is the
+  /// highest-numbered child of its parent, the first of them the backward pass solves,
+  /// so it starts the parent's sums (no separate pass clears them).
+  std::vector<char> has_children;
+  std::vector<char> opens_parent;
 
   /// Names of the independent coordinates, index = position in q, size nq.
   std::vector<std::string> coordinate_names;
@@ -116,7 +128,8 @@ struct Model {
     return total;
   }
 
-  /// Fills has_inertia and gyroscopic from the rest of the model. The direction of a
+  /// Fills has_inertia, gyroscopic, axis_index, has_children and opens_parent from the
+  /// rest of the model. The direction of a
   /// segment's angular velocity is constant in its frame when the base is fixed and
   /// every joint above it turns about one and the same axis (a planar chain): then the
   /// gyroscopic term vanishes wherever that axis is a principal axis of inertia.
@@ -129,6 +142,7 @@ struct Model {
     std::vector<int> kind(static_cast<std::size_t>(n), 2);
     std::vector<Vector3> dir(static_cast<std::size_t>(n), Vector3::Zero());
     const Scalar eps = Scalar(64) * Eigen::NumTraits<Scalar>::epsilon();
+    analyzeTopology();
     for (int i = 0; i < n; ++i) {
       has_inertia[i] = mass[i] != Scalar(0) || !inertia_com[i].isZero(Scalar(0));
       if (i == 0) {
@@ -158,6 +172,26 @@ struct Model {
     }
   }
 
+  /// axis_index, has_children and opens_parent (part of analyze()).
+  void analyzeTopology() {
+    const int n = nsegments();
+    axis_index.assign(static_cast<std::size_t>(n), -1);
+    has_children.assign(static_cast<std::size_t>(n), 0);
+    opens_parent.assign(static_cast<std::size_t>(n), 0);
+    for (int i = n - 1; i > 0; --i) {
+      if (!has_children[parent[i]]) opens_parent[i] = 1;
+      has_children[parent[i]] = 1;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (!isMoving(joint_type[i])) continue;
+      for (int k = 0; k < 3; ++k) {
+        const Scalar a = axis[i][(k + 1) % 3], b = axis[i][(k + 2) % 3];
+        if (a == Scalar(0) && b == Scalar(0) && std::abs(axis[i][k]) == Scalar(1))
+          axis_index[i] = static_cast<signed char>(k);
+      }
+    }
+  }
+
   /// The same model in another scalar type.
   template <typename Other>
   Model<Other> cast() const {
@@ -175,6 +209,9 @@ struct Model {
     out.warnings = warnings;
     out.has_inertia = has_inertia;
     out.gyroscopic = gyroscopic;
+    out.axis_index = axis_index;
+    out.has_children = has_children;
+    out.opens_parent = opens_parent;
     for (int i = 0; i < nsegments(); ++i) {
       out.R_parent_joint.push_back(R_parent_joint[i].template cast<Other>());
       out.p_parent_joint.push_back(p_parent_joint[i].template cast<Other>());

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <joint_load_estimator/config.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>

@@ -51,6 +51,7 @@
 #pragma once
 
 #include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
 

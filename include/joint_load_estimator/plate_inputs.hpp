@@ -5,6 +5,7 @@
 #include <joint_load_estimator/data.hpp>
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/input_buffer.hpp>
 #include <joint_load_estimator/model.hpp>

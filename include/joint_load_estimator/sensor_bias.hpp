@@ -3,6 +3,7 @@
 #pragma once
 
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/eigen_abi.hpp>
 
 #include <Eigen/Core>
 

@@ -5,6 +5,8 @@
 // docs/zero_phase.md.
 #pragma once
 
+#include <joint_load_estimator/eigen_abi.hpp>
+
 #include <Eigen/Core>
 
 #include <cstdint>

@@ -241,7 +241,7 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
 
   stamp_ = bank_.stamp();
   const BaseState<double> base_state = readEstimate();
-  const bool contacts_changed = plates_.updateContacts(stamp_);
+  const bool contacts_changed = plates_.size() > 0 && plates_.updateContacts(stamp_);
   // Same filtered inputs as the last computation: same loads (exact by construction).
   reused_ = config_.savings.reuse_unchanged && sameFilteredInputs(contacts_changed);
   if (!reused_) {
@@ -334,8 +334,14 @@ void Estimator::computeLoads(const Model<Scalar>& model, Data<Scalar>& data,
                              const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
                              const VectorX<Scalar>& qdd, const BaseState<Scalar>& base) {
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  forwardKinematics(model, data, q, qd, qdd, Vector3(config_.gravity_world.template cast<Scalar>()),
-                    base, kinematics_segments_, static_);
+  const Vector3 gravity(config_.gravity_world.template cast<Scalar>());
+  const bool all = static_cast<int>(dynamics_segments_.size()) == model.nsegments();
+  if (all && !static_)  // every segment: the loops without the index lists
+    localKinematics(model, data, q, qd, qdd, gravity, base);
+  else
+    localKinematics(model, data, q, qd, qdd, gravity, base, kinematics_segments_, static_);
+  // World poses: only the force plates read them (the feet's positions).
+  if (plates_.size() > 0) worldPoses(model, data, kinematics_segments_);
   for (std::size_t k = 0; k < inputs_.size(); ++k) {
     const WrenchInput& input = inputs_[k];
     if (!input.needed || sensors_.segment(static_cast<int>(k)) >= 0) continue;  // sensors: below
@@ -343,9 +349,12 @@ void Estimator::computeLoads(const Model<Scalar>& model, Data<Scalar>& data,
     addExternalWrench(model, data, input.frame, Vector3(w.force.template cast<Scalar>()),
                       Vector3(w.moment.template cast<Scalar>()), WrenchFrame::kLocal);
   }
-  plates_.apply(model, data, bank_);
+  if (plates_.size() > 0) plates_.apply(model, data, bank_);
   if (!sensors_.any()) {
-    inverseDynamics(model, data, dynamics_segments_);
+    if (all)
+      inverseDynamics(model, data);
+    else
+      inverseDynamics(model, data, dynamics_segments_);
     return;
   }
   for (std::size_t k = 0; k < inputs_.size(); ++k)
@@ -367,6 +376,7 @@ void Estimator::computeInFloat(const BaseState<double>& base_state) {
     data_.moment[i] = d.moment[i].cast<double>();
     data_.effort[i] = d.effort[i];
   }
+  if (plates_.size() == 0) return;  // no world poses computed (computeLoads)
   for (int i : kinematics_segments_) {
     data_.R_world[i] = d.R_world[i].cast<double>();
     data_.p_world[i] = d.p_world[i].cast<double>();

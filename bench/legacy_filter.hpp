@@ -1,0 +1,538 @@
+// The filter bank as it was before the leaner Kalman step (main at c185352), frozen for
+// the before/after rows of bench/speed_core.cpp. Not used by the package.
+// Online estimation of a signal's value, rate and second derivative from its samples:
+// Savitzky-Golay fits (finite differences are the smallest of them) and Kalman filters.
+// A bank filters many channels that share their sample times (all the joints of one
+// JointState, the components of the wrenches resampled at the same stamps) at the cost
+// of one set of coefficients.
+#pragma once
+
+#include <joint_load_estimator/bandwidth_selection.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/Householder>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace jle_legacy_filter {
+
+using jle::BandwidthSelection;
+
+enum class DifferentiatorType : std::uint8_t {
+  kFiniteDifference,  ///< exact through order+1 points (3-point, 2nd order by default)
+  kSavitzkyGolay,     ///< least-squares polynomial of `order` over `window` samples
+  kKalman,            ///< white-noise acceleration or jerk model
+  /// Kalman filters of `kalman_model` on a grid of bandwidths, the one whose innovations
+  /// are the likeliest over the recent samples selected, the noise estimated online
+  /// (bandwidth_selection.hpp).
+  kAdaptive,
+};
+
+enum class KalmanModel : std::uint8_t {
+  kConstantAcceleration,  ///< state (x, x', x''), white noise on x'''
+  kConstantJerk,          ///< state (x, x', x'', x'''), white noise on x''''
+};
+
+/// The default is what the node runs (config/default.yaml): the constant-jerk Kalman
+/// filter, process noise 1e4, measurement noise 1e-4 rad. The adaptive filter is an
+/// option: better on the accuracy study's scenes of real logs, worse on clean ones, and
+/// its noise gain understates the q'' noise (README "Differentiators").
+struct DifferentiatorConfig {
+  DifferentiatorType type = DifferentiatorType::kKalman;
+  /// Savitzky-Golay: samples in the fit and degree of the polynomial (2..5). The
+  /// estimate describes the sample `delay` steps before the newest: 0 is causal,
+  /// (window - 1) / 2 is centred. Finite differences use window = order + 1.
+  int window = 9;
+  int order = 2;
+  int delay = 0;
+  /// Kalman: spectral density of the white noise driving the highest derivative
+  /// [unit^2 / s^(2n-1)], and standard deviation of the position measurement [unit].
+  KalmanModel kalman_model = KalmanModel::kConstantJerk;
+  double process_noise = 1e4;
+  double measurement_noise = 1e-4;
+  /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
+  /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
+  /// noise [unit] if known (0: estimated online from the innovations), and the time
+  /// constant [s] of the likelihood that selects the bandwidth.
+  double min_bandwidth = 0.5;
+  double max_bandwidth = 50.0;
+  double noise = 0.0;
+  double memory = 1.0;
+  /// A gap between samples longer than this [s] restarts the filter (its memory no
+  /// longer describes the signal).
+  double max_gap = 0.5;
+};
+
+/// Checks a configuration once (the bank on construction, validate(EstimatorConfig) in
+/// config.hpp); throws std::invalid_argument naming the parameter as config/default.yaml
+/// spells it ("parameter 'differentiator/order' must be 2..5 ...").
+inline void validate(const DifferentiatorConfig& c) {
+  const auto fail = [](const char* key, const std::string& what) {
+    throw std::invalid_argument(std::string("parameter 'differentiator/") + key + "' " + what);
+  };
+  if (c.type == DifferentiatorType::kAdaptive) {
+    if (!(c.min_bandwidth > 0.0) || !std::isfinite(c.min_bandwidth))
+      fail("min_bandwidth", "must be finite and > 0 [Hz]");
+    if (!(c.max_bandwidth >= c.min_bandwidth) || !std::isfinite(c.max_bandwidth))
+      fail("max_bandwidth", "must be finite and >= min_bandwidth [Hz]");
+    if (!(c.noise >= 0.0) || !std::isfinite(c.noise))
+      fail("noise", "must be finite and >= 0 (0: estimated online)");
+    if (!(c.memory > 0.0) || !std::isfinite(c.memory)) fail("memory", "must be finite and > 0 [s]");
+  } else if (c.type == DifferentiatorType::kKalman) {
+    if (!(c.process_noise > 0.0) || !std::isfinite(c.process_noise))
+      fail("process_noise", "must be finite and > 0");
+    if (!(c.measurement_noise > 0.0) || !std::isfinite(c.measurement_noise))
+      fail("measurement_noise", "must be finite and > 0");
+  } else {
+    if (c.order < 2 || c.order > 5)
+      fail("order", "must be 2..5 (a second derivative needs a quadratic), it is " +
+                        std::to_string(c.order));
+    const int window = c.type == DifferentiatorType::kFiniteDifference ? c.order + 1 : c.window;
+    if (window < c.order + 1 || window > 101)
+      fail("window", "must be order+1..101, it is " + std::to_string(c.window));
+    if (c.delay < 0 || c.delay >= window)
+      fail("delay", "must be 0..window-1, it is " + std::to_string(c.delay));
+  }
+  if (!(c.max_gap > 0.0) || !std::isfinite(c.max_gap))
+    fail("max_gap", "must be finite and > 0 [s]");
+}
+
+/// A bank of identical filters over `channels` signals sampled at common times.
+/// update() takes the newest sample; after it returns true, stamp() is the time the
+/// estimate describes (earlier than the newest sample by the configured delay) and
+/// value/rate/accel(c) the estimate for channel c. Memory is allocated in the
+/// constructor only. Times must increase: the caller resets on a backward jump and
+/// drops duplicates (update() refuses them).
+class DifferentiatorBank {
+ public:
+  static constexpr int kMaxOrder = 5;
+  /// Adaptive: ratio of neighbouring bandwidths of its filters.
+  static constexpr double kBandwidthRatio = 2.0;
+  using SmallMatrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, kMaxOrder + 1>;
+
+  DifferentiatorBank(const DifferentiatorConfig& config, int channels)
+      : config_(config), channels_(channels) {
+    validate(config_);
+    if (config_.type == DifferentiatorType::kFiniteDifference) {
+      config_.window = config_.order + 1;
+    }
+    if (config_.type == DifferentiatorType::kKalman ||
+        config_.type == DifferentiatorType::kAdaptive) {
+      n_ = config_.kalman_model == KalmanModel::kConstantAcceleration ? 3 : 4;
+      config_.window = 1;
+      config_.delay = 0;
+      state_.setZero(n_, channels_);
+      P_.setZero(n_, n_);
+      innovation_.setZero(channels_);
+      if (config_.type == DifferentiatorType::kAdaptive) buildModels();
+    } else {
+      n_ = config_.order + 1;
+      coeff_.setZero(3, config_.window);
+      tau_prev_.setConstant(config_.window, std::nan(""));
+    }
+    times_.setZero(config_.window);
+    values_.setZero(config_.window, channels_);
+    out_.setZero(3, channels_);
+  }
+
+  const DifferentiatorConfig& config() const { return config_; }
+  int channels() const { return channels_; }
+  /// Samples needed after a reset before the first estimate.
+  int warmup() const { return isKalman() ? n_ : config_.window; }
+
+  void reset() {
+    count_ = 0;
+    head_ = 0;
+    if (!isKalman()) tau_prev_.setConstant(std::nan(""));
+    dt_prev_ = -1.0;  // a restarted filter is a fresh one, to the bit: no cached F, Q
+    for (DifferentiatorBank& m : models_) m.reset();
+    selection_.reset();
+  }
+
+  /// Adaptive: the bandwidth [Hz] of the filter in use, and the position noise's
+  /// standard deviation [unit] of channel c it assumes (estimated or given; 0 before the
+  /// first estimate).
+  double bandwidth() const {
+    return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
+  }
+  double noise(int c) const {
+    return models_.empty() ? 0.0 : std::sqrt(selection_.noiseVariance(c));
+  }
+
+  /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.
+  /// Throws std::invalid_argument if t does not increase (the caller's duty).
+  bool update(double t, const double* x) {
+    if (count_ > 0) {
+      const double dt = t - last_time_;
+      if (!(dt > 0.0)) throw std::invalid_argument("differentiator: sample time does not increase");
+      if (dt > config_.max_gap) reset();
+    }
+    last_time_ = t;
+    if (config_.type == DifferentiatorType::kKalman) return updateKalman(t, x);
+    if (config_.type == DifferentiatorType::kAdaptive) return updateAdaptive(t, x);
+    // Ring buffer of the last `window` samples.
+    times_[head_] = t;
+    for (int c = 0; c < channels_; ++c) values_(head_, c) = x[c];
+    head_ = (head_ + 1) % config_.window;
+    if (count_ < config_.window) ++count_;
+    if (count_ < config_.window) return false;
+    fitSavitzkyGolay();
+    return true;
+  }
+
+  double stamp() const { return stamp_; }
+  double value(int c) const { return out_(0, c); }
+  double rate(int c) const { return out_(1, c); }
+  double accel(int c) const { return out_(2, c); }
+
+  /// Noise gain of the last estimate: the covariance of (value, rate, accel) per unit
+  /// variance of white noise on the samples (the same for every channel). Savitzky-Golay
+  /// and finite differences: C C^T of the weights C (3 x window) in use. Kalman: the
+  /// noise part of the estimation error, S_k = A_k S_(k-1) A_k^T + K_k K_k^T with
+  /// A_k = (I - K_k H) F_k from S = diag(1, 0, ..) at the first sample: exact through the
+  /// start-up, and at a steady rate the fixed point of the discrete Lyapunov equation,
+  /// after which it is kept (cached) while dt and the gain stay. Adaptive: the selected
+  /// filter's (pooled over the channels: the selection is common to the bank), which is
+  /// exact for the filter that made the estimate, restarts from another one included.
+  Eigen::Matrix3d noiseGain() const {
+    if (config_.type == DifferentiatorType::kAdaptive)
+      return models_[selection_.selected()].noiseGain();
+    if (config_.type == DifferentiatorType::kKalman) return S_.topLeftCorner(3, 3);
+    Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < config_.window; ++k) {
+      const Eigen::Vector3d c = coeff_.col(k);
+      G.noalias() += c * c.transpose();
+    }
+    return G;
+  }
+
+ private:
+  bool isKalman() const {
+    return config_.type == DifferentiatorType::kKalman ||
+           config_.type == DifferentiatorType::kAdaptive;
+  }
+
+  // Adaptive: one Kalman filter per bandwidth from min_bandwidth to max_bandwidth (the
+  // ratio kBandwidthRatio, the last one at max_bandwidth), in unit measurement noise
+  // (the gain depends on process / measurement noise only); their process noise is set
+  // from the first interval (tuneModels).
+  void buildModels() {
+    const double span = std::log(config_.max_bandwidth / config_.min_bandwidth);
+    const int count = 1 + static_cast<int>(std::ceil(span / std::log(kBandwidthRatio) - 1e-9));
+    DifferentiatorConfig k = config_;
+    k.type = DifferentiatorType::kKalman;
+    k.measurement_noise = 1.0;
+    k.process_noise = 1.0;
+    for (int m = 0; m < count; ++m) {
+      bandwidths_.push_back(
+          std::min(config_.max_bandwidth, config_.min_bandwidth * std::pow(kBandwidthRatio, m)));
+      models_.emplace_back(k, channels_);
+    }
+    selection_ = BandwidthSelection(count, channels_, config_.noise, config_.memory);
+  }
+
+  // The process noise of every filter for samples h [s] apart: the density q at which
+  // the signal's spectrum q / w^(2n) meets the noise's, h (unit noise), at 2 pi f.
+  void tuneModels(double h) {
+    for (std::size_t m = 0; m < models_.size(); ++m) {
+      models_[m].config_.process_noise = h * std::pow(2.0 * M_PI * bandwidths_[m], 2 * n_);
+      models_[m].dt_prev_ = -1.0;
+    }
+  }
+
+  bool updateAdaptive(double t, const double* x) {
+    const double dt = t - prev_t_;
+    if (count_ == 1) tuneModels(dt);
+    for (DifferentiatorBank& m : models_) m.update(t, x);
+    prev_t_ = t;
+    stamp_ = t;
+    // The innovations describe the noise once the filters predict from data alone.
+    if (count_ > n_) selectModel(dt, x);
+    if (count_ <= n_) ++count_;
+    out_ = models_[selection_.selected()].out_;
+    return count_ >= n_;
+  }
+
+  // The noise from the widest filter (the least disturbed by the motion), the likeliest
+  // filter, and the narrower ones left far behind restarted from it.
+  void selectModel(double dt, const double* x) {
+    const DifferentiatorBank& widest = models_.back();
+    selection_.observeNoise(x, widest.innovation_.data(), widest.noise_innovation_, dt);
+    const int count = static_cast<int>(models_.size());
+    for (int m = 0; m < count; ++m)
+      selection_.score(m, models_[m].innovation_.data(), models_[m].innovation_variance_, dt);
+    const int best = selection_.select();
+    for (int m = 0; m < best; ++m) {
+      if (!selection_.behind(m)) continue;
+      models_[m].adopt(models_[best]);
+      selection_.restarted(m);
+    }
+  }
+
+  // The state and noise gain of another filter of the same model and channels.
+  void adopt(const DifferentiatorBank& other) {
+    state_ = other.state_;
+    S_ = other.S_;
+    noise_settled_ = false;
+    out_ = other.out_;
+  }
+
+  // Index in the ring of the sample k steps before the newest.
+  int ring(int k) const { return (head_ - 1 - k + 2 * config_.window) % config_.window; }
+
+  void fitSavitzkyGolay() {
+    const int w = config_.window;
+    stamp_ = times_[ring(config_.delay)];
+    // Times centred on the window and scaled to [-1, 1], so that the Vandermonde matrix
+    // stays well conditioned at any rate and any offset of the clock.
+    const double newest = times_[ring(0)], oldest = times_[ring(w - 1)];
+    const double mid = 0.5 * (newest + oldest), half = 0.5 * (newest - oldest);
+    if (!sameSpacing(mid, half)) {
+      factorVandermonde();
+      weightsAt((stamp_ - mid) / half, half);
+      tau_prev_.head(w) = tau_.head(w);
+      half_prev_ = half;
+    }
+    out_.setZero();
+    for (int k = 0; k < w; ++k) out_.noalias() += coeff_.col(k) * values_.row(ring(k));
+  }
+
+  // Fills tau_ with the window's times centred on mid and scaled by half; whether they
+  // have the same spacing as at the last fit (a steady rate: the weights are reused).
+  // "Same" means every sample within kSameSpacing of where the last fit had it: stamps
+  // are integers of nanoseconds, so a smaller difference is the rounding of the double
+  // time axis (its ulp is 1e-13 s at 1000 s), not information about the signal.
+  bool sameSpacing(double mid, double half) {
+    constexpr double kSameSpacing = 1e-10;  // [s]
+    const int w = config_.window;
+    bool same = std::abs(half - half_prev_) <= kSameSpacing;
+    for (int k = 0; k < w; ++k) {
+      const double tau = (times_[ring(k)] - mid) / half;
+      same = same && std::abs(tau - tau_prev_[k]) * half <= kSameSpacing;
+      tau_[k] = tau;
+    }
+    return same;
+  }
+
+  // Least squares by Householder QR of the Vandermonde V (w x n) of tau_, V = Q R: the
+  // weights of derivative d are row d of E pinv(V) = (Q R^-T E^T)^T, where row d of
+  // E evaluates the d-th derivative of 1, tau, ..., tau^(n-1) at the stamp. Their
+  // error grows like cond(V), where the normal equations' grows like cond(V)^2: with
+  // one 1 us interval among 1 ms ones, the 3-point difference (V square) lost a
+  // factor 250 over what its inputs allow, and 1.3e6 at 0.1 ns (docs/stability.md).
+  // The centring and scaling keep cond(V) small for any spacing that is not
+  // degenerate, at any offset of the clock. The estimate is a fixed linear
+  // combination of the window: coeff row d . x is the d-th derivative at the stamp.
+  // Factored in place in V_: R on and above the diagonal, the reflectors' essential
+  // parts below, their coefficients in h_.
+  void factorVandermonde() {
+    const int w = config_.window;
+    V_.resize(w, n_);
+    for (int k = 0; k < w; ++k) {
+      double p = 1.0;
+      for (int j = 0; j < n_; ++j, p *= tau_[k]) V_(k, j) = p;
+    }
+    for (int j = 0; j < n_; ++j) {
+      double beta;
+      V_.col(j).tail(w - j).makeHouseholderInPlace(h_[j], beta);
+      V_(j, j) = beta;
+      if (j + 1 < n_)
+        V_.bottomRightCorner(w - j, n_ - j - 1)
+            .applyHouseholderOnTheLeft(V_.col(j).tail(w - j - 1), h_[j], work_.data());
+    }
+  }
+
+  // The weights coeff_ (3 x w) of the value, rate and acceleration at the scaled stamp
+  // te from the factors of factorVandermonde(); half: the time scale [s].
+  void weightsAt(double te, double half) {
+    const int w = config_.window;
+    const Vandermonde& QR = V_;
+    // Y = R^-T E^T (n x 3) by forward substitution.
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxOrder + 1, 3> Y(n_, 3);
+    for (int j = 0; j < n_; ++j) {
+      Y(j, 0) = std::pow(te, j);
+      Y(j, 1) = j >= 1 ? j * std::pow(te, j - 1) : 0.0;
+      Y(j, 2) = j >= 2 ? j * (j - 1) * std::pow(te, j - 2) : 0.0;
+      for (int i = 0; i < j; ++i) Y.row(j) -= QR(i, j) * Y.row(i);
+      Y.row(j) /= QR(j, j);
+    }
+    // coeff^T = Q [Y; 0] (w x 3): the reflectors H_{n-1} .. H_0 applied in turn,
+    // H_j = I - h_j v_j v_j^T with v_j = (0 .. 0, 1, QR(j+1 .., j)).
+    coeff_t_.setZero(w, 3);
+    coeff_t_.topRows(n_) = Y;
+    for (int j = n_ - 1; j >= 0; --j) {
+      const int len = w - j - 1;
+      Eigen::Matrix<double, 1, 3> vx =
+          coeff_t_.row(j) + QR.col(j).segment(j + 1, len).transpose() * coeff_t_.bottomRows(len);
+      vx *= h_[j];
+      coeff_t_.row(j) -= vx;
+      coeff_t_.bottomRows(len).noalias() -= QR.col(j).segment(j + 1, len) * vx;
+    }
+    coeff_ = coeff_t_.transpose();
+    coeff_.row(1) /= half;
+    coeff_.row(2) /= half * half;
+  }
+
+  bool updateKalman(double t, const double* x) {
+    const int n = n_;
+    if (count_ == 0) {
+      startKalman(t, x);
+      return false;
+    }
+    const double dt = t - prev_t_;
+    prev_t_ = t;
+    const bool changed = discretize(dt);
+    // Predict, then update with the position measurement: the gain is the same for
+    // every channel, so the covariance is propagated once; at a steady rate it reaches
+    // its fixed point (the Riccati recursion converges), after which the gain stays.
+    const bool steady = !changed && gain_settled_;
+    if (!steady) updateKalmanGain();
+    // Noise gain: kept once it no longer changes under a settled gain.
+    if (!(steady && noise_settled_)) updateNoiseGain(steady);
+    if (n == 3)
+      kalmanChannels<3>(x);
+    else
+      kalmanChannels<4>(x);
+    stamp_ = t;
+    out_ = state_.topRows(3);
+    if (count_ < n) ++count_;
+    return count_ >= n;
+  }
+
+  // The first sample: the state starts at the measurement, at rest, with a wide prior on
+  // the derivatives.
+  void startKalman(double t, const double* x) {
+    const int n = n_;
+    state_.setZero();
+    for (int c = 0; c < channels_; ++c) state_(0, c) = x[c];
+    P_.setZero();
+    const double r2 = config_.measurement_noise * config_.measurement_noise;
+    P_(0, 0) = r2;
+    for (int i = 1; i < n; ++i) P_(i, i) = 1e12 * r2;
+    K_.setZero(n);
+    gain_settled_ = false;
+    S_.setZero(n, n);
+    S_(0, 0) = 1.0;  // the state starts at the measurement
+    noise_settled_ = false;
+    prev_t_ = t;
+    count_ = 1;
+    stamp_ = t;
+    out_.topRows(std::min(3, n)) = state_.topRows(std::min(3, n));
+  }
+
+  // Exact discretisation for this dt [s]: F = exp(A dt) of the integrator chain, Q the
+  // integrated white noise of density q on the highest derivative. Recomputed (true)
+  // only when dt changes by more than the time axis resolves (see sameSpacing).
+  bool discretize(double dt) {
+    if (std::abs(dt - dt_prev_) <= 1e-10) return false;
+    const int n = n_;
+    double fact[2 * kMaxOrder + 2], dt_pow[2 * kMaxOrder + 2];
+    fact[0] = 1.0;
+    dt_pow[0] = 1.0;
+    for (int i = 1; i < 2 * kMaxOrder + 2; ++i) {
+      fact[i] = fact[i - 1] * i;
+      dt_pow[i] = dt_pow[i - 1] * dt;
+    }
+    F_.setIdentity(n, n);
+    Q_.resize(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) F_(i, j) = dt_pow[j - i] / fact[j - i];
+    const double q = config_.process_noise;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int a = n - 1 - i, b = n - 1 - j;
+        Q_(i, j) = q * dt_pow[a + b + 1] / (fact[a] * fact[b] * (a + b + 1));
+      }
+    dt_prev_ = dt;
+    return true;
+  }
+
+  // The covariance P_ predicted and updated, and the gain K_ (settled once it no longer
+  // changes).
+  void updateKalmanGain() {
+    const SmallMatrix& F = F_;
+    const SmallMatrix& Q = Q_;
+    P_ = F * P_ * F.transpose() + Q;
+    const double r2 = config_.measurement_noise * config_.measurement_noise;
+    const double S = P_(0, 0) + r2;
+    innovation_variance_ = S / r2;
+    const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K = P_.col(0) / S;
+    P_ -= K * P_.row(0);
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    gain_settled_ =
+        count_ >= n_ && (K - K_).cwiseAbs().maxCoeff() <= 1e-15 * K.cwiseAbs().maxCoeff();
+    K_ = K;
+  }
+
+  // The noise gain S_ = A S_ A^T + K K^T with A = (I - K H) F (noiseGain()).
+  void updateNoiseGain(bool steady) {
+    const SmallMatrix& F = F_;
+    noise_innovation_ = (F.row(0) * S_ * F.row(0).transpose()).value() + 1.0;
+    SmallMatrix A = -K_ * F.row(0);
+    A += F;  // (I - K H) F with H = (1, 0, ..)
+    SmallMatrix S = A * S_ * A.transpose();
+    S += K_ * K_.transpose();
+    noise_settled_ = steady && (S - S_).cwiseAbs().maxCoeff() <= 1e-14 * S.cwiseAbs().maxCoeff();
+    S_ = S;
+  }
+
+  // x <- F x + K (measurement - (F x)_0) for every channel, at fixed size N.
+  template <int N>
+  void kalmanChannels(const double* x) {
+    const Eigen::Matrix<double, N, N> F = F_;
+    const Eigen::Matrix<double, N, 1> K = K_;
+    for (int c = 0; c < channels_; ++c) {
+      Eigen::Map<Eigen::Matrix<double, N, 1>> state(state_.col(c).data());
+      Eigen::Matrix<double, N, 1> s = F * state;
+      const double innovation = x[c] - s[0];
+      innovation_[c] = innovation;
+      s += K * innovation;
+      state = s;
+    }
+  }
+
+  DifferentiatorConfig config_;
+  int channels_;
+  int n_ = 3;
+  int count_ = 0;
+  int head_ = 0;
+  double last_time_ = 0.0;
+  double stamp_ = 0.0;
+  double prev_t_ = 0.0;
+  double half_prev_ = 0.0;
+  double dt_prev_ = -1.0;  // Kalman: dt of F_ and Q_
+  SmallMatrix F_, Q_;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> K_;  // Kalman gain
+  bool gain_settled_ = false;
+  SmallMatrix S_;  // Kalman noise gain (noiseGain())
+  bool noise_settled_ = false;
+  Eigen::VectorXd times_;
+  Eigen::MatrixXd values_;  // window x channels
+  Eigen::MatrixXd coeff_;   // 3 x window
+  Eigen::MatrixXd out_;     // 3 x channels
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_{101};
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 101, 1> tau_prev_;
+  using Vandermonde = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 101, kMaxOrder + 1>;
+  Vandermonde V_;
+  Eigen::Matrix<double, kMaxOrder + 1, 1> h_;     // Householder coefficients
+  Eigen::Matrix<double, kMaxOrder + 1, 1> work_;  // workspace of applyHouseholderOnTheLeft
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, 101, 3> coeff_t_;  // w x 3
+  Eigen::MatrixXd state_;                                        // Kalman: n x channels
+  SmallMatrix P_;
+  // Kalman: the last measurements minus their predictions (channels), their predicted
+  // variance, and that of their noise part alone, per unit measurement variance.
+  Eigen::VectorXd innovation_;
+  double innovation_variance_ = 1.0;
+  double noise_innovation_ = 1.0;
+  // Adaptive: the filters from the narrowest to the widest, their bandwidths [Hz], and
+  // the choice among them.
+  std::vector<DifferentiatorBank> models_;
+  std::vector<double> bandwidths_;
+  BandwidthSelection selection_;
+};
+
+}  // namespace jle_legacy_filter
