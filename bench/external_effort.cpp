@@ -185,6 +185,7 @@ struct Scenario {
   double position_noise;  // [rad] 1 sigma
   double effort_noise;    // [N m] 1 sigma
   double stamp_jitter;    // [s] stamps late by U(0, jitter) (taken at reception)
+  double amplitude = 0.3;  // [rad] of the motion (ContactScene)
 };
 
 struct Errors {
@@ -216,6 +217,7 @@ void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration
   jle_testing::ContactScene scene;
   scene.link = kTool;
   scene.t_off = std::min(scene.t_off, duration);
+  scene.amplitude = sc.amplitude;
   jle::Data<double> data(model);
   std::mt19937 rng(5);
   std::normal_distribution<double> gauss(0.0, 1.0);
@@ -256,7 +258,8 @@ int table(bool quick) {
   const Scenario scenarios[] = {{"exact", 0.0, 0.0, 0.0},
                                 {"encoder noise 1e-4 rad", 1e-4, 0.0, 0.0},
                                 {"effort noise 0.1 N m", 0.0, 0.1, 0.0},
-                                {"jittered stamps 0.3 ms", 0.0, 0.0, 3e-4}};
+                                {"jittered stamps 0.3 ms", 0.0, 0.0, 3e-4},
+                                {"exact, slow motion (0.03 rad)", 0.0, 0.0, 0.0, 0.03}};
   const double duration = quick ? 1.5 : 2.2;
   std::printf("| scenario | residual F [N] | residual M [N m] | observer F [N] | observer M [N m] "
               "| KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|\n");

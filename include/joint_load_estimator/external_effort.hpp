@@ -24,7 +24,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include <string>
 #include <vector>
@@ -129,7 +128,7 @@ class ExternalEffort {
   // Contact wrench workspace.
   Eigen::MatrixXd J_, A_;
   Eigen::VectorXd tau_js_, var_js_;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd_;
+  VectorX<double> zero_;  // qdd of the forward pass (the joint-space terms need none)
   // Detection.
   std::vector<double> abs_threshold_, threshold_, sum_sq_;
   std::vector<int> depth_;

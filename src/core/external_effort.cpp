@@ -1,6 +1,8 @@
 #include <joint_load_estimator/external_effort.hpp>
 #include <joint_load_estimator/friction.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -91,6 +93,7 @@ ExternalEffort::ExternalEffort(const Model<double>& model, const ExternalEffortC
   tau_js_ = Eigen::VectorXd::Zero(nj);
   var_js_ = Eigen::VectorXd::Zero(nj);
   J_ = Eigen::MatrixXd::Zero(6, nj);
+  zero_ = VectorX<double>::Zero(model_.nq);
   setUpContacts();
   setUpThresholds();
 }
@@ -129,7 +132,6 @@ void ExternalEffort::setUpContacts() {
     e.link = c.link;
     contacts_.push_back(e);
   }
-  svd_ = Eigen::JacobiSVD<Eigen::MatrixXd>(6, js_.size(), Eigen::ComputeThinU | Eigen::ComputeThinV);
   A_ = Eigen::MatrixXd::Zero(6, js_.size());
 }
 
@@ -177,8 +179,7 @@ void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<do
   BaseState<double> still;  // the joint-space equations hold for a base at rest
   still.R_world_base = base.R_world_base;
   still.p_world_base = base.p_world_base;
-  const VectorX<double> zero = VectorX<double>::Zero(model_.nq);
-  forwardKinematics(model_, data_, q, qd, zero, gravity_, still);
+  forwardKinematics(model_, data_, q, qd, zero_, gravity_, still);
   updateJointSpace(model_, data_, gravity_, js_);
   updateResidual(model_effort, measured, model_variance);
   updateObserver(t, measured);
@@ -252,31 +253,47 @@ void ExternalEffort::updateObserver(double t, const std::vector<double>& measure
   started_observer_ = true;
 }
 
-// Damped least squares of J^T F = tau_ext with J = U S V^T (rows: point velocity, angular
-// velocity): F = U diag(s / (s^2 + lambda^2)) V^T tau; lambda^2 = damping^2 (1 - (s_min /
-// threshold)^2) below the singular threshold, 0 above (Maciejewski & Klein 1988).
+namespace {
+
+// Damped least squares of J^T F = tau_ext for the first R rows of J (rows: point
+// velocity, angular velocity) through the R x R normal matrix G = J J^T = V S^2 V^T:
+// F = V diag(1 / (s^2 + lambda^2)) V^T J tau, lambda^2 = damping^2 (1 - (s_min /
+// threshold)^2) below the singular threshold, 0 above (Maciejewski & Klein 1988). An
+// R x R eigen-decomposition (R = 3 or 6) instead of the SVD of the R x n J: no allocation,
+// and the squared condition number costs ~1e-12 relative here (s_min / s_max > 1e-2).
+template <int R>
+void dampedSolve(const Eigen::MatrixXd& J, const Eigen::VectorXd& tau,
+                 const ExternalEffortConfig& config, Eigen::MatrixXd& P, Vector6d& F,
+                 ContactEstimate& e) {
+  using MatrixR = Eigen::Matrix<double, R, R>;
+  const MatrixR G = J.topRows<R>() * J.topRows<R>().transpose();
+  const Eigen::SelfAdjointEigenSolver<MatrixR> eig(G);
+  const Eigen::Matrix<double, R, 1> s2 = eig.eigenvalues().cwiseMax(0.0);  // ascending
+  const double s_min = std::sqrt(s2[0]);
+  const double ratio = s_min / config.singular_threshold;
+  const double lambda2 = ratio < 1.0 ? config.damping * config.damping * (1.0 - ratio * ratio) : 0.0;
+  e.sigma_min = s_min;
+  e.conditioning = s2[R - 1] > 0.0 ? s_min / std::sqrt(s2[R - 1]) : 0.0;
+  e.damping = std::sqrt(lambda2);
+  Eigen::Matrix<double, R, 1> inverse;
+  for (int r = 0; r < R; ++r) inverse[r] = s2[r] + lambda2 > 0.0 ? 1.0 / (s2[r] + lambda2) : 0.0;
+  const MatrixR Ginv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  P.topRows<R>().noalias() = Ginv * J.topRows<R>();  // tau -> F (world, moment about the point)
+  F.setZero();
+  F.head<R>().noalias() = P.topRows<R>() * tau;
+}
+
+}  // namespace
+
 void ExternalEffort::solveContact(std::size_t k) {
   const Contact& c = contact_setup_[k];
   ContactEstimate& e = contacts_[k];
   pointJacobian(model_, data_, js_, c.segment, c.point_segment, J_);
-  const int rows = c.rows;
-  svd_.compute(J_.topRows(rows), Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Eigen::VectorXd& s = svd_.singularValues();
-  const double s_min = s[rows - 1];
-  const double ratio = s_min / config_.singular_threshold;
-  const double lambda2 =
-      ratio < 1.0 ? config_.damping * config_.damping * (1.0 - ratio * ratio) : 0.0;
-  e.sigma_min = s_min;
-  e.conditioning = s[0] > 0.0 ? s_min / s[0] : 0.0;
-  e.damping = std::sqrt(lambda2);
-  Eigen::Matrix<double, 6, 1> filter = Eigen::Matrix<double, 6, 1>::Zero();
-  for (int r = 0; r < rows; ++r)
-    filter[r] = s[r] > 0.0 || lambda2 > 0.0 ? s[r] / (s[r] * s[r] + lambda2) : 0.0;
-  // P (rows x nj): the map tau -> F (world, moment about the point).
-  A_.topRows(rows).noalias() =
-      svd_.matrixU() * filter.head(rows).asDiagonal() * svd_.matrixV().transpose();
-  Vector6d F = Vector6d::Zero();
-  F.head(rows).noalias() = A_.topRows(rows) * tau_js_;
+  Vector6d F;
+  if (c.rows == 3)
+    dampedSolve<3>(J_, tau_js_, config_, A_, F, e);
+  else
+    dampedSolve<6>(J_, tau_js_, config_, A_, F, e);
   // To the link frame, moment about the link origin: T (6 x 6) acting on (f; m_point).
   const Eigen::Matrix3d R_world_link = data_.R_world[c.segment] * c.R_segment_link;
   const Eigen::Vector3d lever = R_world_link.transpose() * data_.R_world[c.segment] *
@@ -289,7 +306,7 @@ void ExternalEffort::solveContact(std::size_t k) {
   e.force = W.head<3>();
   e.moment = W.tail<3>();
   if (uncertainty_) {
-    const Eigen::MatrixXd P = T.leftCols(rows) * A_.topRows(rows);
+    const Eigen::MatrixXd P = T.leftCols(c.rows) * A_.topRows(c.rows);
     e.covariance.noalias() = P * var_js_.asDiagonal() * P.transpose();
   }
 }
