@@ -182,9 +182,9 @@ BENCHMARK(BM_LoadsAlone);
 
 struct Scenario {
   const char* name;
-  double position_noise;  // [rad] 1 sigma
-  double effort_noise;    // [N m] 1 sigma
-  double stamp_jitter;    // [s] stamps late by U(0, jitter) (taken at reception)
+  double position_noise;   // [rad] 1 sigma
+  double effort_noise;     // [N m] 1 sigma
+  double stamp_jitter;     // [s] stamps late by U(0, jitter) (taken at reception)
   double amplitude = 0.3;  // [rad] of the motion (ContactScene)
 };
 
@@ -261,8 +261,9 @@ int table(bool quick) {
                                 {"jittered stamps 0.3 ms", 0.0, 0.0, 3e-4},
                                 {"exact, slow motion (0.03 rad)", 0.0, 0.0, 0.0, 0.03}};
   const double duration = quick ? 1.5 : 2.2;
-  std::printf("| scenario | residual F [N] | residual M [N m] | observer F [N] | observer M [N m] "
-              "| KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| scenario | residual F [N] | residual M [N m] | observer F [N] | observer M [N m] "
+      "| KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|\n");
   for (const Scenario& sc : scenarios) {
     Errors residual, observer, kdl, kdl_again;
     runScenario(sc, jle::ExternalMethod::kResidual, duration, residual, kdl);

@@ -614,7 +614,8 @@ std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints
     names.push_back("contact");
   }
   for (const std::string& link : layout.contacts)
-    for (const char* component : kWrenchComponents) names.push_back("external@" + link + "." + component);
+    for (const char* component : kWrenchComponents)
+      names.push_back("external@" + link + "." + component);
   for (const std::string& plate : layout.plates)
     for (const char* column : kPlateOutputs) names.push_back(kPlatePrefix + plate + "." + column);
   return names;

@@ -66,8 +66,8 @@ void validate(const ExternalEffortConfig& c) {
 
 ExternalEffort::ExternalEffort(const Model<double>& model, const ExternalEffortConfig& config,
                                const std::vector<int>& published,
-                               const Eigen::Vector3d& gravity_world,
-                               double friction_velocity_scale, bool uncertainty)
+                               const Eigen::Vector3d& gravity_world, double friction_velocity_scale,
+                               bool uncertainty)
     : model_(model),
       config_(config),
       published_(published),
@@ -121,7 +121,8 @@ void ExternalEffort::setUpContacts() {
     for (; s >= 0; s = js_.moving_parent[s], ++joints)
       if (!is_published[s])
         fail(contactKey(k, "link"), "'" + c.link + "' needs the external effort of joint '" +
-                                        model_.joint_name[s] + "', which is not published (joints)");
+                                        model_.joint_name[s] +
+                                        "', which is not published (joints)");
     if (joints < setup.rows)
       fail(contactKey(k, "link"), "'" + c.link + "' has " + std::to_string(joints) +
                                       " moving joints above it; a " +
@@ -213,7 +214,8 @@ void ExternalEffort::updateResidual(const std::vector<double>& model_effort,
     }
     double predicted = model_effort[i];
     if (velocity_scale_ > 0.0)
-      predicted += frictionEffort(model_.damping[s], model_.friction[s], data_.qd[s], velocity_scale_);
+      predicted +=
+          frictionEffort(model_.damping[s], model_.friction[s], data_.qd[s], velocity_scale_);
     residual_[i] = predicted - measured[i];
     residual_var_[i] = noise2 + (model_variance ? (*model_variance)[i] : 0.0);
   }
@@ -271,7 +273,8 @@ void dampedSolve(const Eigen::MatrixXd& J, const Eigen::VectorXd& tau,
   const Eigen::Matrix<double, R, 1> s2 = eig.eigenvalues().cwiseMax(0.0);  // ascending
   const double s_min = std::sqrt(s2[0]);
   const double ratio = s_min / config.singular_threshold;
-  const double lambda2 = ratio < 1.0 ? config.damping * config.damping * (1.0 - ratio * ratio) : 0.0;
+  const double lambda2 =
+      ratio < 1.0 ? config.damping * config.damping * (1.0 - ratio * ratio) : 0.0;
   e.sigma_min = s_min;
   e.conditioning = s2[R - 1] > 0.0 ? s_min / std::sqrt(s2[R - 1]) : 0.0;
   e.damping = std::sqrt(lambda2);
@@ -296,8 +299,8 @@ void ExternalEffort::solveContact(std::size_t k) {
     dampedSolve<6>(J_, tau_js_, config_, A_, F, e);
   // To the link frame, moment about the link origin: T (6 x 6) acting on (f; m_point).
   const Eigen::Matrix3d R_world_link = data_.R_world[c.segment] * c.R_segment_link;
-  const Eigen::Vector3d lever = R_world_link.transpose() * data_.R_world[c.segment] *
-                                (c.point_segment - c.p_segment_link);
+  const Eigen::Vector3d lever =
+      R_world_link.transpose() * data_.R_world[c.segment] * (c.point_segment - c.p_segment_link);
   Matrix6d T = Matrix6d::Zero();
   T.topLeftCorner<3, 3>() = R_world_link.transpose();
   T.bottomRightCorner<3, 3>() = R_world_link.transpose();
@@ -330,7 +333,7 @@ void ExternalEffort::detect(double t) {
     calibrated_ = true;
     return;
   }
-  int over = -1;       // the most distal joint over its threshold
+  int over = -1;  // the most distal joint over its threshold
   bool above_release = false;
   for (std::size_t i = 0; i < n; ++i) {
     if (!(threshold_[i] > 0.0) || !std::isfinite(ext[i])) continue;

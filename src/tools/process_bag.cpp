@@ -219,9 +219,8 @@ Outputs::Outputs(const Options& options, const jle::Pipeline& pipeline) : option
   jle::prepare(record, loads_);
   sto_columns_ = 1 + 7 * record.joint.size() + record.effort_stddev.size();
   const std::size_t kinematics = options.kinematics ? 3 * record.joint.size() : 0;
-  const std::size_t external = record.external_effort.empty()
-                                   ? 0
-                                   : record.joint.size() + 1 + 6 * record.contacts.size();
+  const std::size_t external =
+      record.external_effort.empty() ? 0 : record.joint.size() + 1 + 6 * record.contacts.size();
   row_.resize(sto_columns_ +
               (options.csv.empty() ? 0 : kinematics + record.motor_effort.size() + external));
   if (!options.output.empty()) {

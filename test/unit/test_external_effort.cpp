@@ -184,8 +184,8 @@ void expectRecovered(const std::string& urdf, const std::string& link, const Vec
     const Scene s = makeScene(urdf, seed);
     std::vector<double> model_effort, measured;
     simulate(s, link, point, force, moment, model_effort, measured);
-    jle::ExternalEffort ext(s.model, contactConfig(link, point, force_only), s.published,
-                            kGravity, 0.0, false);
+    jle::ExternalEffort ext(s.model, contactConfig(link, point, force_only), s.published, kGravity,
+                            0.0, false);
     ext.update(0.0, s.q, s.qd, jle::BaseState<double>(), model_effort, measured, nullptr);
     const jle::ContactEstimate& e = ext.contacts()[0];
     // The efforts are O(10..100) N m, exact to ~1e-13; the Jacobian's smallest singular
@@ -310,7 +310,7 @@ struct PipelineRun {
 };
 
 PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double position_noise,
-                bool contact) {
+                        bool contact) {
   const jle::Model<double> model = jle::modelFromUrdfFile(urdfPath("chains/panda_chain.urdf"));
   jle::Settings settings;
   jle::ExternalEffortConfig& x = settings.external_effort;
@@ -379,7 +379,8 @@ PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double 
 // sigma with probability 2e-9 per joint and sample, and the window's RMS includes the
 // motion's model error.
 TEST(FreeMotion, NoiseAndFalseContacts) {
-  for (jle::ExternalMethod method : {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
+  for (jle::ExternalMethod method :
+       {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
     const PipelineRun run = runPipeline(method, 0.05, 1e-5, false);
     const char* name = method == jle::ExternalMethod::kResidual ? "residual" : "observer";
     std::printf("%s: free samples %ld, false-contact samples %ld, RMS tau_ext [N m]:", name,
@@ -398,7 +399,8 @@ TEST(FreeMotion, NoiseAndFalseContacts) {
 // RMS error 3.7 N residual, 2.2 N observer: the force comes from efforts of 0.05 N m
 // noise through lever arms of ~0.1 m; a wrong sign or frame errs by ~24 N).
 TEST(FreeMotion, ContactIsDetectedAtTheToolAndItsWrenchEstimated) {
-  for (jle::ExternalMethod method : {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
+  for (jle::ExternalMethod method :
+       {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
     const PipelineRun run = runPipeline(method, 0.05, 1e-5, true);
     const char* name = method == jle::ExternalMethod::kResidual ? "residual" : "observer";
     std::printf("%s: contacts started %ld at %s (%s), RMS force error %.3g N\n", name,

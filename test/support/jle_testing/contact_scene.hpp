@@ -19,12 +19,12 @@
 namespace jle_testing {
 
 struct ContactScene {
-  std::string link;                         ///< where the wrench acts (URDF link)
-  Eigen::Vector3d force_link{5, -3, 10};    ///< [N] link frame
+  std::string link;                             ///< where the wrench acts (URDF link)
+  Eigen::Vector3d force_link{5, -3, 10};        ///< [N] link frame
   Eigen::Vector3d moment_link{0.2, 0.1, -0.3};  ///< [N m] about the link origin
-  double t_on = 1.0, t_off = 2.0;           ///< [s] the wrench acts in [t_on, t_off)
-  double amplitude = 0.3;                   ///< [rad] of every joint's sinusoid
-  double frequency = 0.4;                   ///< [Hz] of the first joint (others faster)
+  double t_on = 1.0, t_off = 2.0;               ///< [s] the wrench acts in [t_on, t_off)
+  double amplitude = 0.3;                       ///< [rad] of every joint's sinusoid
+  double frequency = 0.4;                       ///< [Hz] of the first joint (others faster)
 
   bool active(double t) const { return t >= t_on && t < t_off; }
 
