@@ -54,8 +54,7 @@ void ExternalOutputs::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN,
                         "in contact at joint '" + joint_ + "' (link '" + link_ + "')");
   status.add("contacts started", contacts_);
-  if (!wrench_pubs_.empty())
-    status.add("worst contact Jacobian conditioning", worst_conditioning_);
+  if (!wrench_pubs_.empty()) status.add("worst contact Jacobian conditioning", worst_conditioning_);
   worst_conditioning_ = 1.0;
 }
 

@@ -134,19 +134,19 @@ void expectSame(const jle::PlateTopicSettings& a, const jle::PlateTopicSettings&
   EXPECT_SAME(pose_configured);
 }
 
+void expectSame(const jle::ContactLinkConfig& a, const jle::ContactLinkConfig& b,
+                const std::string& where) {
+  EXPECT_SAME(link);
+  EXPECT_SAME(point);
+  EXPECT_SAME(force_only);
+}
+
 // Element by element, "wrenches[k]/" named on a failure.
 template <typename T>
 void expectSameList(const std::vector<T>& a, const std::vector<T>& b, const std::string& list) {
   ASSERT_EQ(a.size(), b.size()) << list;
   for (std::size_t k = 0; k < a.size(); ++k)
     expectSame(a[k], b[k], list + "[" + std::to_string(k) + "]/");
-}
-
-void expectSame(const jle::ContactLinkConfig& a, const jle::ContactLinkConfig& b,
-                const std::string& where) {
-  EXPECT_SAME(link);
-  EXPECT_SAME(point);
-  EXPECT_SAME(force_only);
 }
 
 void expectSame(const jle::ExternalEffortConfig& a, const jle::ExternalEffortConfig& b) {
