@@ -27,10 +27,14 @@ fi
 # The benchmarks, once each on a tiny input, so that they cannot rot (no timing is
 # judged here).
 bench_status=0
-for b in bench_speed_core bench_speed_messages; do
+for b in bench_speed_core bench_speed_messages bench_external_effort; do
   "$ws/devel/lib/joint_load_estimator/$b" --benchmark_min_time=0.0001 >"$ws/$b.log" 2>&1 ||
     { echo "benchmark $b failed (log: $ws/$b.log)"; bench_status=1; }
 done
+# The external-effort error table on 1.5 s of the scene (about 2 s).
+"$ws/devel/lib/joint_load_estimator/bench_external_effort" --table --quick \
+  >"$ws/external_effort_table.log" 2>&1 ||
+  { tail -20 "$ws/external_effort_table.log"; echo "external effort table failed"; bench_status=1; }
 bash "$repo/tools/accuracy.sh" --quick >"$ws/accuracy_quick.log" 2>&1 ||
   { tail -20 "$ws/accuracy_quick.log"; echo "accuracy --quick failed"; bench_status=1; }
 bash "$repo/tools/stability.sh" --quick >"$ws/stability_quick.log" 2>&1 ||

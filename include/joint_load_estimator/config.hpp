@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace jle {
@@ -202,6 +203,57 @@ struct FrictionConfig {
   double velocity_scale = 0.01;
 };
 
+/// Which estimate of the external joint efforts drives the contact detection and the
+/// contact wrenches (external_effort.hpp; README, "External torques and contact wrenches").
+enum class ExternalMethod : std::uint8_t {
+  kObserver,  ///< the momentum observer: no q-ddot, a first-order lag of cut-off observer_cutoff
+  kResidual,  ///< predicted minus measured effort: uses the filtered q-ddot (the loads' delay)
+};
+
+/// A link where a contact is estimated (external_effort/contacts[k]).
+struct ContactLinkConfig {
+  std::string link;  ///< URDF link; required
+  /// The contact point in the link frame [m]: the force acts there; the published moment
+  /// is about the link origin (the WrenchStamped convention).
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  /// true: a point contact, a force only (3 unknowns; needs >= 3 joints above the link);
+  /// false: a full wrench at the point (6 unknowns; >= 6 joints).
+  bool force_only = false;
+};
+
+/// The external joint efforts, contact detection and contact wrenches from the measured
+/// efforts (JointState.effort), external_effort/...; off by default.
+struct ExternalEffortConfig {
+  bool enabled = false;
+  ExternalMethod method = ExternalMethod::kObserver;
+  /// [Hz] > 0: cut-off of the momentum observer (gain K = 2 pi observer_cutoff [1/s]).
+  double observer_cutoff = 10.0;
+  /// [N m or N] >= 0: 1-sigma white noise of each measured effort, for the covariance of
+  /// the external efforts and wrenches (with uncertainty/enabled).
+  double effort_noise = 0.0;
+  /// Damped least squares of the contact wrench: the damping lambda [m] >= 0 grows from 0
+  /// to `damping` as the smallest singular value of the Jacobian falls from
+  /// singular_threshold to 0 (exact away from singularities).
+  double damping = 0.01;
+  double singular_threshold = 0.01;  ///< [m or 1] > 0
+  std::vector<ContactLinkConfig> contacts;
+  /// Contact detection: a joint is in contact while |tau_ext| exceeds its threshold,
+  /// max(threshold, noise_multiple * sigma), sigma the RMS of its tau_ext over the first
+  /// calibration_time after a start (the robot free). 0 = that part unused; both 0: no
+  /// detection.
+  double threshold = 0.0;         ///< [N m or N] >= 0, every joint
+  double noise_multiple = 0.0;    ///< >= 0
+  double calibration_time = 1.0;  ///< [s] > 0
+  /// Per-joint thresholds [N m or N] (joint name, value) that replace `threshold`.
+  std::vector<std::pair<std::string, double>> joint_thresholds;
+  /// A contact ends when every joint is below this fraction (0, 1] of its threshold.
+  double release_fraction = 0.5;
+};
+
+/// Checks the model-independent settings of external_effort/...; throws SettingsError
+/// naming the key (external_effort.cpp).
+void validate(const ExternalEffortConfig& config);
+
 /// How the message stamps of the joint-state stream become the estimator's times
 /// (README, "Time stamps").
 enum class StampRegularize : std::uint8_t {
@@ -254,6 +306,7 @@ struct Settings {
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;
   FrictionConfig friction;
+  ExternalEffortConfig external_effort;
   /// The estimator's settings; estimator.joints are the joints whose loads are published.
   EstimatorConfig estimator;
   std::vector<WrenchTopicSettings> wrenches;     ///< pairs with estimator.wrenches

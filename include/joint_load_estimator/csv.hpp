@@ -203,6 +203,12 @@ struct LoadColumnLayout {
   bool kinematics = false;
   /// JOINT.motor_effort of every joint (friction.hpp), after the kinematics columns.
   bool motor_effort = false;
+  /// JOINT.external_effort of every joint, then `contact` (1 in contact, 0 not), after the
+  /// motor_effort columns (external_effort.hpp).
+  bool external_effort = false;
+  /// external@LINK.fx, .fy, .fz, .mx, .my, .mz for each contact LINK (link frame, moment
+  /// about its origin), after the external_effort columns.
+  std::vector<std::string> contacts;
   /// Force plates: plate@NAME.contact, .cop_x, .cop_y, .cop_z for each NAME, last.
   std::vector<std::string> plates;
 };
@@ -211,8 +217,10 @@ struct LoadColumnLayout {
 /// order: t; base.fx ... base.mz (layout.base); for each of `joints` JOINT.fx, .fy, .fz,
 /// .mx, .my, .mz, .effort (and JOINT.effort_per_kg with layout.per_kg); JOINT.effort_stddev
 /// for each of `joints` (layout.effort_stddev); JOINT.q, .qd, .qdd for each of `joints`
-/// (layout.kinematics); JOINT.motor_effort for each of `joints` (layout.motor_effort); the
-/// plates' columns (layout.plates).
+/// (layout.kinematics); JOINT.motor_effort for each of `joints` (layout.motor_effort);
+/// JOINT.external_effort for each of `joints` and contact (layout.external_effort);
+/// external@LINK.fx ... .mz per contact link (layout.contacts); the plates' columns
+/// (layout.plates).
 std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints,
                                           const LoadColumnLayout& layout = {});
 

@@ -8,6 +8,7 @@
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/external_effort.hpp>
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/sample_clock.hpp>
@@ -18,6 +19,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -110,6 +112,17 @@ struct LoadsRecord {
   /// With settings.friction.enabled: effort + damping velocity + friction tanh(velocity /
   /// velocity_scale) (friction.hpp) [N m or N]; empty when off.
   std::vector<double> motor_effort;
+  /// With external_effort/enabled (external_effort.hpp; empty when off): per joint the
+  /// external effort of the configured method, the environment's generalised force on the
+  /// robot [N m or N] (NaN where no effort was measured or the joint does not move), and
+  /// with uncertainty its 1-sigma from external_effort/effort_noise.
+  std::vector<double> external_effort, external_effort_stddev;
+  /// The wrench at each external_effort/contacts link (link frame, about its origin).
+  std::vector<ContactEstimate> contacts;
+  /// Contact detection at this sample: in contact, it started / ended here, and the most
+  /// distal joint over its threshold when it started, with its child link.
+  bool in_contact = false, contact_started = false, contact_ended = false;
+  std::string contact_joint, contact_link;
 };
 
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
@@ -183,6 +196,8 @@ class Pipeline {
   const PipelineCounters& counters() const { return counters_; }
   const Settings& settings() const { return settings_; }
   const Estimator& estimator() const { return estimator_; }
+  /// The external-effort estimator (external_effort/enabled), or null.
+  const ExternalEffort* externalEffort() const { return external_.get(); }
   /// The joint-state stream's sample clock (stamps/regularize).
   const SampleClock& sampleClock() const { return clock_; }
   const Model<double>& model() const { return estimator_.model(); }
@@ -244,12 +259,16 @@ class Pipeline {
   bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord();
+  void setUpExternal();
+  void fillExternal();
   void fillCoordinates(std::size_t i, std::size_t segment);
   const Sample* sampleAt(double t) const;
 
   Settings settings_;
   FrameSource* frames_;
   Estimator estimator_;
+  std::unique_ptr<ExternalEffort> external_;  // external_effort/enabled
+  std::vector<double> external_variance_;     // the model efforts' variances, per joint
   JointStateMap joints_;
   LoadsRecord record_;
   PipelineCounters counters_;

@@ -143,6 +143,7 @@ void validate(const Settings& settings) {
   positive("still_velocity", settings.still_velocity);
   positive("diagnostic_period", settings.diagnostic_period);
   positive("friction/velocity_scale", settings.friction.velocity_scale);
+  validate(settings.external_effort);
   const double m = settings.body_mass;
   if (!((m >= 0.0 && std::isfinite(m)) || m == -1.0))
     fail("body_mass",

@@ -609,6 +609,13 @@ std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints
       for (const char* c : {".q", ".qd", ".qdd"}) names.push_back(joint + c);
   if (layout.motor_effort)
     for (const std::string& joint : joints) names.push_back(joint + ".motor_effort");
+  if (layout.external_effort) {
+    for (const std::string& joint : joints) names.push_back(joint + ".external_effort");
+    names.push_back("contact");
+  }
+  for (const std::string& link : layout.contacts)
+    for (const char* component : kWrenchComponents)
+      names.push_back("external@" + link + "." + component);
   for (const std::string& plate : layout.plates)
     for (const char* column : kPlateOutputs) names.push_back(kPlatePrefix + plate + "." + column);
   return names;

@@ -181,6 +181,42 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
   }
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
+  if (settings_.external_effort.enabled) setUpExternal();
+}
+
+void Pipeline::setUpExternal() {
+  const std::size_t n = record_.segment.size();
+  external_ = std::make_unique<ExternalEffort>(
+      estimator_.model(), settings_.external_effort, record_.segment,
+      settings_.estimator.gravity_world,
+      settings_.friction.enabled ? settings_.friction.velocity_scale : 0.0,
+      settings_.estimator.uncertainty.enabled);
+  record_.external_effort.assign(n, kNaN);
+  if (settings_.estimator.uncertainty.enabled) record_.external_effort_stddev.assign(n, 0.0);
+  record_.contacts = external_->contacts();
+  external_variance_.assign(n, 0.0);
+}
+
+void Pipeline::fillExternal() {
+  const bool uncertainty = settings_.estimator.uncertainty.enabled;
+  if (uncertainty)
+    for (std::size_t i = 0; i < external_variance_.size(); ++i)
+      external_variance_[i] = record_.effort_stddev[i] * record_.effort_stddev[i];
+  BaseState<double> base;
+  if (model().floating_base) {
+    base.R_world_base = estimator_.data().R_world[0];
+    base.p_world_base = estimator_.data().p_world[0];
+  }
+  external_->update(estimator_.stamp(), estimator_.q(), estimator_.qd(), base, record_.effort,
+                    record_.measured_effort, uncertainty ? &external_variance_ : nullptr);
+  record_.external_effort = external_->external();
+  if (uncertainty) record_.external_effort_stddev = external_->stddev();
+  record_.contacts = external_->contacts();
+  record_.in_contact = external_->inContact();
+  record_.contact_started = external_->contactStarted();
+  record_.contact_ended = external_->contactEnded();
+  record_.contact_joint = external_->contactJoint();
+  record_.contact_link = external_->contactLink();
 }
 
 void Pipeline::anchor(Stamp stamp) {
@@ -229,6 +265,7 @@ void Pipeline::resetTimeline(Stamp stamp) {
   jump_from_ = last_stamp_;
   jump_to_ = stamp;
   estimator_.reset();
+  if (external_) external_->reset();
   clock_.reset();
   ring_count_ = 0;
   last_stamp_ = 0;
@@ -498,6 +535,7 @@ void Pipeline::fillRecord() {
           out[r] = C(r, r);
     record_.effort_stddev[i] = std::sqrt(estimator_.effortVariance(segment));
   }
+  if (external_) fillExternal();
 }
 
 void Pipeline::fillCoordinates(std::size_t i, std::size_t segment) {

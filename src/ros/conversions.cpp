@@ -76,6 +76,8 @@ void prepare(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
   msg.velocity.resize(n);
   msg.acceleration.resize(n);
   msg.motor_effort.resize(record.motor_effort.size());
+  msg.external_effort.resize(record.external_effort.size());
+  msg.external_effort_stddev.resize(record.external_effort_stddev.size());
 }
 
 void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
@@ -98,6 +100,8 @@ void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg)
   msg.velocity = record.velocity;
   msg.acceleration = record.acceleration;
   msg.motor_effort = record.motor_effort;
+  msg.external_effort = record.external_effort;
+  msg.external_effort_stddev = record.external_effort_stddev;
 }
 
 void prepare(const LoadsRecord& record, sensor_msgs::JointState& msg) {

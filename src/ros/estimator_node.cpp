@@ -82,6 +82,7 @@ void EstimatorNode::advertise() {
           private_nh_.advertise<geometry_msgs::WrenchStamped>("wrench/" + joint, 10));
   if (pipeline_->model().floating_base)
     residual_pub_ = private_nh_.advertise<geometry_msgs::WrenchStamped>("base_residual", 10);
+  external_outputs_.advertise(private_nh_, record);
   wrench_topics_.resize(settings_.wrenches.size());
   plate_topics_.resize(settings_.force_plates.size());
   for (std::size_t k = 0; k < plate_topics_.size(); ++k)
@@ -224,6 +225,7 @@ void EstimatorNode::publish(const ros::Time& received) {
     residual_pub_.publish(wrench_msg_);
   }
   publishConsistency(stamp);
+  external_outputs_.publish(record);
   const double latency = (ros::Time::now() - received).toSec();
   latency_sum_ += latency;
   latency_max_ = std::max(latency_max_, latency);
@@ -279,6 +281,7 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   else
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "publishing");
   diagnoseLevel(status, published);  // what stops the loads comes first
+  external_outputs_.diagnose(status);
   status.add("mean latency [s]", latency_count_ ? latency_sum_ / latency_count_ : 0.0);
   status.add("max latency [s]", latency_max_);
   status.add("joint states received", received);

@@ -239,6 +239,33 @@ void readFriction(Section& s, FrictionConfig& f) {
   s.read("velocity_scale", f.velocity_scale);
 }
 
+void readContact(Section& s, ContactLinkConfig& c) {
+  s.read("link", c.link);
+  s.read("point", c.point.data(), 3);
+  s.read("force_only", c.force_only);
+}
+
+void readExternalEffort(Section& s, ExternalEffortConfig& e) {
+  s.read("enabled", e.enabled);
+  s.read("method", e.method,
+         {{"observer", ExternalMethod::kObserver}, {"residual", ExternalMethod::kResidual}});
+  s.read<double>({{"observer_cutoff", &e.observer_cutoff},
+                  {"effort_noise", &e.effort_noise},
+                  {"damping", &e.damping},
+                  {"singular_threshold", &e.singular_threshold},
+                  {"threshold", &e.threshold},
+                  {"noise_multiple", &e.noise_multiple},
+                  {"calibration_time", &e.calibration_time},
+                  {"release_fraction", &e.release_fraction}});
+  s.readList("contacts", [&](Section& m) { readContact(m, e.contacts.emplace_back()); });
+  s.readList("joint_thresholds", [&](Section& m) {
+    std::pair<std::string, double>& jt = e.joint_thresholds.emplace_back();
+    m.read("joint", jt.first);
+    m.read("threshold", jt.second);
+    if (jt.first.empty()) throw SettingsError("parameter '" + m.name("joint") + "' is required");
+  });
+}
+
 void readWrench(Section& s, WrenchTopicSettings& w, WrenchInputConfig& input) {
   s.read("topic", w.topic);
   s.read("frame", w.frame);
@@ -336,6 +363,7 @@ Settings parseSettings(const XmlRpcValue& params) {
   s.readMap("stamps", [&](Section& m) { readStamps(m, n.stamps); });
   s.readMap("uncertainty", [&](Section& m) { readUncertainty(m, n.estimator.uncertainty); });
   s.readMap("friction", [&](Section& m) { readFriction(m, n.friction); });
+  s.readMap("external_effort", [&](Section& m) { readExternalEffort(m, n.external_effort); });
   s.readMap("differentiator",
             [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });
   s.readList("wrenches", [&](Section& m) {

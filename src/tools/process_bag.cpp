@@ -3,12 +3,14 @@
 // conversions), in the bag's time order, with the bag's /tf and /tf_static in a tf2
 // buffer for the frames the URDF does not hold (jle::processBag, bag_processing.hpp);
 // this tool parses the options and writes the outputs. docs/demo.md.
+#include <joint_load_estimator/Contact.h>
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/csv.hpp>
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bag_processing.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
+#include <joint_load_estimator/ros/external_outputs.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
 
@@ -56,7 +58,11 @@ bag is played to it, without the timing of a live system.
                        JOINT.effort_stddev for every joint; with --kinematics,
                        then JOINT.q, .qd, .qdd for every joint (what the loads were
                        computed from: the filter's estimate); with friction enabled
-                       in the config, then JOINT.motor_effort for every joint
+                       in the config, then JOINT.motor_effort for every joint;
+                       with external_effort enabled, then JOINT.external_effort for
+                       every joint, contact (0/1) and external@LINK.fx ... .mz per
+                       contact link (the bag gets PREFIX/external_wrench/LINK and
+                       PREFIX/contact, as the node publishes them)
   --kinematics         the JOINT.q, .qd, .qdd columns in the CSV (docs/outputs.md)
   --sto PATH           also (or only) write them as an OpenSim storage file: the
                        same numbers, tab-separated, under OpenSim's column names
@@ -163,6 +169,12 @@ class Outputs : public jle::LoadsSink {
   std::string bag_temporary_, topic_;
   std::unique_ptr<jle::CsvWriter> csv_;
   std::unique_ptr<jle::StoWriter> sto_;
+  // external_effort/enabled: the wrench topics per contact link and the contact events.
+  std::vector<std::string> external_topics_;
+  std::string contact_topic_;
+  geometry_msgs::WrenchStamped wrench_;
+  double* writeExternal(const jle::LoadsRecord& record, double* row);
+  void writeExternalMessages(const jle::LoadsRecord& record);
 };
 
 void Outputs::open(const jle::Pipeline& pipeline) {
@@ -171,7 +183,10 @@ void Outputs::open(const jle::Pipeline& pipeline) {
   jle::prepare(record, loads_);
   sto_columns_ = 1 + 7 * record.joint.size() + record.effort_stddev.size();
   const std::size_t kinematics = options.kinematics ? 3 * record.joint.size() : 0;
-  row_.resize(sto_columns_ + (options.csv.empty() ? 0 : kinematics + record.motor_effort.size()));
+  const std::size_t external =
+      record.external_effort.empty() ? 0 : record.joint.size() + 1 + 6 * record.contacts.size();
+  row_.resize(sto_columns_ +
+              (options.csv.empty() ? 0 : kinematics + record.motor_effort.size() + external));
   if (!options.output.empty()) {
     bag_temporary_ = options.output + ".partial";
     bag_ = std::make_unique<rosbag::Bag>();
@@ -184,6 +199,11 @@ void Outputs::open(const jle::Pipeline& pipeline) {
       throw std::runtime_error(options.output + ": " + e.what());
     }
     topic_ = options.prefix + "/joint_loads";
+    if (!record.external_effort.empty()) {
+      for (const jle::ContactEstimate& c : record.contacts)
+        external_topics_.push_back(options.prefix + "/external_wrench/" + c.link);
+      contact_topic_ = options.prefix + "/contact";
+    }
   }
   const std::vector<std::string> names = jle::jointLoadColumns(record.joint);
   if (!options.csv.empty()) {
@@ -191,6 +211,9 @@ void Outputs::open(const jle::Pipeline& pipeline) {
     layout.effort_stddev = !record.effort_stddev.empty();
     layout.kinematics = options.kinematics;
     layout.motor_effort = !record.motor_effort.empty();
+    layout.external_effort = !record.external_effort.empty();
+    if (layout.external_effort)
+      for (const jle::ContactEstimate& c : record.contacts) layout.contacts.push_back(c.link);
     csv_ = std::make_unique<jle::CsvWriter>(options.csv);
     csv_->writeHeader(jle::jointLoadColumns(record.joint, layout));
   }
@@ -221,8 +244,10 @@ void Outputs::write(const jle::LoadsRecord& record, long seq) {
       *row++ = record.velocity[i];
       *row++ = record.acceleration[i];
     }
-  if (csv_)
+  if (csv_) {
     for (double e : record.motor_effort) *row++ = e;
+    row = writeExternal(record, row);
+  }
   assert(static_cast<std::size_t>(row - row_.data()) == (csv_ ? row_.size() : sto_columns_));
   if (csv_) csv_->writeRow(row_.data(), row_.size());
   if (sto_) sto_->writeRow(row_.data(), sto_columns_);
@@ -230,7 +255,34 @@ void Outputs::write(const jle::LoadsRecord& record, long seq) {
     jle::toMessage(record, loads_);
     loads_.header.seq = static_cast<std::uint32_t>(seq);
     bag_->write(topic_, loads_.header.stamp, loads_);
+    writeExternalMessages(record);
   }
+}
+
+double* Outputs::writeExternal(const jle::LoadsRecord& record, double* row) {
+  if (record.external_effort.empty()) return row;
+  for (double e : record.external_effort) *row++ = e;
+  *row++ = record.in_contact ? 1.0 : 0.0;
+  for (const jle::ContactEstimate& c : record.contacts) {
+    for (int k = 0; k < 3; ++k) *row++ = c.force[k];
+    for (int k = 0; k < 3; ++k) *row++ = c.moment[k];
+  }
+  return row;
+}
+
+// As the node publishes them: ~external_wrench/<link> and the ~contact events.
+void Outputs::writeExternalMessages(const jle::LoadsRecord& record) {
+  for (std::size_t k = 0; k < external_topics_.size(); ++k) {
+    jle::toWrenchMessage(record.contacts[k], record.stamp, wrench_);
+    bag_->write(external_topics_[k], wrench_.header.stamp, wrench_);
+  }
+  if (contact_topic_.empty() || !(record.contact_started || record.contact_ended)) return;
+  joint_load_estimator::Contact contact;
+  contact.header.stamp = jle::toRosTime(record.stamp);
+  contact.in_contact = record.contact_started;
+  contact.joint = record.contact_joint;
+  contact.link = record.contact_link;
+  bag_->write(contact_topic_, contact.header.stamp, contact);
 }
 
 void Outputs::commit() {

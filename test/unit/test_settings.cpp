@@ -134,12 +134,35 @@ void expectSame(const jle::PlateTopicSettings& a, const jle::PlateTopicSettings&
   EXPECT_SAME(pose_configured);
 }
 
+void expectSame(const jle::ContactLinkConfig& a, const jle::ContactLinkConfig& b,
+                const std::string& where) {
+  EXPECT_SAME(link);
+  EXPECT_SAME(point);
+  EXPECT_SAME(force_only);
+}
+
 // Element by element, "wrenches[k]/" named on a failure.
 template <typename T>
 void expectSameList(const std::vector<T>& a, const std::vector<T>& b, const std::string& list) {
   ASSERT_EQ(a.size(), b.size()) << list;
   for (std::size_t k = 0; k < a.size(); ++k)
     expectSame(a[k], b[k], list + "[" + std::to_string(k) + "]/");
+}
+
+void expectSame(const jle::ExternalEffortConfig& a, const jle::ExternalEffortConfig& b) {
+  const std::string where = "external_effort/";
+  EXPECT_SAME(enabled);
+  EXPECT_SAME(method);
+  EXPECT_SAME(observer_cutoff);
+  EXPECT_SAME(effort_noise);
+  EXPECT_SAME(damping);
+  EXPECT_SAME(singular_threshold);
+  EXPECT_SAME(threshold);
+  EXPECT_SAME(noise_multiple);
+  EXPECT_SAME(calibration_time);
+  EXPECT_SAME(joint_thresholds);
+  EXPECT_SAME(release_fraction);
+  expectSameList(a.contacts, b.contacts, "external_effort/contacts");
 }
 
 void expectSame(const jle::EstimatorConfig& a, const jle::EstimatorConfig& b) {
@@ -173,6 +196,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(diagnostic_period);
   EXPECT_SAME(body_mass);
   expectSame(a.estimator, b.estimator);
+  expectSame(a.external_effort, b.external_effort);
   expectSameList(a.wrenches, b.wrenches, "wrenches");
   expectSameList(a.force_plates, b.force_plates, "force_plates");
 }
@@ -196,6 +220,7 @@ const Refused kRefused[] = {
     {"ko_uncertainty.yaml", "'uncertainty/position_noise'", "must be finite and >= 0"},
     {"ko_savings.yaml", "'savings/static_velocity'", "must be finite and >= 0"},
     {"ko_stamps.yaml", "'stamps/jump_confirm'", "must be >= 1"},
+    {"ko_external_effort.yaml", "'external_effort/release_fraction'", "must be in (0, 1]"},
 };
 
 TEST(SettingsReader, EachKoFileIsRefusedWithItsReason) {
@@ -306,6 +331,32 @@ TEST(SettingsReader, UncertaintyKeys) {
   expectSame(parseFile(kConfig + "/ok_uncertainty.yaml"), e);
 }
 
+TEST(SettingsReader, ExternalEffortKeys) {
+  Settings e;
+  jle::ExternalEffortConfig& x = e.external_effort;
+  x.enabled = true;
+  x.method = jle::ExternalMethod::kResidual;
+  x.observer_cutoff = 25.0;
+  x.effort_noise = 0.05;
+  x.damping = 0.02;
+  x.singular_threshold = 0.03;
+  x.threshold = 1.5;
+  x.noise_multiple = 6.0;
+  x.calibration_time = 0.5;
+  x.release_fraction = 0.25;
+  x.joint_thresholds = {{"panda_joint7", 0.4}};
+  jle::ContactLinkConfig c;
+  c.link = "panda_hand_tcp";
+  c.point = Eigen::Vector3d(0.0, 0.0, 0.02);
+  c.force_only = true;
+  x.contacts.push_back(c);
+  c.link = "panda_link5";
+  c.point = Eigen::Vector3d::Zero();
+  c.force_only = false;
+  x.contacts.push_back(c);
+  expectSame(parseFile(kConfig + "/ok_external_effort.yaml"), e);
+}
+
 TEST(SettingsReader, SavingsKeys) {
   Settings e;
   jle::Savings& v = e.estimator.savings;
@@ -368,6 +419,13 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
   expectRefused("wrenches: [{topic: '', link: l}]", "parameter 'wrenches[0]/topic' is required");
   expectRefused("joints: [a, b, a]", "parameter 'joints[2]' is 'a', as is 'joints[0]'");
   expectRefused("keep_fixed_joints: [f, f]", "parameter 'keep_fixed_joints[1]' is 'f'");
+  expectRefused(
+      "external_effort: {method: kalman}",
+      "parameter 'external_effort/method' is 'kalman'; expected one of observer, residual");
+  expectRefused("external_effort: {contacts: [{point: [0, 0, 0]}]}",
+                "parameter 'external_effort/contacts[0]/link' is required");
+  expectRefused("external_effort: {joint_thresholds: [{threshold: 1}]}",
+                "parameter 'external_effort/joint_thresholds[0]/joint' is required");
 }
 
 // ---------------------------------------------------------------------------------------
@@ -383,7 +441,8 @@ TEST(SettingsDocs, DefaultYamlIsSettingsDefaults) {
 // config/default.yaml: top-level keys at the top, a map's keys in that map.
 TEST(SettingsDocs, DefaultYamlListsEveryKey) {
   XmlRpc::XmlRpcValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
-  for (const char* family : {"top_level", "differentiator", "savings", "uncertainty", "stamps"}) {
+  for (const char* family :
+       {"top_level", "differentiator", "savings", "uncertainty", "stamps", "external_effort"}) {
     XmlRpc::XmlRpcValue ok = jle::loadYaml(kConfig + "/ok_" + family + ".yaml");
     for (auto& kv : ok) {
       ASSERT_TRUE(defaults.hasMember(kv.first)) << kv.first << " is not in config/default.yaml";

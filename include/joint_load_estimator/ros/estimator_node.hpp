@@ -8,6 +8,7 @@
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
+#include <joint_load_estimator/ros/external_outputs.hpp>
 #include <joint_load_estimator/ros/input_health.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
@@ -119,6 +120,7 @@ class EstimatorNode {
   std::vector<PlateTopic> plate_topics_;
   ros::Publisher loads_pub_, residual_pub_;
   std::vector<ros::Publisher> wrench_pubs_;
+  ExternalOutputs external_outputs_;  // external_effort/enabled
   joint_load_estimator::JointLoads loads_msg_;
   ros::Publisher efforts_pub_;           // ~joint_efforts (sensor_msgs/JointState)
   sensor_msgs::JointState efforts_msg_;  // the JointLoads' names, q, q-dot, efforts

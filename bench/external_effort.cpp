@@ -1,0 +1,291 @@
+// External efforts and contact wrenches against KDL's ChainExternalWrenchEstimator
+// (Debian's liborocos-kdl-dev), on the same chain and the same states.
+//
+//   bench_external_effort [Google Benchmark flags]   time per sample (docs/external_effort.md)
+//   bench_external_effort --table [--quick]          the error table against a known contact
+//
+// Speed: per sample on the Panda chain (7 joints, a wrench at panda_hand_tcp): our
+// update (forward pass, M by the composite-rigid-body pass, C^T qd and g through the
+// subtree momenta, observer, residual, one damped least-squares solve), the joint-space
+// terms alone, KDL's estimator, and the loads alone (jle::rnea) as the peers.
+//
+// Table: a known wrench at the tool from 1 s to 2 s on a moving Panda (jle_testing::
+// ContactScene), 1 kHz joint states through the Pipeline (the node's default filter) for
+// the residual and the observer; KDL's estimator is fed the same filtered q, qd and the
+// same measured efforts at the same stamps. RMS of the force and moment error over the
+// contact after 0.3 s of settling, per scenario: exact, encoder noise, effort noise,
+// jittered stamps.
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/external_effort.hpp>
+#include <joint_load_estimator/joint_space.hpp>
+#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <jle_testing/contact_scene.hpp>
+
+#include <benchmark/benchmark.h>
+#include <kdl/chain.hpp>
+#include <kdl/chainexternalwrenchestimator.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/tree.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+const Eigen::Vector3d kGravity(0.0, 0.0, -9.80665);
+const char* kTool = "panda_hand_tcp";
+constexpr double kCutoff = 10.0;  // [Hz] observer cut-off, ours and KDL's gain 2 pi f
+
+std::string chainPath() { return std::string(JLE_BENCH_DATA) + "/urdf/chains/panda_chain.urdf"; }
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+KDL::Chain kdlChain() {
+  KDL::Tree tree;
+  KDL::Chain chain;
+  if (!kdl_parser::treeFromString(readFile(chainPath()), tree) ||
+      !tree.getChain("panda_link0", kTool, chain))
+    throw std::runtime_error("KDL cannot read " + chainPath());
+  return chain;
+}
+
+void toKdl(const double* v, int n, KDL::JntArray& a) {
+  for (int i = 0; i < n; ++i) a(static_cast<unsigned>(i)) = v[i];
+}
+
+jle::ExternalEffortConfig externalConfig(jle::ExternalMethod method) {
+  jle::ExternalEffortConfig c;
+  c.enabled = true;
+  c.method = method;
+  c.observer_cutoff = kCutoff;
+  jle::ContactLinkConfig contact;
+  contact.link = kTool;
+  c.contacts.push_back(contact);
+  return c;
+}
+
+// A few hundred states of the scene, with their measured and model efforts.
+struct States {
+  jle::Model<double> model = jle::modelFromUrdfFile(chainPath());
+  std::vector<int> published = jle::publishedSegments(model, {});
+  std::vector<jle::VectorX<double>> q, qd, qdd;
+  std::vector<std::vector<double>> measured, model_effort;
+  States() {
+    jle_testing::ContactScene scene;
+    scene.link = kTool;
+    scene.t_on = 0.0;
+    jle::Data<double> data(model);
+    for (int k = 0; k < 256; ++k) {
+      const double t = k * 1e-3;
+      jle::VectorX<double> a, b, c;
+      scene.state(model, t, a, b, c);
+      q.push_back(a);
+      qd.push_back(b);
+      qdd.push_back(c);
+      std::vector<double> e;
+      scene.efforts(model, data, t, published, kGravity, e);
+      measured.push_back(e);
+      jle::rnea(model, data, a, b, c, kGravity);
+      e.clear();
+      for (int s : published) e.push_back(data.effort[s]);
+      model_effort.push_back(e);
+    }
+  }
+};
+
+const States& states() {
+  static const States s;
+  return s;
+}
+
+void BM_OursExternalEffort(benchmark::State& st) {
+  const States& s = states();
+  jle::ExternalEffort ext(s.model, externalConfig(jle::ExternalMethod::kObserver), s.published,
+                          kGravity, 0.0, false);
+  std::size_t k = 0;
+  double t = 0.0;
+  for (auto _ : st) {
+    ext.update(t, s.q[k], s.qd[k], jle::BaseState<double>(), s.model_effort[k], s.measured[k],
+               nullptr);
+    benchmark::DoNotOptimize(ext.contacts()[0].force);
+    k = (k + 1) % s.q.size();
+    t += 1e-3;
+  }
+}
+BENCHMARK(BM_OursExternalEffort);
+
+void BM_OursJointSpaceTerms(benchmark::State& st) {
+  const States& s = states();
+  jle::Data<double> data(s.model);
+  jle::JointSpace js(s.model);
+  const jle::VectorX<double> zero = jle::VectorX<double>::Zero(s.model.nq);
+  std::size_t k = 0;
+  for (auto _ : st) {
+    jle::forwardKinematics(s.model, data, s.q[k], s.qd[k], zero, kGravity);
+    jle::updateJointSpace(s.model, data, kGravity, js);
+    benchmark::DoNotOptimize(js.coriolis_transpose.data());
+    k = (k + 1) % s.q.size();
+  }
+}
+BENCHMARK(BM_OursJointSpaceTerms);
+
+void BM_KdlExternalWrenchEstimator(benchmark::State& st) {
+  const States& s = states();
+  const KDL::Chain chain = kdlChain();
+  KDL::ChainExternalWrenchEstimator kdl(chain, KDL::Vector(0, 0, kGravity.z()), 1000.0,
+                                        2.0 * M_PI * kCutoff, 0.0);
+  const int n = s.model.nq;
+  KDL::JntArray q(n), qd(n), tau(n);
+  KDL::Wrench w;
+  std::size_t k = 0;
+  for (auto _ : st) {
+    toKdl(s.q[k].data(), n, q);
+    toKdl(s.qd[k].data(), n, qd);
+    toKdl(s.measured[k].data(), n, tau);
+    kdl.JntToExtWrench(q, qd, tau, w);
+    benchmark::DoNotOptimize(w);
+    k = (k + 1) % s.q.size();
+  }
+}
+BENCHMARK(BM_KdlExternalWrenchEstimator);
+
+void BM_LoadsAlone(benchmark::State& st) {
+  const States& s = states();
+  jle::Data<double> data(s.model);
+  std::size_t k = 0;
+  for (auto _ : st) {
+    jle::rnea(s.model, data, s.q[k], s.qd[k], s.qdd[k], kGravity);
+    benchmark::DoNotOptimize(data.effort.data());
+    k = (k + 1) % s.q.size();
+  }
+}
+BENCHMARK(BM_LoadsAlone);
+
+// ---------------------------------------------------------------------------------------
+// The error table.
+
+struct Scenario {
+  const char* name;
+  double position_noise;   // [rad] 1 sigma
+  double effort_noise;     // [N m] 1 sigma
+  double stamp_jitter;     // [s] stamps late by U(0, jitter) (taken at reception)
+  double amplitude = 0.3;  // [rad] of the motion (ContactScene)
+};
+
+struct Errors {
+  double force2 = 0.0, moment2 = 0.0;
+  long n = 0;
+  void add(const Eigen::Vector3d& f, const Eigen::Vector3d& m, const jle_testing::ContactScene& s) {
+    force2 += (f - s.force_link).squaredNorm();
+    moment2 += (m - s.moment_link).squaredNorm();
+    ++n;
+  }
+  double force() const { return n ? std::sqrt(force2 / n) : NAN; }
+  double moment() const { return n ? std::sqrt(moment2 / n) : NAN; }
+};
+
+// One run of the scenario through the Pipeline with `method`; KDL fed alongside.
+void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration, Errors& ours,
+                 Errors& kdl_errors) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(chainPath());
+  jle::Settings settings;
+  settings.external_effort = externalConfig(method);
+  jle::Pipeline pipeline(model, settings, nullptr);
+  const KDL::Chain chain = kdlChain();
+  KDL::ChainExternalWrenchEstimator kdl(chain, KDL::Vector(0, 0, kGravity.z()), 1000.0,
+                                        2.0 * M_PI * kCutoff, 0.0);
+  const int n = model.nq;
+  KDL::JntArray kq(n), kqd(n), ktau(n);
+  KDL::Wrench kw;
+  bool kdl_started = false;
+  jle_testing::ContactScene scene;
+  scene.link = kTool;
+  scene.t_off = std::min(scene.t_off, duration);
+  scene.amplitude = sc.amplitude;
+  jle::Data<double> data(model);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> late(0.0, 1.0);
+  std::vector<double> effort, position, none;
+  const jle::Stamp t0 = 1000000000000LL;
+  for (int k = 0; k < static_cast<int>(duration * 1000.0); ++k) {
+    const double t = k * 1e-3;
+    jle::VectorX<double> q, qd, qdd;
+    scene.state(model, t, q, qd, qdd);
+    scene.efforts(model, data, t, pipeline.record().segment, kGravity, effort);
+    position.assign(q.data(), q.data() + n);
+    for (double& p : position) p += sc.position_noise * gauss(rng);
+    for (double& e : effort) e += sc.effort_noise * gauss(rng);
+    const double stamp_t = t + sc.stamp_jitter * late(rng);
+    const jle::Stamp stamp = t0 + static_cast<jle::Stamp>(std::llround(stamp_t * 1e9));
+    if (pipeline.onJointState(stamp, stamp, model.coordinate_names, position, none, effort) !=
+        jle::Outcome::kPublished)
+      continue;
+    const jle::LoadsRecord& r = pipeline.record();
+    toKdl(r.position.data(), n, kq);
+    toKdl(r.velocity.data(), n, kqd);
+    toKdl(r.measured_effort.data(), n, ktau);
+    if (!kdl_started) kdl.setInitialMomentum(kq, kqd);
+    kdl_started = true;
+    kdl.JntToExtWrench(kq, kqd, ktau, kw);
+    // The record describes the sample whose (jittered) stamp it carries: its true time is
+    // the nearest millisecond at or below.
+    const double tr = std::floor(static_cast<double>(r.stamp - t0) * 1e-6 + 1e-6) * 1e-3;
+    if (!(tr >= scene.t_on + 0.3 && scene.active(tr))) continue;
+    ours.add(r.contacts[0].force, r.contacts[0].moment, scene);
+    kdl_errors.add(Eigen::Vector3d(kw.force.x(), kw.force.y(), kw.force.z()),
+                   Eigen::Vector3d(kw.torque.x(), kw.torque.y(), kw.torque.z()), scene);
+  }
+}
+
+int table(bool quick) {
+  const Scenario scenarios[] = {{"exact", 0.0, 0.0, 0.0},
+                                {"encoder noise 1e-4 rad", 1e-4, 0.0, 0.0},
+                                {"effort noise 0.1 N m", 0.0, 0.1, 0.0},
+                                {"jittered stamps 0.3 ms", 0.0, 0.0, 3e-4},
+                                {"exact, slow motion (0.03 rad)", 0.0, 0.0, 0.0, 0.03}};
+  const double duration = quick ? 1.5 : 2.2;
+  std::printf(
+      "| scenario | residual F [N] | residual M [N m] | observer F [N] | observer M [N m] "
+      "| KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|\n");
+  for (const Scenario& sc : scenarios) {
+    Errors residual, observer, kdl, kdl_again;
+    runScenario(sc, jle::ExternalMethod::kResidual, duration, residual, kdl);
+    runScenario(sc, jle::ExternalMethod::kObserver, duration, observer, kdl_again);
+    std::printf("| %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", sc.name, residual.force(),
+                residual.moment(), observer.force(), observer.moment(), kdl.force(), kdl.moment());
+    if (!(residual.n > 0 && observer.n > 0)) return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool want_table = false, quick = false;
+  for (int i = 1; i < argc; ++i) {
+    want_table = want_table || std::strcmp(argv[i], "--table") == 0;
+    quick = quick || std::strcmp(argv[i], "--quick") == 0;
+  }
+  if (want_table) return table(quick);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  return 0;
+}

@@ -1,0 +1,355 @@
+#include <joint_load_estimator/external_effort.hpp>
+#include <joint_load_estimator/friction.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace jle {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kPi = 3.14159265358979323846;
+
+[[noreturn]] void fail(const std::string& key, const std::string& what) {
+  throw SettingsError("parameter '" + key + "' " + what);
+}
+
+std::string number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+void positive(const std::string& key, double v) {
+  if (!(v > 0.0) || !std::isfinite(v)) fail(key, "must be finite and > 0, it is " + number(v));
+}
+
+void nonNegative(const std::string& key, double v) {
+  if (!(v >= 0.0) || !std::isfinite(v)) fail(key, "must be finite and >= 0, it is " + number(v));
+}
+
+std::string contactKey(std::size_t k, const char* key) {
+  return "external_effort/contacts[" + std::to_string(k) + "]/" + key;
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
+  Eigen::Matrix3d m;
+  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return m;
+}
+
+}  // namespace
+
+void validate(const ExternalEffortConfig& c) {
+  positive("external_effort/observer_cutoff", c.observer_cutoff);
+  nonNegative("external_effort/effort_noise", c.effort_noise);
+  nonNegative("external_effort/damping", c.damping);
+  positive("external_effort/singular_threshold", c.singular_threshold);
+  nonNegative("external_effort/threshold", c.threshold);
+  nonNegative("external_effort/noise_multiple", c.noise_multiple);
+  positive("external_effort/calibration_time", c.calibration_time);
+  if (!(c.release_fraction > 0.0 && c.release_fraction <= 1.0))
+    fail("external_effort/release_fraction",
+         "must be in (0, 1], it is " + number(c.release_fraction));
+  for (std::size_t k = 0; k < c.contacts.size(); ++k) {
+    if (c.contacts[k].link.empty()) fail(contactKey(k, "link"), "is required");
+    if (!c.contacts[k].point.allFinite()) fail(contactKey(k, "point"), "must be finite");
+  }
+  for (const auto& jt : c.joint_thresholds)
+    nonNegative("external_effort/joint_thresholds/" + jt.first, jt.second);
+}
+
+ExternalEffort::ExternalEffort(const Model<double>& model, const ExternalEffortConfig& config,
+                               const std::vector<int>& published,
+                               const Eigen::Vector3d& gravity_world, double friction_velocity_scale,
+                               bool uncertainty)
+    : model_(model),
+      config_(config),
+      published_(published),
+      gravity_(gravity_world),
+      velocity_scale_(friction_velocity_scale),
+      uncertainty_(uncertainty),
+      gain_(2.0 * kPi * config.observer_cutoff),
+      data_(model_),
+      js_(model_) {
+  validate(config_);
+  const std::size_t n = published_.size();
+  row_.assign(n, -1);
+  for (std::size_t i = 0; i < n; ++i) row_[i] = js_.index[published_[i]];
+  residual_.assign(n, kNaN);
+  observer_.assign(n, kNaN);
+  stddev_.assign(uncertainty_ ? n : 0, 0.0);
+  residual_var_.assign(n, 0.0);
+  const int nj = js_.size();
+  p_prev_ = Eigen::VectorXd::Zero(nj);
+  beta_prev_ = Eigen::VectorXd::Zero(nj);
+  r_ = Eigen::VectorXd::Zero(nj);
+  row_started_.assign(static_cast<std::size_t>(nj), 0);
+  tau_js_ = Eigen::VectorXd::Zero(nj);
+  var_js_ = Eigen::VectorXd::Zero(nj);
+  J_ = Eigen::MatrixXd::Zero(6, nj);
+  zero_ = VectorX<double>::Zero(model_.nq);
+  setUpContacts();
+  setUpThresholds();
+}
+
+void ExternalEffort::setUpContacts() {
+  std::vector<char> is_published(static_cast<std::size_t>(model_.nsegments()), 0);
+  for (int s : published_) is_published[s] = 1;
+  for (std::size_t k = 0; k < config_.contacts.size(); ++k) {
+    const ContactLinkConfig& c = config_.contacts[k];
+    int f = 0;
+    try {
+      f = model_.frameIndex(c.link);
+    } catch (const std::invalid_argument& e) {
+      fail(contactKey(k, "link"), std::string("names ") + e.what());
+    }
+    const Frame<double>& fr = model_.frames[f];
+    Contact setup;
+    setup.segment = fr.segment;
+    setup.R_segment_link = fr.R_segment_frame;
+    setup.p_segment_link = fr.p_segment_frame;
+    setup.point_segment = fr.p_segment_frame + fr.R_segment_frame * c.point;
+    setup.rows = c.force_only ? 3 : 6;
+    int joints = 0;
+    int s = js_.index[fr.segment] >= 0 ? fr.segment : js_.moving_parent[fr.segment];
+    for (; s >= 0; s = js_.moving_parent[s], ++joints)
+      if (!is_published[s])
+        fail(contactKey(k, "link"), "'" + c.link + "' needs the external effort of joint '" +
+                                        model_.joint_name[s] +
+                                        "', which is not published (joints)");
+    if (joints < setup.rows)
+      fail(contactKey(k, "link"), "'" + c.link + "' has " + std::to_string(joints) +
+                                      " moving joints above it; a " +
+                                      (c.force_only ? "force" : "wrench") + " needs " +
+                                      std::to_string(setup.rows) + " (force_only: 3)");
+    contact_setup_.push_back(setup);
+    ContactEstimate e;
+    e.link = c.link;
+    contacts_.push_back(e);
+  }
+  A_ = Eigen::MatrixXd::Zero(6, js_.size());
+}
+
+void ExternalEffort::setUpThresholds() {
+  const std::size_t n = published_.size();
+  abs_threshold_.assign(n, config_.threshold);
+  threshold_.assign(n, 0.0);
+  sum_sq_.assign(n, 0.0);
+  depth_.assign(n, 0);
+  for (const auto& jt : config_.joint_thresholds) {
+    bool found = false;
+    for (std::size_t i = 0; i < n; ++i)
+      if (model_.joint_name[published_[i]] == jt.first) {
+        abs_threshold_[i] = jt.second;
+        found = true;
+      }
+    if (!found)
+      fail("external_effort/joint_thresholds/" + jt.first, "names no published moving joint");
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (int s = published_[i]; s > 0; s = model_.parent[s]) ++depth_[i];
+  if (config_.noise_multiple == 0.0) {
+    calibrated_ = true;
+    threshold_ = abs_threshold_;
+  }
+}
+
+void ExternalEffort::reset() {
+  std::fill(row_started_.begin(), row_started_.end(), 0);
+  r_.setZero();
+  started_observer_ = false;
+  have_start_ = false;
+  if (config_.noise_multiple > 0.0) {
+    calibrated_ = false;
+    calib_count_ = 0;
+    std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
+  }
+  in_contact_ = started_ = ended_ = false;
+}
+
+void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<double>& qd,
+                            const BaseState<double>& base, const std::vector<double>& model_effort,
+                            const std::vector<double>& measured,
+                            const std::vector<double>* model_variance) {
+  BaseState<double> still;  // the joint-space equations hold for a base at rest
+  still.R_world_base = base.R_world_base;
+  still.p_world_base = base.p_world_base;
+  forwardKinematics(model_, data_, q, qd, zero_, gravity_, still);
+  updateJointSpace(model_, data_, gravity_, js_);
+  updateResidual(model_effort, measured, model_variance);
+  updateObserver(t, measured);
+  const std::vector<double>& ext = external();
+  tau_js_.setZero();
+  var_js_.setZero();
+  for (std::size_t i = 0; i < published_.size(); ++i) {
+    const int j = row_[i];
+    if (j < 0 || !std::isfinite(ext[i])) continue;
+    tau_js_[j] = ext[i];
+    var_js_[j] = config_.method == ExternalMethod::kObserver
+                     ? observer_var_factor_ * config_.effort_noise * config_.effort_noise
+                     : residual_var_[i];
+  }
+  if (uncertainty_)
+    for (std::size_t i = 0; i < published_.size(); ++i)
+      stddev_[i] = row_[i] >= 0 ? std::sqrt(var_js_[row_[i]]) : 0.0;
+  for (std::size_t k = 0; k < contacts_.size(); ++k) solveContact(k);
+  detect(t);
+}
+
+void ExternalEffort::updateResidual(const std::vector<double>& model_effort,
+                                    const std::vector<double>& measured,
+                                    const std::vector<double>* model_variance) {
+  const double noise2 = config_.effort_noise * config_.effort_noise;
+  for (std::size_t i = 0; i < published_.size(); ++i) {
+    const int s = published_[i];
+    if (row_[i] < 0 || !std::isfinite(measured[i])) {
+      residual_[i] = kNaN;
+      continue;
+    }
+    double predicted = model_effort[i];
+    if (velocity_scale_ > 0.0)
+      predicted +=
+          frictionEffort(model_.damping[s], model_.friction[s], data_.qd[s], velocity_scale_);
+    residual_[i] = predicted - measured[i];
+    residual_var_[i] = noise2 + (model_variance ? (*model_variance)[i] : 0.0);
+  }
+}
+
+void ExternalEffort::updateObserver(double t, const std::vector<double>& measured) {
+  const double dt = started_observer_ ? t - t_prev_ : 0.0;
+  const bool step = started_observer_ && dt > 0.0;
+  if (started_observer_ && !(dt > 0.0)) std::fill(row_started_.begin(), row_started_.end(), 0);
+  const double a = step ? gain_ * dt / (1.0 + gain_ * dt) : 0.0;
+  observer_var_factor_ = a / 2.0;  // trapezoid-averaged white noise through the lag
+  for (std::size_t i = 0; i < published_.size(); ++i) {
+    const int j = row_[i];
+    if (j < 0) continue;
+    const int s = published_[i];
+    if (!std::isfinite(measured[i])) {
+      row_started_[j] = 0;
+      observer_[i] = kNaN;
+      continue;
+    }
+    double beta = measured[i] + js_.coriolis_transpose[j] - js_.gravity[j];
+    if (velocity_scale_ > 0.0)
+      beta -= frictionEffort(model_.damping[s], model_.friction[s], data_.qd[s], velocity_scale_);
+    const double p = js_.momentum[j];
+    if (row_started_[j] && step) {
+      const double drive = p - p_prev_[j] - 0.5 * dt * (beta + beta_prev_[j]);
+      r_[j] = (r_[j] + gain_ * drive) / (1.0 + gain_ * dt);
+    } else {
+      r_[j] = 0.0;  // starts from "no contact": the lag settles in a few 1 / K
+      row_started_[j] = 1;
+    }
+    p_prev_[j] = p;
+    beta_prev_[j] = beta;
+    observer_[i] = r_[j];
+  }
+  t_prev_ = t;
+  started_observer_ = true;
+}
+
+namespace {
+
+// Damped least squares of J^T F = tau_ext for the first R rows of J (rows: point
+// velocity, angular velocity) through the R x R normal matrix G = J J^T = V S^2 V^T:
+// F = V diag(1 / (s^2 + lambda^2)) V^T J tau, lambda^2 = damping^2 (1 - (s_min /
+// threshold)^2) below the singular threshold, 0 above (Maciejewski & Klein 1988). An
+// R x R eigen-decomposition (R = 3 or 6) instead of the SVD of the R x n J: no allocation,
+// and the squared condition number costs ~1e-12 relative here (s_min / s_max > 1e-2).
+template <int R>
+void dampedSolve(const Eigen::MatrixXd& J, const Eigen::VectorXd& tau,
+                 const ExternalEffortConfig& config, Eigen::MatrixXd& P, Vector6d& F,
+                 ContactEstimate& e) {
+  using MatrixR = Eigen::Matrix<double, R, R>;
+  const MatrixR G = J.topRows<R>() * J.topRows<R>().transpose();
+  const Eigen::SelfAdjointEigenSolver<MatrixR> eig(G);
+  const Eigen::Matrix<double, R, 1> s2 = eig.eigenvalues().cwiseMax(0.0);  // ascending
+  const double s_min = std::sqrt(s2[0]);
+  const double ratio = s_min / config.singular_threshold;
+  const double lambda2 =
+      ratio < 1.0 ? config.damping * config.damping * (1.0 - ratio * ratio) : 0.0;
+  e.sigma_min = s_min;
+  e.conditioning = s2[R - 1] > 0.0 ? s_min / std::sqrt(s2[R - 1]) : 0.0;
+  e.damping = std::sqrt(lambda2);
+  Eigen::Matrix<double, R, 1> inverse;
+  for (int r = 0; r < R; ++r) inverse[r] = s2[r] + lambda2 > 0.0 ? 1.0 / (s2[r] + lambda2) : 0.0;
+  const MatrixR Ginv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  P.topRows<R>().noalias() = Ginv * J.topRows<R>();  // tau -> F (world, moment about the point)
+  F.setZero();
+  F.head<R>().noalias() = P.topRows<R>() * tau;
+}
+
+}  // namespace
+
+void ExternalEffort::solveContact(std::size_t k) {
+  const Contact& c = contact_setup_[k];
+  ContactEstimate& e = contacts_[k];
+  pointJacobian(model_, data_, js_, c.segment, c.point_segment, J_);
+  Vector6d F;
+  if (c.rows == 3)
+    dampedSolve<3>(J_, tau_js_, config_, A_, F, e);
+  else
+    dampedSolve<6>(J_, tau_js_, config_, A_, F, e);
+  // To the link frame, moment about the link origin: T (6 x 6) acting on (f; m_point).
+  const Eigen::Matrix3d R_world_link = data_.R_world[c.segment] * c.R_segment_link;
+  const Eigen::Vector3d lever =
+      R_world_link.transpose() * data_.R_world[c.segment] * (c.point_segment - c.p_segment_link);
+  Matrix6d T = Matrix6d::Zero();
+  T.topLeftCorner<3, 3>() = R_world_link.transpose();
+  T.bottomRightCorner<3, 3>() = R_world_link.transpose();
+  T.bottomLeftCorner<3, 3>() = skew(lever) * R_world_link.transpose();
+  const Vector6d W = T * F;
+  e.force = W.head<3>();
+  e.moment = W.tail<3>();
+  if (uncertainty_) {
+    const Eigen::MatrixXd P = T.leftCols(c.rows) * A_.topRows(c.rows);
+    e.covariance.noalias() = P * var_js_.asDiagonal() * P.transpose();
+  }
+}
+
+void ExternalEffort::detect(double t) {
+  started_ = ended_ = false;
+  const std::vector<double>& ext = external();
+  const std::size_t n = published_.size();
+  if (!calibrated_) {
+    if (!have_start_) {
+      have_start_ = true;
+      t_start_ = t;
+    }
+    ++calib_count_;
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::isfinite(ext[i])) sum_sq_[i] += ext[i] * ext[i];
+    if (t - t_start_ < config_.calibration_time) return;
+    for (std::size_t i = 0; i < n; ++i)
+      threshold_[i] = std::max(abs_threshold_[i],
+                               config_.noise_multiple * std::sqrt(sum_sq_[i] / calib_count_));
+    calibrated_ = true;
+    return;
+  }
+  int over = -1;  // the most distal joint over its threshold
+  bool above_release = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(threshold_[i] > 0.0) || !std::isfinite(ext[i])) continue;
+    const double m = std::abs(ext[i]);
+    if (m > threshold_[i] && (over < 0 || depth_[i] > depth_[static_cast<std::size_t>(over)]))
+      over = static_cast<int>(i);
+    if (m >= config_.release_fraction * threshold_[i]) above_release = true;
+  }
+  if (!in_contact_ && over >= 0) {
+    in_contact_ = started_ = true;
+    contact_joint_ = model_.joint_name[published_[static_cast<std::size_t>(over)]];
+    contact_link_ = model_.link_name[published_[static_cast<std::size_t>(over)]];
+  } else if (in_contact_ && !above_release) {
+    in_contact_ = false;
+    ended_ = true;
+  }
+}
+
+}  // namespace jle

@@ -1,0 +1,483 @@
+// External efforts and contact wrenches (external_effort.hpp, joint_space.hpp) against
+// independent references:
+//  - M(q), g(q) and M qd against KDL's ChainDynParam (another implementation, Debian's
+//    liborocos-kdl-dev) on the Panda chain; C(q, qd)^T qd against the central difference
+//    of the kinetic energy T = qd^T M_KDL(q) qd / 2 in q (Lagrange: C^T qd = dT/dq);
+//  - contact wrenches against simulated contacts with exact truth: the "measured" efforts
+//    are this package's inverse dynamics with the wrench applied (addExternalWrench), the
+//    model efforts the same without it; the estimate must return the applied wrench;
+//  - the observer against the residual passed through the observer's own first-order lag.
+#include <joint_load_estimator/data.hpp>
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/external_effort.hpp>
+#include <joint_load_estimator/joint_space.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <jle_testing/contact_scene.hpp>
+
+#include <gtest/gtest.h>
+#include <kdl/chain.hpp>
+#include <kdl/chaindynparam.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/jntspaceinertiamatrix.hpp>
+#include <kdl/tree.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Eigen::Vector3d;
+using jle::VectorX;
+
+const Vector3d kGravity(0.0, 0.0, -9.80665);
+
+std::string urdfPath(const std::string& relative) {
+  return std::string(JLE_TEST_DATA) + "/urdf/" + relative;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+VectorX<double> randomVector(std::mt19937& rng, int n, double scale) {
+  std::uniform_real_distribution<double> u(-scale, scale);
+  VectorX<double> v(n);
+  for (int i = 0; i < n; ++i) v[i] = u(rng);
+  return v;
+}
+
+KDL::JntArray toKdl(const VectorX<double>& v) {
+  KDL::JntArray a(static_cast<unsigned>(v.size()));
+  for (int i = 0; i < v.size(); ++i) a(static_cast<unsigned>(i)) = v[i];
+  return a;
+}
+
+// ---------------------------------------------------------------------------------------
+// The joint-space terms against KDL.
+
+class PandaChainVsKdl : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    model_ = jle::modelFromUrdfFile(urdfPath("chains/panda_chain.urdf"));
+    KDL::Tree tree;
+    ASSERT_TRUE(kdl_parser::treeFromString(readFile(urdfPath("chains/panda_chain.urdf")), tree));
+    ASSERT_TRUE(tree.getChain("panda_link0", "panda_hand_tcp", chain_));
+    ASSERT_EQ(static_cast<int>(chain_.getNrOfJoints()), model_.nq);
+  }
+  Eigen::MatrixXd kdlMass(const VectorX<double>& q) {
+    KDL::ChainDynParam dyn(chain_, KDL::Vector(0, 0, kGravity.z()));
+    KDL::JntSpaceInertiaMatrix M(chain_.getNrOfJoints());
+    EXPECT_GE(dyn.JntToMass(toKdl(q), M), 0);
+    return M.data;
+  }
+  jle::Model<double> model_;
+  KDL::Chain chain_;
+};
+
+// The panda chain's joints are its moving segments in URDF order, as KDL numbers them.
+TEST_F(PandaChainVsKdl, InertiaGravityMomentumAndCoriolisTranspose) {
+  std::mt19937 rng(7);
+  jle::Data<double> data(model_);
+  jle::JointSpace js(model_);
+  ASSERT_EQ(js.size(), model_.nq);
+  KDL::ChainDynParam dyn(chain_, KDL::Vector(0, 0, kGravity.z()));
+  for (int trial = 0; trial < 20; ++trial) {
+    const VectorX<double> q = randomVector(rng, model_.nq, 2.5);
+    const VectorX<double> qd = randomVector(rng, model_.nq, 2.0);
+    const VectorX<double> zero = VectorX<double>::Zero(model_.nq);
+    jle::forwardKinematics(model_, data, q, qd, zero, kGravity);
+    jle::updateJointSpace(model_, data, kGravity, js);
+    const Eigen::MatrixXd M_kdl = kdlMass(q);
+    KDL::JntArray g_kdl(chain_.getNrOfJoints());
+    ASSERT_GE(dyn.JntToGravity(toKdl(q), g_kdl), 0);
+    // Both sides sum ~10^2 products of O(1) numbers: ~1e-15 apart; 1e-12 catches any
+    // wrong term (a missed lever arm changes M by >1e-3).
+    EXPECT_LE((js.M - M_kdl).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
+    EXPECT_LE((js.gravity - g_kdl.data).cwiseAbs().maxCoeff(), 1e-11) << "trial " << trial;
+    EXPECT_LE((js.momentum - M_kdl * qd).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
+    // dT/dq by a central difference of KDL's M: truncation h^2 T''' ~ 1e-10 with h = 1e-5,
+    // rounding eps T / h ~ 1e-11; 1e-8 N m is far below any real Coriolis term (O(1)).
+    const double h = 1e-5;
+    for (int k = 0; k < model_.nq; ++k) {
+      VectorX<double> qp = q, qm = q;
+      qp[k] += h;
+      qm[k] -= h;
+      const double Tp = 0.5 * qd.dot(kdlMass(qp) * qd);
+      const double Tm = 0.5 * qd.dot(kdlMass(qm) * qd);
+      EXPECT_NEAR(js.coriolis_transpose[k], (Tp - Tm) / (2.0 * h), 1e-8)
+          << "trial " << trial << " joint " << k;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Exact contacts.
+
+struct Scene {
+  jle::Model<double> model;
+  std::vector<int> published;
+  VectorX<double> q, qd, qdd;
+};
+
+Scene makeScene(const std::string& urdf, unsigned seed) {
+  Scene s;
+  s.model = jle::modelFromUrdfFile(urdfPath(urdf));
+  s.published = jle::publishedSegments(s.model, {});
+  std::mt19937 rng(seed);
+  s.q = randomVector(rng, s.model.nq, 1.2);
+  s.qd = randomVector(rng, s.model.nq, 1.0);
+  s.qdd = randomVector(rng, s.model.nq, 3.0);
+  return s;
+}
+
+// Per published joint: the effort of inverse dynamics with the wrench (force at
+// point_link, moment) applied TO link `link` (link frame), and without it.
+void simulate(const Scene& s, const std::string& link, const Vector3d& point_link,
+              const Vector3d& force_link, const Vector3d& moment_link,
+              std::vector<double>& model_effort, std::vector<double>& measured) {
+  jle::Data<double> data(s.model);
+  jle::forwardKinematics(s.model, data, s.q, s.qd, s.qdd, kGravity);
+  jle::inverseDynamics(s.model, data);
+  model_effort.clear();
+  for (int seg : s.published) model_effort.push_back(data.effort[seg]);
+  jle::forwardKinematics(s.model, data, s.q, s.qd, s.qdd, kGravity);
+  const Vector3d moment_origin = moment_link + point_link.cross(force_link);
+  jle::addExternalWrench(s.model, data, s.model.frameIndex(link), force_link, moment_origin,
+                         jle::WrenchFrame::kLocal);
+  jle::inverseDynamics(s.model, data);
+  measured.clear();
+  for (int seg : s.published) measured.push_back(data.effort[seg]);
+}
+
+jle::ExternalEffortConfig contactConfig(const std::string& link, const Vector3d& point,
+                                        bool force_only) {
+  jle::ExternalEffortConfig c;
+  c.enabled = true;
+  c.method = jle::ExternalMethod::kResidual;
+  jle::ContactLinkConfig contact;
+  contact.link = link;
+  contact.point = point;
+  contact.force_only = force_only;
+  c.contacts.push_back(contact);
+  return c;
+}
+
+// The wrench the estimate returns, with the truth's moment about the link origin.
+void expectRecovered(const std::string& urdf, const std::string& link, const Vector3d& point,
+                     const Vector3d& force, const Vector3d& moment, bool force_only) {
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const Scene s = makeScene(urdf, seed);
+    std::vector<double> model_effort, measured;
+    simulate(s, link, point, force, moment, model_effort, measured);
+    jle::ExternalEffort ext(s.model, contactConfig(link, point, force_only), s.published, kGravity,
+                            0.0, false);
+    ext.update(0.0, s.q, s.qd, jle::BaseState<double>(), model_effort, measured, nullptr);
+    const jle::ContactEstimate& e = ext.contacts()[0];
+    // The efforts are O(10..100) N m, exact to ~1e-13; the Jacobian's smallest singular
+    // value is > 0.02 m at these states (above singular_threshold: no damping), so the
+    // wrench is exact to ~1e-11.
+    ASSERT_GT(e.sigma_min, 0.02) << urdf << " seed " << seed;
+    EXPECT_EQ(e.damping, 0.0);
+    EXPECT_GT(e.conditioning, 0.0);
+    EXPECT_LE((e.force - force).norm(), 1e-9) << urdf << " " << link << " seed " << seed;
+    EXPECT_LE((e.moment - (moment + point.cross(force))).norm(), 1e-9)
+        << urdf << " " << link << " seed " << seed;
+  }
+}
+
+TEST(ExactContact, PushOnPandaLink5) {
+  // Five joints above panda_link5: a point force (3 unknowns) is determined.
+  expectRecovered("panda.urdf", "panda_link5", Vector3d(0.02, 0.06, -0.12), Vector3d(12, -7, 20),
+                  Vector3d::Zero(), true);
+}
+
+TEST(ExactContact, WrenchAtPandaTool) {
+  expectRecovered("panda.urdf", "panda_hand_tcp", Vector3d(0.0, 0.0, 0.01), Vector3d(-5, 9, 15),
+                  Vector3d(0.3, -0.8, 0.5), false);
+}
+
+TEST(ExactContact, WrenchAtTalosHand) {
+  // A tree: the left hand's wrench through torso and arm (9 joints); the other branches'
+  // joints see nothing and do not enter the solve.
+  expectRecovered("talos_reduced.urdf", "gripper_left_base_link", Vector3d(0.0, 0.02, -0.05),
+                  Vector3d(20, -10, -30), Vector3d(1.0, 2.0, -0.5), false);
+}
+
+TEST(ExactContact, TooFewJointsIsRefusedNamingTheLink) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(urdfPath("panda.urdf"));
+  try {
+    jle::ExternalEffort ext(model, contactConfig("panda_link3", Vector3d::Zero(), false),
+                            jle::publishedSegments(model, {}), kGravity, 0.0, false);
+    FAIL() << "a wrench at panda_link3 (3 joints) was accepted";
+  } catch (const jle::SettingsError& e) {
+    EXPECT_NE(std::string(e.what()).find("panda_link3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("external_effort/contacts[0]/link"), std::string::npos);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// The momentum observer against the residual.
+
+// At rest under a constant push the observer's fixed point is tau_ext itself: after
+// 40 time constants (K = 2 pi 10 Hz, 0.64 s) the lag's memory of its zero start is
+// e^-40 ~ 4e-18 of it; what is left is rounding of p differences (~1e-13 N m).
+TEST(Observer, AtRestConvergesToTheResidual) {
+  Scene s = makeScene("panda.urdf", 3);
+  s.qd.setZero();
+  s.qdd.setZero();
+  std::vector<double> model_effort, measured;
+  const Vector3d f(4, -6, 9), m(0.2, 0.3, -0.1);
+  simulate(s, "panda_hand_tcp", Vector3d::Zero(), f, m, model_effort, measured);
+  jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
+  c.method = jle::ExternalMethod::kObserver;
+  jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, false);
+  for (int k = 0; k <= 640; ++k)
+    ext.update(k * 1e-3, s.q, s.qd, jle::BaseState<double>(), model_effort, measured, nullptr);
+  for (std::size_t i = 0; i < s.published.size(); ++i)
+    EXPECT_NEAR(ext.observer()[i], ext.residual()[i], 1e-9) << s.model.joint_name[s.published[i]];
+  EXPECT_LE((ext.contacts()[0].force - f).norm(), 1e-8);
+  EXPECT_LE((ext.contacts()[0].moment - m).norm(), 1e-8);
+}
+
+// Moving, with a constant wrench at the tool: the observer is the residual through the
+// lag r' = K (tau_ext - r). The reference runs that lag (the same implicit Euler, the
+// step's mean of tau_ext as the trapezoid gives it) on the exact residual; the observer
+// gets there through p = M qd, C^T qd and g instead of the inverse dynamics: they differ
+// by the trapezoid's O(dt^2) error on beta, measured 1e-5..1e-4 of tau_ext here (a lag
+// that took tau_ext at the step's end instead would differ by dt/2 tau_ext-dot: 3e-3).
+TEST(Observer, MovingFollowsTheLaggedResidual) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(urdfPath("chains/panda_chain.urdf"));
+  const std::vector<int> published = jle::publishedSegments(model, {});
+  jle_testing::ContactScene scene;
+  scene.link = "panda_hand_tcp";
+  scene.t_on = 0.0;
+  scene.t_off = 10.0;
+  jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
+  c.method = jle::ExternalMethod::kObserver;
+  jle::ExternalEffort ext(model, c, published, kGravity, 0.0, false);
+  jle::Data<double> data(model);
+  const double dt = 1e-3, K = 2.0 * M_PI * c.observer_cutoff;
+  std::vector<double> lagged(published.size(), 0.0), previous(published.size(), 0.0);
+  std::vector<double> measured, model_effort;
+  double worst = 0.0, scale = 0.0;
+  for (int k = 0; k <= 2000; ++k) {
+    const double t = k * dt;
+    VectorX<double> q, qd, qdd;
+    scene.state(model, t, q, qd, qdd);
+    scene.efforts(model, data, t, published, kGravity, measured);
+    jle::rnea(model, data, q, qd, qdd, kGravity);
+    model_effort.clear();
+    for (int seg : published) model_effort.push_back(data.effort[seg]);
+    ext.update(t, q, qd, jle::BaseState<double>(), model_effort, measured, nullptr);
+    for (std::size_t i = 0; i < published.size(); ++i) {
+      const double mean = 0.5 * (ext.residual()[i] + previous[i]);  // over the step
+      lagged[i] = k == 0 ? 0.0 : (lagged[i] + K * dt * mean) / (1.0 + K * dt);
+      previous[i] = ext.residual()[i];
+      if (t < 0.5) continue;  // both start from zero; compare once settled alike
+      worst = std::max(worst, std::abs(ext.observer()[i] - lagged[i]));
+      scale = std::max(scale, std::abs(ext.residual()[i]));
+    }
+  }
+  std::printf("observer - lagged residual: worst %.3g N m of max |tau_ext| %.3g N m\n", worst,
+              scale);
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LE(worst, 1e-4 * scale);
+}
+
+// ---------------------------------------------------------------------------------------
+// Through the Pipeline: free motion with noise, then a contact.
+
+struct PipelineRun {
+  std::vector<double> rms;  // per joint, of tau_ext over the free samples after calibration
+  long free_samples = 0, false_contact_samples = 0, contacts_started = 0;
+  std::string first_joint, first_link;
+  double force_error = 0.0;  // RMS |F - F_true| over the contact window after 0.3 s [N]
+};
+
+PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double position_noise,
+                        bool contact) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(urdfPath("chains/panda_chain.urdf"));
+  jle::Settings settings;
+  jle::ExternalEffortConfig& x = settings.external_effort;
+  x.enabled = true;
+  x.method = method;
+  x.noise_multiple = 6.0;
+  x.calibration_time = 0.5;
+  jle::ContactLinkConfig c;
+  c.link = "panda_hand_tcp";
+  x.contacts.push_back(c);
+  jle::Pipeline pipeline(model, settings, nullptr);
+  jle_testing::ContactScene scene;
+  scene.link = "panda_hand_tcp";
+  if (!contact) scene.t_on = scene.t_off = 100.0;
+  const std::vector<int>& published = pipeline.record().segment;
+  jle::Data<double> data(model);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  PipelineRun run;
+  run.rms.assign(published.size(), 0.0);
+  std::vector<double> effort, position, none;
+  double err2 = 0.0;
+  long err_n = 0;
+  const long kMs = 1000000;
+  for (int k = 0; k < 3000; ++k) {
+    const double t = k * 1e-3;
+    VectorX<double> q, qd, qdd;
+    scene.state(model, t, q, qd, qdd);
+    scene.efforts(model, data, t, published, kGravity, effort);
+    position.assign(q.data(), q.data() + q.size());
+    for (double& p : position) p += position_noise * noise(rng);
+    for (double& e : effort) e += effort_noise * noise(rng);
+    const jle::Stamp stamp = 1000 * kMs + k * kMs;
+    if (pipeline.onJointState(stamp, stamp, model.coordinate_names, position, none, effort) !=
+        jle::Outcome::kPublished)
+      continue;
+    const jle::LoadsRecord& r = pipeline.record();
+    const double tr = static_cast<double>(r.stamp - 1000 * kMs) * 1e-9;
+    if (r.contact_started) {
+      ++run.contacts_started;
+      if (run.first_joint.empty()) {
+        run.first_joint = r.contact_joint;
+        run.first_link = r.contact_link;
+      }
+    }
+    if (!scene.active(tr) && tr > 0.6 && (tr < scene.t_on || tr > scene.t_off + 0.5)) {
+      ++run.free_samples;
+      if (r.in_contact) ++run.false_contact_samples;
+      for (std::size_t i = 0; i < published.size(); ++i)
+        run.rms[i] += r.external_effort[i] * r.external_effort[i];
+    }
+    if (scene.active(tr) && tr > scene.t_on + 0.3) {
+      err2 += (r.contacts[0].force - scene.force_link).squaredNorm();
+      ++err_n;
+    }
+  }
+  for (double& v : run.rms) v = std::sqrt(v / std::max(1L, run.free_samples));
+  run.force_error = err_n ? std::sqrt(err2 / err_n) : 0.0;
+  return run;
+}
+
+// Free motion, effort noise 0.05 N m, encoder noise 1e-5 rad: the RMS of tau_ext per joint
+// and the fraction of samples flagged in contact with thresholds of 6 sigma of the
+// calibration window. The residual carries the filtered q-ddot's error besides the effort
+// noise; the observer low-passes both. No sample may be flagged: a Gaussian exceeds 6
+// sigma with probability 2e-9 per joint and sample, and the window's RMS includes the
+// motion's model error.
+TEST(FreeMotion, NoiseAndFalseContacts) {
+  for (jle::ExternalMethod method :
+       {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
+    const PipelineRun run = runPipeline(method, 0.05, 1e-5, false);
+    const char* name = method == jle::ExternalMethod::kResidual ? "residual" : "observer";
+    std::printf("%s: free samples %ld, false-contact samples %ld, RMS tau_ext [N m]:", name,
+                run.free_samples, run.false_contact_samples);
+    for (double v : run.rms) std::printf(" %.3g", v);
+    std::printf("\n");
+    EXPECT_GT(run.free_samples, 2000);
+    EXPECT_EQ(run.false_contact_samples, 0) << name;
+    EXPECT_EQ(run.contacts_started, 0) << name;
+    for (double v : run.rms) EXPECT_LT(v, 1.0) << name;
+  }
+}
+
+// A wrench at the tool from 1 s to 2 s (|F| 11.9 N, |M| 0.37 N m): detected once, on the
+// last joint, its force estimated to within half its size under this noise (measured
+// RMS error 3.7 N residual, 2.2 N observer: the force comes from efforts of 0.05 N m
+// noise through lever arms of ~0.1 m; a wrong sign or frame errs by ~24 N).
+TEST(FreeMotion, ContactIsDetectedAtTheToolAndItsWrenchEstimated) {
+  for (jle::ExternalMethod method :
+       {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
+    const PipelineRun run = runPipeline(method, 0.05, 1e-5, true);
+    const char* name = method == jle::ExternalMethod::kResidual ? "residual" : "observer";
+    std::printf("%s: contacts started %ld at %s (%s), RMS force error %.3g N\n", name,
+                run.contacts_started, run.first_joint.c_str(), run.first_link.c_str(),
+                run.force_error);
+    EXPECT_EQ(run.contacts_started, 1) << name;
+    EXPECT_EQ(run.first_joint, "panda_joint7") << name;
+    EXPECT_LT(run.force_error, 0.5 * jle_testing::ContactScene().force_link.norm()) << name;
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// The stated covariance against Monte Carlo.
+
+// Residual: the wrench covariance P diag(sigma^2) P^T against the spread of 4000 solves
+// with Gaussian effort noise (sigma 0.1 N m). The sample variances scatter by
+// sqrt(2 / 4000) = 2.2 %; 10 % is 4.5 of those.
+TEST(Covariance, ResidualWrenchMatchesMonteCarlo) {
+  const Scene s = makeScene("panda.urdf", 4);
+  std::vector<double> model_effort, measured;
+  simulate(s, "panda_hand_tcp", Vector3d::Zero(), Vector3d(3, 4, 5), Vector3d(0.1, 0.2, 0.3),
+           model_effort, measured);
+  jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
+  c.effort_noise = 0.1;
+  jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, true);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, c.effort_noise);
+  const int kDraws = 4000;
+  jle::Matrix6d sum2 = jle::Matrix6d::Zero();
+  jle::Vector6d sum = jle::Vector6d::Zero();
+  std::vector<double> noisy;
+  for (int d = 0; d < kDraws; ++d) {
+    noisy = measured;
+    for (double& e : noisy) e += noise(rng);
+    ext.update(0.0, s.q, s.qd, jle::BaseState<double>(), model_effort, noisy, nullptr);
+    jle::Vector6d w;
+    w << ext.contacts()[0].force, ext.contacts()[0].moment;
+    sum += w;
+    sum2 += w * w.transpose();
+  }
+  const jle::Vector6d mean = sum / kDraws;
+  const jle::Matrix6d empirical = sum2 / kDraws - mean * mean.transpose();
+  const jle::Matrix6d& stated = ext.contacts()[0].covariance;
+  for (int r = 0; r < 6; ++r)
+    EXPECT_NEAR(empirical(r, r), stated(r, r), 0.1 * stated(r, r)) << "component " << r;
+  for (std::size_t i = 0; i < 7; ++i) EXPECT_DOUBLE_EQ(ext.stddev()[i], c.effort_noise);
+}
+
+// Observer at rest: the stated 1-sigma sqrt(a / 2) sigma, a = K dt / (1 + K dt), against
+// the spread of r over 20000 steps of white effort noise (after 1 s of settling). The
+// samples are correlated over ~1 / a = 17 steps: ~1200 independent ones, 4 % scatter;
+// 12 % is 3 of those.
+TEST(Covariance, ObserverStddevMatchesMonteCarlo) {
+  Scene s = makeScene("panda.urdf", 5);
+  s.qd.setZero();
+  s.qdd.setZero();
+  std::vector<double> model_effort, measured;
+  simulate(s, "panda_hand_tcp", Vector3d::Zero(), Vector3d::Zero(), Vector3d::Zero(), model_effort,
+           measured);
+  jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
+  c.method = jle::ExternalMethod::kObserver;
+  c.effort_noise = 0.1;
+  jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, true);
+  std::mt19937 rng(8);
+  std::normal_distribution<double> noise(0.0, c.effort_noise);
+  std::vector<double> noisy, sum2(7, 0.0);
+  long n = 0;
+  for (int k = 0; k < 21000; ++k) {
+    noisy = measured;
+    for (double& e : noisy) e += noise(rng);
+    ext.update(k * 1e-3, s.q, s.qd, jle::BaseState<double>(), model_effort, noisy, nullptr);
+    if (k < 1000) continue;
+    for (std::size_t i = 0; i < 7; ++i) sum2[i] += ext.observer()[i] * ext.observer()[i];
+    ++n;
+  }
+  for (std::size_t i = 0; i < 7; ++i)
+    EXPECT_NEAR(std::sqrt(sum2[i] / n), ext.stddev()[i], 0.12 * ext.stddev()[i]) << "joint " << i;
+}
+
+}  // namespace
