@@ -12,6 +12,7 @@
 // serialisation), and in a process of its own (`nodelet standalone`) beside the
 // joint_load_estimator node (roscpp's TCP transport, tcpNoDelay). The code is the same.
 #include <joint_load_estimator/JointLoads.h>
+#include <joint_load_estimator/ros/inline_callback_queue.hpp>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/WrenchStamped.h>
@@ -68,24 +69,38 @@ struct Run {
   long received = 0;
   long node_lost = 0;
   std::vector<double> latency;        // [s] publication -> the receiver's callback
-  std::vector<double> receiver_wait;  // [s] the loads' receipt -> the receiver's callback
+  std::vector<double> delivered;      // [s] publication -> the loads in the receiver's queue
   std::vector<double> node_wait;      // [s] per diagnostics period: the node's mean queue wait
   std::vector<double> node_callback;  // [s] per period: the node's mean callback to publish
 };
 
 class LatencyBench {
  public:
+  using LoadsEvent = ros::MessageEvent<const joint_load_estimator::JointLoads>;
+
   LatencyBench(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
     pnh.param("seconds", seconds_, seconds_);
     pnh.param("path", path_, path_);
+    bool inline_receiver = false;
+    pnh.param("inline_receiver", inline_receiver, inline_receiver);
     std::vector<double> r;
     if (pnh.getParam("rates", r)) rates_ = r;
     for (int i = 1; i <= 7; ++i) names_.push_back("panda_joint" + std::to_string(i));
     js_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 1000);
     w1_ = nh_.advertise<geometry_msgs::WrenchStamped>("ft_sensor/wrench", 1000);
     w2_ = nh_.advertise<geometry_msgs::WrenchStamped>("handle/wrench", 1000);
-    loads_ = nh_.subscribe("joint_load_estimator/joint_loads", 10000, &LatencyBench::onLoads, this,
-                           ros::TransportHints().tcpNoDelay());
+    // The receiver: on the callback queue of the node handle (the process's spinner, a
+    // nodelet's worker threads) or, with ~inline_receiver, in the delivering thread.
+    ros::SubscribeOptions options;
+    options.initByFullCallbackType<const LoadsEvent&>(
+        "joint_load_estimator/joint_loads", 10000,
+        [this](const LoadsEvent& event) { onLoads(event); });
+    options.transport_hints = ros::TransportHints().tcpNoDelay();
+    if (inline_receiver) {
+      options.callback_queue = &inline_queue_;
+      options.allow_concurrent_callbacks = true;  // onLoads locks mutex_
+    }
+    loads_ = nh_.subscribe(options);
     diagnostics_ = nh_.subscribe("/diagnostics", 100, &LatencyBench::onDiagnostics, this);
   }
 
@@ -94,21 +109,21 @@ class LatencyBench {
     if (!waitForNode(stop)) return false;
     std::printf(
         "| path | input rate [Hz] | sent | loads received | lost | lost, counted by the node | "
-        "latency median [us] | p99 [us] | max [us] | node: queue wait, mean [us] | node: "
-        "callback to published, mean [us] | receiver: queue wait median [us] | p99 [us] |\n");
+        "latency median [us] | p99 [us] | max [us] | delivered median [us] | p99 [us] | node: "
+        "queue wait, mean [us] | node: callback to published, mean [us] |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (double rate : rates_) {
       if (stop) return true;
       Run result = runRate(rate, stop);
       const auto us = [](double s) { return 1e6 * s; };
       std::printf(
-          "| %s | %.0f | %ld | %ld | %ld | %ld | %.0f | %.0f | %.0f | %.1f | %.1f | %.0f | %.0f "
+          "| %s | %.0f | %ld | %ld | %ld | %ld | %.0f | %.0f | %.0f | %.0f | %.0f | %.1f | %.1f "
           "|\n",
           path_.c_str(), rate, result.sent, result.received, result.sent - result.received,
           result.node_lost, us(percentile(result.latency, 0.5)),
           us(percentile(result.latency, 0.99)), us(percentile(result.latency, 1.0)),
-          us(mean(result.node_wait)), us(mean(result.node_callback)),
-          us(percentile(result.receiver_wait, 0.5)), us(percentile(result.receiver_wait, 0.99)));
+          us(percentile(result.delivered, 0.5)), us(percentile(result.delivered, 0.99)),
+          us(mean(result.node_wait)), us(mean(result.node_callback)));
       std::fflush(stdout);
     }
     return true;
@@ -192,7 +207,7 @@ class LatencyBench {
     js_.publish(sensor_msgs::JointStateConstPtr(state));
   }
 
-  void onLoads(const ros::MessageEvent<const joint_load_estimator::JointLoads>& event) {
+  void onLoads(const LoadsEvent& event) {
     const double now = ros::WallTime::now().toSec();
     const double receipt = event.getReceiptTime().toSec();  // entered our subscription queue
     std::lock_guard<std::mutex> lock(mutex_);
@@ -200,7 +215,7 @@ class LatencyBench {
     auto it = sent_at_.find(event.getConstMessage()->header.stamp.toNSec());
     if (it == sent_at_.end()) return;
     run_->latency.push_back(now - it->second);
-    run_->receiver_wait.push_back(now - receipt);
+    run_->delivered.push_back(receipt - it->second);
     ++run_->received;
     sent_at_.erase(it);
   }
@@ -230,6 +245,7 @@ class LatencyBench {
   std::vector<double> rates_ = {1000, 5000, 10000};
   std::vector<std::string> names_;
   ros::Publisher js_, w1_, w2_;
+  jle::InlineCallbackQueue inline_queue_;
   ros::Subscriber loads_, diagnostics_;
   std::uint32_t seq_ = 0;
   double t_sim_ = 0.0;

@@ -7,7 +7,8 @@
 #            messages are passed as shared pointers, never serialised);
 #   tcp:     the joint_load_estimator node and the bench in a process of its own
 #            (`nodelet standalone`; roscpp's TCP transport, tcpNoDelay);
-# each with the estimator's inline_callbacks false (the default) and true ("inline").
+# the nodelet path also with the estimator's inline_callbacks true ("inline"), and with
+# the bench's receiver inline too (~inline_receiver).
 # Usage: bench/node_latency.sh [seconds per rate] [repeats]
 # (JLE_BENCH_RATES="[1000, 5000, 10000]" the rates; JLE_BENCH_PORT the master's port.)
 set -euo pipefail
@@ -33,7 +34,9 @@ rosparam set -t "$repo/test/data/urdf/chains/panda_chain.urdf" robot_description
 rosparam load "$repo/bench/node_latency.yaml" /joint_load_estimator
 rosparam set /node_latency_bench/seconds "$seconds"
 rosparam set /node_latency_bench/rates "${JLE_BENCH_RATES:-[1000, 5000, 10000]}"
-bench=(rosrun nodelet nodelet)
+# The nodelet executable (Debian's path, else through rosrun).
+nodelet=(/usr/lib/nodelet/nodelet)
+[ -x "${nodelet[0]}" ] || nodelet=(rosrun nodelet nodelet)
 status=0
 
 # Runs "$@" (the process that holds the bench) until the bench asks it to stop.
@@ -44,6 +47,9 @@ run_bench() {
     'BEGIN { n = gsub(/,/, ",", r) + 1; print int(60 + n * (s + 3)) }')
   timeout "$bench_timeout" "$@" >"$out" 2>&1 || { echo "the bench failed (log: $out)" >&2; status=1; }
   grep -E '^\|' "$out" || { echo "no figures (log: $out)" >&2; status=1; }
+  # Every rate must have had its loads (column 5: loads received).
+  awk -F'|' '/^\| [a-z]/ && $3 ~ /[0-9]/ && $5 + 0 == 0 { bad = 1 } END { exit bad }' "$out" ||
+    { echo "a rate without loads (log: $out)" >&2; status=1; }
 }
 
 stop_all() {
@@ -52,40 +58,42 @@ stop_all() {
   pids=()
 }
 
-# One configuration: $1 inline_callbacks (false, true), $2 run number.
+# One configuration: $1 the path's name, $2 the estimator's inline_callbacks, $3 the
+# bench receiver's (~inline_receiver), $4 the run's number.
+configure() {
+  echo "run $4, $1; $(uptime)"
+  rosparam set /joint_load_estimator/inline_callbacks "$2"
+  rosparam set /node_latency_bench/inline_receiver "$3"
+  rosparam set /node_latency_bench/path "$1"
+}
+
 nodelet_path() {
-  local label="nodelet" ; [ "$1" = false ] || label="nodelet, inline"
-  echo "run $2, $label; $(uptime)"
-  rosparam set /joint_load_estimator/inline_callbacks "$1"
-  rosparam set /node_latency_bench/path "$label"
-  "${bench[@]}" load joint_load_estimator/EstimatorNodelet jle_latency_manager \
-    __name:=joint_load_estimator >"$log/load_estimator_$1_$2.log" 2>&1 &
+  configure "$@"
+  "${nodelet[@]}" load joint_load_estimator/EstimatorNodelet jle_latency_manager \
+    __name:=joint_load_estimator >"$log/load_estimator_$4.log" 2>&1 &
   pids+=($!)
-  "${bench[@]}" load joint_load_estimator/LatencyBenchNodelet jle_latency_manager \
-    __name:=node_latency_bench >"$log/load_bench_$1_$2.log" 2>&1 &
+  "${nodelet[@]}" load joint_load_estimator/LatencyBenchNodelet jle_latency_manager \
+    __name:=node_latency_bench >"$log/load_bench_$4.log" 2>&1 &
   pids+=($!)
   # The loaders wait for the manager; the bench nodelet shuts the manager down when done.
-  run_bench "$log/nodelet_$1_$2.out" "${bench[@]}" manager __name:=jle_latency_manager
+  run_bench "$log/$4_$1.out" "${nodelet[@]}" manager __name:=jle_latency_manager
   stop_all
 }
 
 tcp_path() {
-  local label="tcp" ; [ "$1" = false ] || label="tcp, inline"
-  echo "run $2, $label; $(uptime)"
-  rosparam set /joint_load_estimator/inline_callbacks "$1"
-  rosparam set /node_latency_bench/path "$label"
-  "$ws/devel/lib/joint_load_estimator/joint_load_estimator" >"$log/node_$1_$2.log" 2>&1 &
+  configure "$@"
+  "$ws/devel/lib/joint_load_estimator/joint_load_estimator" >"$log/node_$4.log" 2>&1 &
   pids+=($!)
-  run_bench "$log/tcp_$1_$2.out" "${bench[@]}" standalone joint_load_estimator/LatencyBenchNodelet \
+  run_bench "$log/$4_$1.out" "${nodelet[@]}" standalone joint_load_estimator/LatencyBenchNodelet \
     __name:=node_latency_bench
   stop_all
 }
 
 for r in $(seq "$repeats"); do
-  for inline in false true; do
-    nodelet_path "$inline" "$r"
-    tcp_path "$inline" "$r"
-  done
+  nodelet_path nodelet false false "$r"
+  nodelet_path "nodelet, inline" true false "$r"
+  nodelet_path "nodelet, inline, inline receiver" true true "$r"
+  tcp_path tcp false false "$r"
 done
 echo "logs: $log; after the run: $(uptime)"
 exit $status

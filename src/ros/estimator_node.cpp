@@ -163,6 +163,18 @@ void EstimatorNode::report(Outcome outcome) {
 
 void EstimatorNode::onJointState(const JointStateEvent& event) {
   std::lock_guard<std::mutex> lock(callbacks_mutex_);
+  if (settings_.inline_callbacks && event.getPublisherName() != ros::this_node::getName()) {
+    // From another process: this runs in roscpp's network thread, inside the
+    // subscription's lock; publishing the loads from here could deadlock with an
+    // in-process publisher (which holds roscpp's publication lock while it delivers).
+    ++exceptions_;
+    ROS_ERROR_THROTTLE(kThrottle,
+                       "joint_states from '%s' (another process): with inline_callbacks only "
+                       "publishers in the same nodelet manager are taken (dropped; set "
+                       "inline_callbacks: false)",
+                       event.getPublisherName().c_str());
+    return;
+  }
   const ros::Time received = ros::Time::now();
   const double queue_wait = (received - event.getReceiptTime()).toSec();
   queue_wait_sum_ += queue_wait;
@@ -263,7 +275,10 @@ void EstimatorNode::publishPlates(const ros::Time& stamp) {
 }
 
 void EstimatorNode::onDiagnosticsTimer(const ros::WallTimerEvent&) {
-  std::lock_guard<std::mutex> lock(callbacks_mutex_);
+  // The status functions take callbacks_mutex_; the publication comes after they
+  // return: roscpp publishes under its own lock, which an in-process publisher holds
+  // while it delivers a message inline (inline_callbacks), so holding ours across a
+  // publication would invert the order of the two locks.
   try {
     updater_.force_update();
   } catch (const std::exception& e) {
@@ -273,6 +288,7 @@ void EstimatorNode::onDiagnosticsTimer(const ros::WallTimerEvent&) {
 }
 
 void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
   const PipelineCounters& c = pipeline_->counters();
   const long received = c.received(InputKind::kJointState);
   const long published = c.count(Outcome::kPublished);
