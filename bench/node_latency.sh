@@ -32,8 +32,7 @@ trap cleanup EXIT
 for _ in $(seq 100); do rosparam list >/dev/null 2>&1 && break; sleep 0.1; done
 rosparam set -t "$repo/test/data/urdf/chains/panda_chain.urdf" robot_description
 rosparam load "$repo/bench/node_latency.yaml" /joint_load_estimator
-rosparam set /node_latency_bench/seconds "$seconds"
-rosparam set /node_latency_bench/rates "${JLE_BENCH_RATES:-[1000, 5000, 10000]}"
+rates=${JLE_BENCH_RATES:-[1000, 5000, 10000]}
 # The nodelet executable (Debian's path, else through rosrun).
 nodelet=(/usr/lib/nodelet/nodelet)
 [ -x "${nodelet[0]}" ] || nodelet=(rosrun nodelet nodelet)
@@ -43,7 +42,7 @@ status=0
 run_bench() {
   local out=$1 bench_timeout
   shift
-  bench_timeout=$(awk -v s="$seconds" -v r="${JLE_BENCH_RATES:-[1000, 5000, 10000]}" \
+  bench_timeout=$(awk -v s="$seconds" -v r="$rates" \
     'BEGIN { n = gsub(/,/, ",", r) + 1; print int(60 + n * (s + 3)) }')
   timeout "$bench_timeout" "$@" >"$out" 2>&1 || { echo "the bench failed (log: $out)" >&2; status=1; }
   grep -E '^\|' "$out" || { echo "no figures (log: $out)" >&2; status=1; }
@@ -62,9 +61,9 @@ stop_all() {
 # bench receiver's (~inline_receiver), $4 the run's number.
 configure() {
   echo "run $4, $1; $(uptime)"
-  rosparam set /joint_load_estimator/inline_callbacks "$2"
-  rosparam set /node_latency_bench/inline_receiver "$3"
-  rosparam set /node_latency_bench/path "$1"
+  printf 'joint_load_estimator: {inline_callbacks: %s}\nnode_latency_bench: {inline_receiver: %s, path: "%s", seconds: %s, rates: %s}\n' \
+    "$2" "$3" "$1" "$seconds" "$rates" >"$log/params.yaml"
+  rosparam load "$log/params.yaml"  # one process: each costs a second on a loaded machine
 }
 
 nodelet_path() {
