@@ -1,22 +1,98 @@
 #!/usr/bin/env bash
-# End-to-end latency of the node on loopback (docs/node_latency.md): starts a private
-# master, the node on the Panda chain with two wrench inputs, and the publisher/
-# receiver bench at increasing rates. Usage: bench/node_latency.sh [seconds per rate]
+# End-to-end latency of the estimator on one machine (docs/node_latency.md), through
+# both paths in one run: a private master, the Panda chain with two wrench inputs
+# (bench/node_latency.yaml), and the bench's driver side (bench/node_latency.cpp,
+# joint_load_estimator/LatencyBenchNodelet) at each rate:
+#   nodelet: the estimator nodelet and the bench nodelet in one nodelet manager (the
+#            messages are passed as shared pointers, never serialised);
+#   tcp:     the joint_load_estimator node and the bench in a process of its own
+#            (`nodelet standalone`; roscpp's TCP transport, tcpNoDelay);
+# the nodelet path also with the estimator's inline_callbacks true ("inline"), and with
+# the bench's receiver inline too (~inline_receiver).
+# Usage: bench/node_latency.sh [seconds per rate] [repeats]
+# (JLE_BENCH_RATES="[1000, 5000, 10000]" the rates; JLE_BENCH_PORT the master's port.)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 seconds=${1:-2.0}
+repeats=${2:-1}
 export PATH=/usr/bin:$PATH
 set +u; source "$ws/devel/setup.bash"; set -u
 export ROS_MASTER_URI=http://127.0.0.1:${JLE_BENCH_PORT:-11517}
 export ROS_HOSTNAME=127.0.0.1
-roscore -p "${ROS_MASTER_URI##*:}" >/tmp/jle_bench_roscore.log 2>&1 &
+log=$(mktemp -d /tmp/jle_node_latency.XXXXXX)
+roscore -p "${ROS_MASTER_URI##*:}" >"$log/roscore.log" 2>&1 &
 core=$!
-trap 'kill $node $core 2>/dev/null || true; wait 2>/dev/null || true' EXIT
-node=
+pids=()
+cleanup() {
+  for p in "${pids[@]}" $core; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+}
+trap cleanup EXIT
 for _ in $(seq 100); do rosparam list >/dev/null 2>&1 && break; sleep 0.1; done
 rosparam set -t "$repo/test/data/urdf/chains/panda_chain.urdf" robot_description
 rosparam load "$repo/bench/node_latency.yaml" /joint_load_estimator
-"$ws/devel/lib/joint_load_estimator/joint_load_estimator" >/tmp/jle_bench_node.log 2>&1 &
-node=$!
-"$ws/devel/lib/joint_load_estimator/bench_node_latency" _seconds:="$seconds" ${JLE_BENCH_RATES:+_rates:="$JLE_BENCH_RATES"}
+rates=${JLE_BENCH_RATES:-[1000, 5000, 10000]}
+# The nodelet executable (Debian's path, else through rosrun).
+nodelet=(/usr/lib/nodelet/nodelet)
+[ -x "${nodelet[0]}" ] || nodelet=(rosrun nodelet nodelet)
+status=0
+
+# Runs "$@" (the process that holds the bench) until the bench asks it to stop.
+run_bench() {
+  local out=$1 bench_timeout
+  shift
+  bench_timeout=$(awk -v s="$seconds" -v r="$rates" \
+    'BEGIN { n = gsub(/,/, ",", r) + 1; print int(60 + n * (s + 3)) }')
+  timeout "$bench_timeout" "$@" >"$out" 2>&1 || { echo "the bench failed (log: $out)" >&2; status=1; }
+  grep -E '^\|' "$out" || { echo "no figures (log: $out)" >&2; status=1; }
+  # Every rate must have had its loads (column 5: loads received).
+  awk -F'|' '/^\| [a-z]/ && $3 ~ /[0-9]/ && $5 + 0 == 0 { bad = 1 } END { exit bad }' "$out" ||
+    { echo "a rate without loads (log: $out)" >&2; status=1; }
+}
+
+stop_all() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  pids=()
+}
+
+# One configuration: $1 the path's name, $2 the estimator's inline_callbacks, $3 the
+# bench receiver's (~inline_receiver), $4 the run's number.
+configure() {
+  echo "run $4, $1; $(uptime)"
+  printf 'joint_load_estimator: {inline_callbacks: %s}\nnode_latency_bench: {inline_receiver: %s, path: "%s", seconds: %s, rates: %s}\n' \
+    "$2" "$3" "$1" "$seconds" "$rates" >"$log/params.yaml"
+  rosparam load "$log/params.yaml"  # one process: each costs a second on a loaded machine
+}
+
+nodelet_path() {
+  configure "$@"
+  "${nodelet[@]}" load joint_load_estimator/EstimatorNodelet jle_latency_manager \
+    __name:=joint_load_estimator >"$log/load_estimator_$4.log" 2>&1 &
+  pids+=($!)
+  "${nodelet[@]}" load joint_load_estimator/LatencyBenchNodelet jle_latency_manager \
+    __name:=node_latency_bench >"$log/load_bench_$4.log" 2>&1 &
+  pids+=($!)
+  # The loaders wait for the manager; the bench nodelet shuts the manager down when done.
+  run_bench "$log/$4_$1.out" "${nodelet[@]}" manager __name:=jle_latency_manager
+  stop_all
+}
+
+tcp_path() {
+  configure "$@"
+  "$ws/devel/lib/joint_load_estimator/joint_load_estimator" >"$log/node_$4.log" 2>&1 &
+  pids+=($!)
+  run_bench "$log/$4_$1.out" "${nodelet[@]}" standalone joint_load_estimator/LatencyBenchNodelet \
+    __name:=node_latency_bench
+  stop_all
+}
+
+for r in $(seq "$repeats"); do
+  nodelet_path nodelet false false "$r"
+  nodelet_path "nodelet, inline" true false "$r"
+  nodelet_path "nodelet, inline, inline receiver" true true "$r"
+  tcp_path tcp false false "$r"
+done
+echo "logs: $log; after the run: $(uptime)"
+exit $status

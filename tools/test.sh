@@ -39,6 +39,13 @@ bash "$repo/tools/accuracy.sh" --quick >"$ws/accuracy_quick.log" 2>&1 ||
   { tail -20 "$ws/accuracy_quick.log"; echo "accuracy --quick failed"; bench_status=1; }
 bash "$repo/tools/stability.sh" --quick >"$ws/stability_quick.log" 2>&1 ||
   { tail -20 "$ws/stability_quick.log"; echo "stability --quick failed"; bench_status=1; }
+# The node's latency bench (every path, one rate, 0.3 s) and the offline throughput
+# bench with its parallel-equals-serial check, on tiny inputs (about 70 s together on
+# the loaded 2-core machine, mostly process start-up).
+JLE_BENCH_RATES="[1000]" bash "$repo/bench/node_latency.sh" 0.3 >"$ws/node_latency_quick.log" 2>&1 ||
+  { tail -20 "$ws/node_latency_quick.log"; echo "node_latency.sh failed"; bench_status=1; }
+bash "$repo/bench/offline_throughput.sh" --quick >"$ws/offline_throughput_quick.log" 2>&1 ||
+  { tail -20 "$ws/offline_throughput_quick.log"; echo "offline_throughput.sh failed"; bench_status=1; }
 # Robustness: the soaks (1e6 samples with bad messages mixed in, in process and
 # through the real node over ROS), the fuzzers
 # (regressions first, then 30 s each), the unit tests under ASan + UBSan (a second

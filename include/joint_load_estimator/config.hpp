@@ -303,6 +303,13 @@ struct Settings {
   /// [s] > 0: period of the node's diagnostics timer (/diagnostics), a wall-clock timer:
   /// its rate holds through sim-time jumps and while no input arrives.
   double diagnostic_period = 1.0;
+  /// For the nodelet beside a driver in the same manager: the input callbacks (joint
+  /// states, wrenches, plates) run at once in the thread that delivers the message (the
+  /// driver's publishing thread) instead of being queued for the manager's worker
+  /// threads: one thread hand-over less per sample, at the price of the estimate running
+  /// in the publisher's thread. Joint states from another process (TCP) are then
+  /// dropped with an error (README "Latency: nodelet or TCP").
+  bool inline_callbacks = false;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;
   FrictionConfig friction;

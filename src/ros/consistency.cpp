@@ -115,6 +115,7 @@ void EstimatorNode::collectBiasSample() {
 }
 
 void EstimatorNode::diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
   std::string warnings;
   auto warn = [&](const std::string& w) { warnings += (warnings.empty() ? "" : "; ") + w; };
   char text[256];

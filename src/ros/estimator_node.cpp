@@ -12,6 +12,9 @@ namespace {
 constexpr double kThrottle = 2.0;  // [s] between repeats of one kind of message
 // [s] without a joint state: the loads have stopped (an ERROR in the diagnostics).
 constexpr double kSilence = 1.0;
+// ~joint_loads messages kept for reuse; beyond them, a message still held by a
+// subscriber (in a queue of the same process or of TCP) is replaced by a new one.
+constexpr std::size_t kLoadsPool = 8;
 
 }  // namespace
 
@@ -90,9 +93,21 @@ void EstimatorNode::advertise() {
         "cop/" + settings_.estimator.plates[k].plate.name, 10);
 }
 
+template <class Event>
+ros::Subscriber EstimatorNode::subscribeInput(const std::string& topic,
+                                              const boost::function<void(const Event&)>& callback) {
+  ros::SubscribeOptions options;
+  options.initByFullCallbackType<const Event&>(topic, 100, callback);
+  options.transport_hints = ros::TransportHints().tcpNoDelay();
+  if (settings_.inline_callbacks) {
+    options.callback_queue = &inline_queue_;
+    options.allow_concurrent_callbacks = true;  // serialised by callbacks_mutex_ instead
+  }
+  return nh_.subscribe(options);
+}
+
 void EstimatorNode::subscribe() {
   const Estimator& estimator = pipeline_->estimator();
-  const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
   joint_health_ = InputHealth(nh_.resolveName(settings_.joint_states_topic));
   for (std::size_t k = 0; k < wrench_topics_.size(); ++k) {
     const std::string& topic = settings_.wrenches[k].topic;
@@ -102,11 +117,8 @@ void EstimatorNode::subscribe() {
                topic.c_str(), settings_.estimator.wrenches[k].link.c_str());
       continue;
     }
-    wrench_topics_[k].subscriber = nh_.subscribe<const WrenchEvent&>(
-        topic, 100, boost::function<void(const WrenchEvent&)>([this, k](const WrenchEvent& event) {
-          onWrench(k, event);
-        }),
-        ros::VoidConstPtr(), hints);
+    wrench_topics_[k].subscriber = subscribeInput<WrenchEvent>(
+        topic, [this, k](const WrenchEvent& event) { onWrench(k, event); });
   }
   for (std::size_t k = 0; k < plate_topics_.size(); ++k) {
     plate_topics_[k].health = InputHealth(settings_.force_plates[k].topic);
@@ -118,14 +130,12 @@ void EstimatorNode::subscribe() {
           settings_.estimator.plates[k].plate.link.c_str());
       continue;
     }
-    plate_topics_[k].subscriber = nh_.subscribe<const WrenchEvent&>(
-        settings_.force_plates[k].topic, 100,
-        boost::function<void(const WrenchEvent&)>(
-            [this, k](const WrenchEvent& event) { onPlate(k, event); }),
-        ros::VoidConstPtr(), hints);
+    plate_topics_[k].subscriber =
+        subscribeInput<WrenchEvent>(settings_.force_plates[k].topic,
+                                    [this, k](const WrenchEvent& event) { onPlate(k, event); });
   }
-  joint_sub_ =
-      nh_.subscribe(settings_.joint_states_topic, 100, &EstimatorNode::onJointState, this, hints);
+  joint_sub_ = subscribeInput<JointStateEvent>(
+      settings_.joint_states_topic, [this](const JointStateEvent& event) { onJointState(event); });
 }
 
 void EstimatorNode::report(Outcome outcome) {
@@ -157,7 +167,24 @@ void EstimatorNode::report(Outcome outcome) {
 }
 
 void EstimatorNode::onJointState(const JointStateEvent& event) {
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
+  if (settings_.inline_callbacks && event.getPublisherName() != ros::this_node::getName()) {
+    // From another process: this runs in roscpp's network thread, inside the
+    // subscription's lock; publishing the loads from here could deadlock with an
+    // in-process publisher (which holds roscpp's publication lock while it delivers).
+    ++exceptions_;
+    ROS_ERROR_THROTTLE(kThrottle,
+                       "joint_states from '%s' (another process): with inline_callbacks only "
+                       "publishers in the same nodelet manager are taken (dropped; set "
+                       "inline_callbacks: false)",
+                       event.getPublisherName().c_str());
+    return;
+  }
   const ros::Time received = ros::Time::now();
+  const double queue_wait = (received - event.getReceiptTime()).toSec();
+  queue_wait_sum_ += queue_wait;
+  queue_wait_max_ = std::max(queue_wait_max_, queue_wait);
+  ++queue_wait_count_;
   const sensor_msgs::JointState& msg = *event.getConstMessage();
   try {
     applyPendingBias();
@@ -175,6 +202,7 @@ void EstimatorNode::onJointState(const JointStateEvent& event) {
 }
 
 void EstimatorNode::onWrench(std::size_t k, const WrenchEvent& event) {
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
   const geometry_msgs::WrenchStamped& msg = *event.getConstMessage();
   try {
     applyPendingBias();
@@ -189,6 +217,7 @@ void EstimatorNode::onWrench(std::size_t k, const WrenchEvent& event) {
 }
 
 void EstimatorNode::onPlate(std::size_t k, const WrenchEvent& event) {
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
   const geometry_msgs::WrenchStamped& msg = *event.getConstMessage();
   try {
     const Outcome outcome = feedPlate(*pipeline_, static_cast<int>(k), msg, ros::Time::now());
@@ -201,17 +230,27 @@ void EstimatorNode::onPlate(std::size_t k, const WrenchEvent& event) {
   }
 }
 
+joint_load_estimator::JointLoadsPtr EstimatorNode::freeLoadsMessage() {
+  // use_count() 1: only the pool holds it, and only this thread hands it out.
+  for (const joint_load_estimator::JointLoadsPtr& msg : loads_pool_)
+    if (msg.use_count() == 1) return msg;
+  auto msg = boost::make_shared<joint_load_estimator::JointLoads>(loads_msg_);
+  if (loads_pool_.size() < kLoadsPool) loads_pool_.push_back(msg);
+  return msg;
+}
+
 void EstimatorNode::publish(const ros::Time& received) {
   const LoadsRecord& record = pipeline_->record();
-  toMessage(record, loads_msg_);
+  const joint_load_estimator::JointLoadsPtr loads = freeLoadsMessage();
+  toMessage(record, *loads);
   for (std::size_t i = 0; i < wrench_pubs_.size(); ++i)
     if (wrench_pubs_[i].getNumSubscribers() > 0) {
       toWrenchMessage(record, i, wrench_msg_);
       wrench_pubs_[i].publish(wrench_msg_);
     }
-  const ros::Time stamp = loads_msg_.header.stamp;
+  const ros::Time stamp = loads->header.stamp;
   publishPlates(stamp);
-  loads_pub_.publish(loads_msg_);
+  loads_pub_.publish(joint_load_estimator::JointLoadsConstPtr(loads));
   if (efforts_pub_.getNumSubscribers() > 0) {
     toJointState(record, efforts_msg_);
     efforts_pub_.publish(efforts_msg_);
@@ -246,6 +285,10 @@ void EstimatorNode::publishPlates(const ros::Time& stamp) {
 }
 
 void EstimatorNode::onDiagnosticsTimer(const ros::WallTimerEvent&) {
+  // The status functions take callbacks_mutex_; the publication comes after they
+  // return: roscpp publishes under its own lock, which an in-process publisher holds
+  // while it delivers a message inline (inline_callbacks), so holding ours across a
+  // publication would invert the order of the two locks.
   try {
     updater_.force_update();
   } catch (const std::exception& e) {
@@ -255,6 +298,7 @@ void EstimatorNode::onDiagnosticsTimer(const ros::WallTimerEvent&) {
 }
 
 void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
   const PipelineCounters& c = pipeline_->counters();
   const long received = c.received(InputKind::kJointState);
   const long published = c.count(Outcome::kPublished);
@@ -284,6 +328,8 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   external_outputs_.diagnose(status);
   status.add("mean latency [s]", latency_count_ ? latency_sum_ / latency_count_ : 0.0);
   status.add("max latency [s]", latency_max_);
+  status.add("mean queue wait [s]", queue_wait_count_ ? queue_wait_sum_ / queue_wait_count_ : 0.0);
+  status.add("max queue wait [s]", queue_wait_max_);
   status.add("joint states received", received);
   status.add("wrenches received", c.received(InputKind::kWrench));
   status.add("loads published", published);
@@ -292,6 +338,9 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   latency_sum_ = 0.0;
   latency_max_ = 0.0;
   latency_count_ = 0;
+  queue_wait_sum_ = 0.0;
+  queue_wait_max_ = 0.0;
+  queue_wait_count_ = 0;
 }
 
 void EstimatorNode::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& status,

@@ -315,6 +315,7 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("time_jump_threshold", n.time_jump_threshold);
   s.read("keep_fixed_joints", n.keep_fixed_joints);
   s.read("diagnostic_period", n.diagnostic_period);
+  s.read("inline_callbacks", n.inline_callbacks);
   s.read("decimation", n.estimator.decimation);
   s.read("gravity", n.estimator.gravity_world.data(), 3);
   s.read("precision", n.estimator.precision,

@@ -194,6 +194,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(still_velocity);
   EXPECT_SAME(bias_file);
   EXPECT_SAME(diagnostic_period);
+  EXPECT_SAME(inline_callbacks);
   EXPECT_SAME(body_mass);
   expectSame(a.estimator, b.estimator);
   expectSame(a.external_effort, b.external_effort);
@@ -250,6 +251,7 @@ TEST(SettingsReader, TopLevelKeys) {
   e.still_velocity = 0.05;
   e.bias_file = "/tmp/ft_bias.yaml";
   e.diagnostic_period = 0.25;
+  e.inline_callbacks = true;
   e.body_mass = -1.0;
   expectSame(parseFile(kConfig + "/ok_top_level.yaml"), e);
 }

@@ -9,6 +9,7 @@
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
 #include <joint_load_estimator/ros/external_outputs.hpp>
+#include <joint_load_estimator/ros/inline_callback_queue.hpp>
 #include <joint_load_estimator/ros/input_health.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
@@ -78,12 +79,20 @@ class EstimatorNode {
   void setUpConsistency();
   using JointStateEvent = ros::MessageEvent<const sensor_msgs::JointState>;
   using WrenchEvent = ros::MessageEvent<const geometry_msgs::WrenchStamped>;
+  // An input subscription (queue of 100, tcpNoDelay), inline with inline_callbacks.
+  template <class Event>
+  ros::Subscriber subscribeInput(const std::string& topic,
+                                 const boost::function<void(const Event&)>& callback);
   void onJointState(const JointStateEvent& event);
   void onWrench(std::size_t k, const WrenchEvent& event);
   void onPlate(std::size_t k, const WrenchEvent& event);
   // Logs what the pipeline said of the last message, each problem throttled on its own.
   void report(Outcome outcome);
   void publish(const ros::Time& received);
+  // A ~joint_loads message to fill: one of the pool that no subscriber holds any more,
+  // else a new one (published as a shared pointer, so that a subscriber in the same
+  // process gets the message itself, not a serialised copy).
+  joint_load_estimator::JointLoadsPtr freeLoadsMessage();
   void publishPlates(const ros::Time& stamp);
   // /diagnostics on a wall-clock timer (diagnostic_period): it keeps its rate whatever
   // the inputs and the (sim) clock do.
@@ -111,6 +120,10 @@ class EstimatorNode {
 
   ros::NodeHandle nh_, private_nh_;
   Settings settings_;
+  // The input callbacks and the diagnostics timer take it: with inline_callbacks they
+  // run in the threads that deliver the messages (one per publisher in the process).
+  std::mutex callbacks_mutex_;
+  InlineCallbackQueue inline_queue_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   Tf2FrameSource frames_;
@@ -120,8 +133,9 @@ class EstimatorNode {
   std::vector<PlateTopic> plate_topics_;
   ros::Publisher loads_pub_, residual_pub_;
   std::vector<ros::Publisher> wrench_pubs_;
-  ExternalOutputs external_outputs_;  // external_effort/enabled
-  joint_load_estimator::JointLoads loads_msg_;
+  ExternalOutputs external_outputs_;             // external_effort/enabled
+  joint_load_estimator::JointLoads loads_msg_;  // the template: names and sizes
+  std::vector<joint_load_estimator::JointLoadsPtr> loads_pool_;
   ros::Publisher efforts_pub_;           // ~joint_efforts (sensor_msgs/JointState)
   sensor_msgs::JointState efforts_msg_;  // the JointLoads' names, q, q-dot, efforts
   geometry_msgs::WrenchStamped wrench_msg_;
@@ -136,8 +150,11 @@ class EstimatorNode {
   long exceptions_ = 0;
   long published_at_last_diag_ = 0, received_at_last_diag_ = 0;
   ros::WallTime last_diag_ = ros::WallTime::now();
-  double latency_sum_ = 0.0, latency_max_ = 0.0;
+  double latency_sum_ = 0.0, latency_max_ = 0.0;  // callback entry -> loads published [s]
   long latency_count_ = 0;
+  // Receipt of a joint state (in roscpp's subscription queue) -> its callback [s].
+  double queue_wait_sum_ = 0.0, queue_wait_max_ = 0.0;
+  long queue_wait_count_ = 0;
   // Consistency.
   std::vector<std::size_t> sensor_topics_;               // indices of the sensor inputs
   double base_force_max_ = 0.0, base_moment_max_ = 0.0;  // since the last diagnosis
