@@ -157,7 +157,8 @@ const std::vector<Kind>& kinds() {
        [](sensor_msgs::JointState& js, const HostileSend& send) {
          send.joint(offBy(js, js.header.stamp - kTwoHours));
        }},
-      {"JointStateStampedZero", "a joint state stamped 0 on a stamped stream", "dropped: rogue stamp",
+      {"JointStateStampedZero", "a joint state stamped 0 on a stamped stream",
+       "dropped: rogue stamp",
        [](sensor_msgs::JointState& js, const HostileSend& send) {
          send.joint(offBy(js, ros::Time()));
        }},
@@ -169,7 +170,8 @@ const std::vector<Kind>& kinds() {
        [](sensor_msgs::JointState& js, const HostileSend& send) {
          send.wrench(wild(js.header.stamp - kTwoHours));
        }},
-      {"WrenchAheadOfItsTimeout", "a wrench ahead of the joint states by 0.5 s (timeout 0.05 s)", "dropped: rogue stamp",
+      {"WrenchAheadOfItsTimeout", "a wrench ahead of the joint states by 0.5 s (timeout 0.05 s)",
+       "dropped: rogue stamp",
        [](sensor_msgs::JointState& js, const HostileSend& send) {
          send.wrench(wild(js.header.stamp + ros::Duration(0.5)));
        }},
@@ -280,7 +282,8 @@ void hostileStream(const std::vector<const Kind*>& cycle, const ros::Time& start
                                          "dropped: stamp order",
                                          "time jumps back",
                                          "input '/hostile/joint_states': lost (header.seq gaps)"};
-  for (const std::string& key : keys) before[key] = std::max(0L, diag.latest(hostile.status(), key));
+  for (const std::string& key : keys)
+    before[key] = std::max(0L, diag.latest(hostile.status(), key));
   Reference ref(kUr5);
   const std::vector<std::string>& names = ref.model.coordinate_names;
   std::map<std::string, long> expected;
@@ -342,8 +345,7 @@ TEST_P(HostileKind, ChangesNoLoadsAndIsCounted) {
   hostileStream({&kind}, ros::Time(20000 + 100 * GetParam(), 0), 200);
 }
 
-INSTANTIATE_TEST_SUITE_P(Each, HostileKind,
-                         ::testing::Range(0, static_cast<int>(kinds().size())),
+INSTANTIATE_TEST_SUITE_P(Each, HostileKind, ::testing::Range(0, static_cast<int>(kinds().size())),
                          [](const ::testing::TestParamInfo<int>& info) {
                            return std::string(kinds()[static_cast<std::size_t>(info.param)].name);
                          });

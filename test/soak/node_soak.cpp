@@ -5,9 +5,9 @@
 // samples (every kind the node counts, cycled: invalid values and sizes, stamp
 // order, rogue stamps of joint states and wrenches, unknown frames and joints),
 // plus a few backward jumps of time (a looping bag, confirmed by
-// stamps/jump_confirm joint states on the new timeline). Flow control: at most --window joint-state messages unacknowledged (a
-// message is acknowledged by the loads of it or of a later sample; the node's
-// subscriber queues hold 100), so no queue drops anything. Checks
+// stamps/jump_confirm joint states on the new timeline). Flow control: at most --window joint-state
+// messages unacknowledged (a message is acknowledged by the loads of it or of a later sample; the
+// node's subscriber queues hold 100), so no queue drops anything. Checks
 //  1. every good sample produces its loads: the sequence of ~joint_loads stamps
 //  equals the
 //     expected one, derived from the filter's documented warm-up
@@ -339,8 +339,8 @@ class Driver {
   // The tool wrench (constant), to the node and the clean stream.
   void sendGoodWrench(std::int64_t stamp) {
     sendWrench(stamp, kWrenchFx, wrench_link_);
-    reference_->onWrench(0, stamp, nowNs(), wrench_link_,
-                         Eigen::Vector3d(kWrenchFx, 2.0, -5.0), Eigen::Vector3d(0.1, 0.0, 0.0));
+    reference_->onWrench(0, stamp, nowNs(), wrench_link_, Eigen::Vector3d(kWrenchFx, 2.0, -5.0),
+                         Eigen::Vector3d(0.1, 0.0, 0.0));
     last_wrench_ns_ = stamp;
     wrench_in_segment_ = true;
   }
@@ -460,7 +460,7 @@ class Driver {
       case kRogueAhead:
       case kRogueBack:
       case kRogueZero:
-        m.header.stamp = fromNs(kind == kRogueZero ? 0
+        m.header.stamp = fromNs(kind == kRogueZero    ? 0
                                 : kind == kRogueAhead ? last_good_ns_ + kTwoHoursNs
                                                       : last_good_ns_ - kTwoHoursNs);
         for (double& q : m.position) q += 0.3;  // used, it would change every load
@@ -468,9 +468,7 @@ class Driver {
       case kWrenchAhead: sendWrench(last_good_ns_ + kTwoHoursNs, 1000.0, wrench_link_); return true;
       case kWrenchBack: sendWrench(last_good_ns_ - kTwoHoursNs, 1000.0, wrench_link_); return true;
       case kWrenchZero: sendWrench(0, 1000.0, wrench_link_); return true;
-      case kWrenchLead:
-        sendWrench(last_good_ns_ + 500000000, 1000.0, wrench_link_);
-        return true;
+      case kWrenchLead: sendWrench(last_good_ns_ + 500000000, 1000.0, wrench_link_); return true;
       default: return false;
     }
     return sendJoint(m);

@@ -111,8 +111,8 @@ TEST(DefaultPeriodSigma, WithinFivePercentOfTheExactOneFromTheFirstSample) {
       ASSERT_GT(e, 0.0) << "joint " << j << " message " << i;
       const double error = std::abs(a / e - 1.0);
       worst[p] = std::max(worst[p], error);
-      EXPECT_LE(error, 0.05) << "joint " << j << " message "
-                             << i << " (" << phase[p] << "): sigma " << a << " exact " << e;
+      EXPECT_LE(error, 0.05) << "joint " << j << " message " << i << " (" << phase[p] << "): sigma "
+                             << a << " exact " << e;
     }
   }
   for (int p = 0; p < 4; ++p)
@@ -140,9 +140,9 @@ TEST(DefaultFilterSigma, MatchesAMonteCarloThroughTheMessagePath) {
     jle::Pipeline pipeline(rec.model, published_settings, nullptr);
     std::size_t next = 0;
     for (int k = 0; k < samples; ++k) {
-      const Outcome o = pipeline.onJointState(messages[k].stamp, messages[k].stamp,
-                                              rec.model.coordinate_names,
-                                              rec.positions(messages[k].t), kNone, kNone);
+      const Outcome o =
+          pipeline.onJointState(messages[k].stamp, messages[k].stamp, rec.model.coordinate_names,
+                                rec.positions(messages[k].t), kNone, kNone);
       if (next < instants.size() && k == instants[next]) {
         ASSERT_EQ(o, Outcome::kPublished) << k;
         mean[next] = pipeline.record().effort;

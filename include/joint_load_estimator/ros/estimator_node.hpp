@@ -133,7 +133,7 @@ class EstimatorNode {
   std::vector<PlateTopic> plate_topics_;
   ros::Publisher loads_pub_, residual_pub_;
   std::vector<ros::Publisher> wrench_pubs_;
-  ExternalOutputs external_outputs_;             // external_effort/enabled
+  ExternalOutputs external_outputs_;            // external_effort/enabled
   joint_load_estimator::JointLoads loads_msg_;  // the template: names and sizes
   std::vector<joint_load_estimator::JointLoadsPtr> loads_pool_;
   ros::Publisher efforts_pub_;           // ~joint_efforts (sensor_msgs/JointState)
