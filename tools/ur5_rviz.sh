@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README "Any robot" commands on the UR5 (test/data/urdf/ur5_robot.urdf), run under
-# a virtual display, with a screenshot of rviz into docs/ur5_rviz.png and what
+# a virtual display, with a screenshot of rviz into docs/ur5_rviz.png, 5 s of
+# ~joint_efforts plotted by plot_efforts into docs/ur5_efforts.png, and what
 # `rostopic echo` shows of ~joint_efforts into docs/ur5_joint_efforts.txt.
 #   bash tools/ur5_rviz.sh     (JLE_WS: the workspace; ROS_PORT: the roscore it starts)
 # Needs rviz, xvfb and imagemagick (installed here if missing: not CI dependencies).
@@ -48,6 +49,8 @@ roslaunch joint_load_estimator any_robot.launch model:="$urdf" bag:="$out/ur5.ba
   rviz_config:="$out/ur5.rviz" >"$out/launch.log" 2>&1 &
 pids=("$!" "${pids[@]}")
 timeout 60 rostopic echo -n 1 /joint_load_estimator/joint_efforts >/dev/null
+rosrun joint_load_estimator plot_efforts /joint_load_estimator/joint_efforts --seconds 5 \
+  --output "$repo/docs/ur5_efforts.png"
 # ---------------------------------------------------------------------------------------
 
 sleep 10  # rviz: the window, the model and a few seconds of wrenches
@@ -58,4 +61,4 @@ import -window root "$repo/docs/ur5_rviz.png"
   echo "\$ rostopic hz /joint_load_estimator/joint_efforts   (5 s)"
   timeout 5 rostopic hz /joint_load_estimator/joint_efforts 2>&1 | tail -2 || true
 } >"$repo/docs/ur5_joint_efforts.txt"
-echo "wrote $repo/docs/ur5_rviz.png and $repo/docs/ur5_joint_efforts.txt"
+echo "wrote $repo/docs/ur5_rviz.png, $repo/docs/ur5_efforts.png and $repo/docs/ur5_joint_efforts.txt"

@@ -844,7 +844,7 @@ std::string packageVersion() {
   return xml.substr(begin + 9, end - begin - 9);
 }
 
-// Every executable of the package (the node, src/tools/*, scripts/rviz_config) prints
+// Every executable of the package (the node, src/tools/*, scripts/*) prints
 // its usage for --help and its version for --version, exiting 0 without touching ROS:
 // the master named here does not exist, and a program that tried to reach it would
 // hang until `timeout` kills it (status 124).
@@ -857,7 +857,7 @@ TEST_F(CliTest, EveryExecutableHasHelpAndVersion) {
     programs.push_back(std::string(JLE_EXECUTABLES).substr(begin, end - begin));
     if (end == std::string::npos) break;
   }
-  ASSERT_EQ(programs.size(), 9u);  // the node, 7 tools, rviz_config
+  ASSERT_EQ(programs.size(), 13u);  // the node, 10 tools, rviz_config, plot_efforts
   for (const std::string& program : programs) {
     const std::string name = fs::path(program).filename().string();
     for (const char* option : {"--help", "--version"}) {
