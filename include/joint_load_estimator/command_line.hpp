@@ -53,6 +53,25 @@ inline std::map<std::string, std::string> optionValues(int argc, char** argv,
   return values;
 }
 
+/// An option that may be repeated (joint_loads' and csv_to_bag's --plate): its values,
+/// as `--key VALUE` or `--key=VALUE`, taken out of argv into `values`, before
+/// optionValues (which allows each other option once) reads `rest` (argv[0] first).
+inline void takeRepeatedOption(int argc, char** argv, const std::string& key,
+                               std::vector<std::string>& values, std::vector<char*>& rest) {
+  rest.assign(1, argv[0]);
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == key) {
+      if (i + 1 >= argc) throw UsageError(key + " needs a value");
+      values.push_back(argv[++i]);
+    } else if (arg.compare(0, key.size() + 1, key + "=") == 0) {
+      values.push_back(arg.substr(key.size() + 1));
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+}
+
 /// The value of a required option of `values` (optionValues); throws UsageError
 /// "KEY WHAT is required" ("--urdf ROBOT.urdf is required") without it.
 inline std::string requiredValue(const std::map<std::string, std::string>& values,

@@ -114,6 +114,28 @@ void validatePlateTopics(const Settings& s) {
 
 }  // namespace
 
+// external_effort/... (its model-level checks are in external_effort.cpp).
+void validate(const ExternalEffortConfig& c) {
+  positive("external_effort/observer_cutoff", c.observer_cutoff);
+  nonNegative("external_effort/effort_noise", c.effort_noise);
+  nonNegative("external_effort/damping", c.damping);
+  positive("external_effort/singular_threshold", c.singular_threshold);
+  nonNegative("external_effort/threshold", c.threshold);
+  nonNegative("external_effort/noise_multiple", c.noise_multiple);
+  positive("external_effort/calibration_time", c.calibration_time);
+  if (!(c.release_fraction > 0.0 && c.release_fraction <= 1.0))
+    fail("external_effort/release_fraction",
+         "must be in (0, 1], it is " + number(c.release_fraction));
+  for (std::size_t k = 0; k < c.contacts.size(); ++k) {
+    if (c.contacts[k].link.empty())
+      fail(element("external_effort/contacts", k, "link"), "is required");
+    if (!c.contacts[k].point.allFinite())
+      fail(element("external_effort/contacts", k, "point"), "must be finite");
+  }
+  for (const auto& jt : c.joint_thresholds)
+    nonNegative("external_effort/joint_thresholds/" + jt.first, jt.second);
+}
+
 void validate(const EstimatorConfig& config) {
   try {
     validate(config.differentiator);

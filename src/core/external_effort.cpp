@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 namespace jle {
 
@@ -17,20 +16,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 [[noreturn]] void fail(const std::string& key, const std::string& what) {
   throw SettingsError("parameter '" + key + "' " + what);
-}
-
-std::string number(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
-void positive(const std::string& key, double v) {
-  if (!(v > 0.0) || !std::isfinite(v)) fail(key, "must be finite and > 0, it is " + number(v));
-}
-
-void nonNegative(const std::string& key, double v) {
-  if (!(v >= 0.0) || !std::isfinite(v)) fail(key, "must be finite and >= 0, it is " + number(v));
 }
 
 std::string contactKey(std::size_t k, const char* key) {
@@ -44,25 +29,6 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
 }
 
 }  // namespace
-
-void validate(const ExternalEffortConfig& c) {
-  positive("external_effort/observer_cutoff", c.observer_cutoff);
-  nonNegative("external_effort/effort_noise", c.effort_noise);
-  nonNegative("external_effort/damping", c.damping);
-  positive("external_effort/singular_threshold", c.singular_threshold);
-  nonNegative("external_effort/threshold", c.threshold);
-  nonNegative("external_effort/noise_multiple", c.noise_multiple);
-  positive("external_effort/calibration_time", c.calibration_time);
-  if (!(c.release_fraction > 0.0 && c.release_fraction <= 1.0))
-    fail("external_effort/release_fraction",
-         "must be in (0, 1], it is " + number(c.release_fraction));
-  for (std::size_t k = 0; k < c.contacts.size(); ++k) {
-    if (c.contacts[k].link.empty()) fail(contactKey(k, "link"), "is required");
-    if (!c.contacts[k].point.allFinite()) fail(contactKey(k, "point"), "must be finite");
-  }
-  for (const auto& jt : c.joint_thresholds)
-    nonNegative("external_effort/joint_thresholds/" + jt.first, jt.second);
-}
 
 ExternalEffort::ExternalEffort(const Model<double>& model, const ExternalEffortConfig& config,
                                const std::vector<int>& published,

@@ -109,19 +109,9 @@ PlatePose parsePlate(const std::string& text) {
 }
 
 Options parseOptions(int argc, char** argv) {
-  std::vector<char*> rest{argv[0]};
+  std::vector<char*> rest;
   std::vector<std::string> plates;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--plate") {
-      if (i + 1 >= argc) throw UsageError("--plate needs a value");
-      plates.push_back(argv[++i]);
-    } else if (arg.compare(0, 8, "--plate=") == 0) {
-      plates.push_back(arg.substr(8));
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
+  takeRepeatedOption(argc, argv, "--plate", plates, rest);
   std::map<std::string, std::string> v =
       optionValues(static_cast<int>(rest.size()), rest.data(),
                    {"--input", "--output", "--world-frame", "--base-frame", "--time-offset",

@@ -213,24 +213,6 @@ jle::ForcePlateConfig parsePlate(const std::string& text) {
   return plate;
 }
 
-// --plate may be repeated: its values are taken out of argv (into `plates`) before the
-// shared parser, which allows each other option once; the rest stays in `rest`.
-void takePlateOptions(int argc, char** argv, std::vector<std::string>& plates,
-                      std::vector<char*>& rest) {
-  rest.assign(1, argv[0]);
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--plate") {
-      if (i + 1 >= argc) throw UsageError("--plate needs a value");
-      plates.push_back(argv[++i]);
-    } else if (arg.compare(0, 8, "--plate=") == 0) {
-      plates.push_back(arg.substr(8));
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-}
-
 // The plates of the --plate values, each with the contact threshold; a name once.
 std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& values,
                                             double contact_threshold) {
@@ -311,7 +293,7 @@ void parseOutputOptions(std::map<std::string, std::string>& v, Options& options)
 Options parseOptions(int argc, char** argv) {
   std::vector<std::string> plates;
   std::vector<char*> rest;
-  takePlateOptions(argc, argv, plates, rest);
+  takeRepeatedOption(argc, argv, "--plate", plates, rest);
   std::map<std::string, std::string> v =
       optionValues(static_cast<int>(rest.size()), rest.data(),
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",

@@ -47,7 +47,8 @@ TEST(External, AWrenchOnTheHandIsDetectedEstimatedAndReported) {
     jle::VectorX<double> q, qd, qdd;
     scene.state(ref.model, t, q, qd, qdd);
     scene.efforts(ref.model, data, t, published, ref.gravity, effort);
-    sensor_msgs::JointState js = jointState(start + ros::Duration(t), ref.model.coordinate_names, q);
+    sensor_msgs::JointState js =
+        jointState(start + ros::Duration(t), ref.model.coordinate_names, q);
     js.effort = effort;
     node.send(js);
     current = t;
@@ -86,8 +87,9 @@ TEST(External, AWrenchOnTheHandIsDetectedEstimatedAndReported) {
   EXPECT_GT(compared, 150);
   // |F| = 12.1 N, |M| = 0.37 N m: the observer's lag behind the joint-space image of the
   // wrench, which changes as the arm moves, and the filter's q-dot are the error.
-  std::printf("external wrench, 1.5-1.95 s: worst force error %.4f N of %.2f, moment %.4f N m of %.3f\n",
-              worst_force, scene.force_link.norm(), worst_moment, scene.moment_link.norm());
+  std::printf(
+      "external wrench, 1.5-1.95 s: worst force error %.4f N of %.2f, moment %.4f N m of %.3f\n",
+      worst_force, scene.force_link.norm(), worst_moment, scene.moment_link.norm());
   EXPECT_LT(worst_force, 0.2 * scene.force_link.norm());
   EXPECT_LT(worst_moment, 0.1);
 
