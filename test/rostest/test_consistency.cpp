@@ -109,12 +109,18 @@ class SensorNode {
       w.wrench.torque = tf2::toMsg(s.m, w.wrench.torque);
       wrench_pub.publish(w);
     };
+    // The run's first joint state before its first readings: a reading is taken only
+    // within its timeout plus ten joint periods ahead of the joint states (README "Time
+    // stamps"), and a run starts seconds after the last one, so readings sent first
+    // would be rogue or not depending on which connection the node serves first.
+    node.send(jointState(stamp(0), names, at(stamp(0)).q));
+    waitFor([] { return false; }, 0.05);
     for (int k = 0; k < kLead; ++k) sendWrench(k);
     int checked = 0;
     for (int k = 0; k < samples && !stop(); ++k) {
       const ros::Time t = stamp(k);
       sendWrench(k + kLead);
-      node.send(jointState(t, names, at(t).q));
+      if (k > 0) node.send(jointState(t, names, at(t).q));
       if (k < 2) continue;  // the 3-point filter's warm-up
       // The first wrenches of a run may come after its first joint states
       // (another connection): with a 0.5 ms timeout and the stop policy
