@@ -5,10 +5,15 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 export JLE_WS=$ws
+# Each stage says when it starts, in seconds since this script began (the CI budget).
+stage() { echo "[test.sh $SECONDS s] $*"; }
+stage install
 bash "$repo/tools/install_deps.sh"
+stage build
 # Warnings are errors in CI (the option JLE_WERROR of CMakeLists.txt, OFF by default).
 bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON
 bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON tests
+stage style
 # House style: no function over 80 lines in src/ and include/, every C++ file formatted
 # by the root .clang-format.
 style_status=0
@@ -18,12 +23,14 @@ bash "$repo/tools/format.sh" --check || { echo "style: run bash tools/format.sh"
 export PATH=/usr/bin:$PATH
 cd "$ws"
 rm -rf build/test_results
+stage run_tests
 # run_tests does not fail on a failed test; catkin_test_results does.
 if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests -j1 >"$ws/run_tests.log" 2>&1; then
   tail -80 "$ws/run_tests.log"
   echo "run_tests failed (log: $ws/run_tests.log)"
   exit 1
 fi
+stage benchmarks
 # The benchmarks, once each on a tiny input, so that they cannot rot (no timing is
 # judged here).
 bench_status=0
@@ -35,6 +42,7 @@ done
 "$ws/devel/lib/joint_load_estimator/bench_external_effort" --table --quick \
   >"$ws/external_effort_table.log" 2>&1 ||
   { tail -20 "$ws/external_effort_table.log"; echo "external effort table failed"; bench_status=1; }
+stage accuracy_stability
 bash "$repo/tools/accuracy.sh" --quick >"$ws/accuracy_quick.log" 2>&1 ||
   { tail -20 "$ws/accuracy_quick.log"; echo "accuracy --quick failed"; bench_status=1; }
 bash "$repo/tools/stability.sh" --quick >"$ws/stability_quick.log" 2>&1 ||
@@ -42,6 +50,7 @@ bash "$repo/tools/stability.sh" --quick >"$ws/stability_quick.log" 2>&1 ||
 # The node's latency bench (every path, one rate, 0.3 s) and the offline throughput
 # bench with its parallel-equals-serial check, on tiny inputs (about 70 s together on
 # the loaded 2-core machine, mostly process start-up).
+stage latency_throughput
 JLE_BENCH_RATES="[1000]" bash "$repo/bench/node_latency.sh" 0.3 >"$ws/node_latency_quick.log" 2>&1 ||
   { tail -20 "$ws/node_latency_quick.log"; echo "node_latency.sh failed"; bench_status=1; }
 bash "$repo/bench/offline_throughput.sh" --quick >"$ws/offline_throughput_quick.log" 2>&1 ||
@@ -50,17 +59,23 @@ bash "$repo/bench/offline_throughput.sh" --quick >"$ws/offline_throughput_quick.
 # through the real node over ROS), the fuzzers
 # (regressions first, then 30 s each), the unit tests under ASan + UBSan (a second
 # workspace).
+stage soak
 "$ws/devel/lib/joint_load_estimator/soak" >"$ws/soak.log" 2>&1 ||
   { tail -20 "$ws/soak.log"; echo "soak failed (log: $ws/soak.log)"; bench_status=1; }
 tail -12 "$ws/soak.log" || true
+stage node_soak
 bash "$repo/test/soak/node_soak.sh" >"$ws/node_soak.log" 2>&1 ||
   { tail -30 "$ws/node_soak.log"; echo "node soak failed (log: $ws/node_soak.log)"; bench_status=1; }
 tail -20 "$ws/node_soak.log" || true
+stage fuzz
 bash "$repo/test/fuzz/build_and_run.sh" 30 >"$ws/fuzz.log" 2>&1 ||
   { tail -30 "$ws/fuzz.log"; echo "fuzzing failed (log: $ws/fuzz.log)"; bench_status=1; }
 grep -E "^(fuzz|#[0-9]+ +DONE)" "$ws/fuzz.log" | tail -6 || true
+stage sanitizers
 bash "$repo/tools/sanitize.sh" || { echo "sanitizer suite failed"; bench_status=1; }
 grep -E "^\[  (FAILED|PASSED) |^\[ *FAILED *\]|^\[ROSTEST\]|FAILURE" "$ws/run_tests.log" | sort | uniq -c | sort -rn | head -40 || true
+stage results
+/usr/bin/python3 "$repo/tools/slowest_tests.py" build/test_results || true
 status=0
 catkin_test_results --verbose build/test_results >"$ws/test_results.txt" 2>&1 || status=$?
 grep -vE "^$" "$ws/test_results.txt" | grep -vE "^(Summary|  )" | tail -20 || true
