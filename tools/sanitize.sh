@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
-# Builds the unit tests with AddressSanitizer + UndefinedBehaviorSanitizer in a second
-# catkin workspace and runs every gtest unit-test binary directly. The unit tests are
-# the ones CMake lists (test/CMakeLists.txt): every gtest registered with
-# catkin_add_gtest or jle_add_unit_test, which needs no master; the target
-# joint_load_estimator_unit_tests builds them and build/joint_load_estimator/unit_tests.txt
-# names their binaries. The rostest node tests (test_node_*) are left to tools/test.sh.
-# Fails on a failed test or on any sanitizer report.
-#   JLE_WS_SAN  workspace (default ~/.cache/joint_load_estimator/ws_asan)
-#   JLE_JOBS    parallel build jobs (default 2)
+# Builds the unit tests with AddressSanitizer + UndefinedBehaviorSanitizer in a catkin
+# workspace of their own and runs every gtest unit-test binary directly. This is where
+# tools/test.sh runs the unit tests: once, sanitized (its Release workspace builds the
+# system tests only). The unit tests are the ones CMake lists (test/unit_tests.cmake):
+# every gtest registered with catkin_add_gtest or jle_add_unit_test, which needs no
+# master; the target joint_load_estimator_unit_tests builds them and
+# build/joint_load_estimator/unit_tests.txt names their binaries. Built at -O1 with line
+# tables only (-g1: a report names file and line), which halves the compile time of
+# -O2 -g; warnings are errors as in the Release build. Fails on a failed test or on any
+# sanitizer report.
+#   JLE_WS_SAN       workspace (default ~/.cache/joint_load_estimator/ws_asan)
+#   JLE_JOBS         parallel build jobs (default 2)
+#   JLE_SAN_RESULTS  directory for the tests' JUnit files, gtest-<test>.xml (default
+#                    $JLE_WS_SAN/test_results), where catkin_test_results reads them
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${JLE_WS_SAN:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws_asan}
@@ -16,8 +21,13 @@ mkdir -p "$ws/src"
 ln -sfn "$repo" "$ws/src/joint_load_estimator"
 export PATH=/usr/bin:$PATH
 cd "$ws"
+results=${JLE_SAN_RESULTS:-$ws/test_results}
+mkdir -p "$results"
+# Build type None: these flags only (no -O2/-O3 of a build type).
 flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
-if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+flags="$flags -O1 -g1 -DNDEBUG"
+if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=None \
+    -DJLE_UNIT_TESTS=ON -DJLE_SYSTEM_TESTS=OFF -DJLE_WERROR=ON \
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
     -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
     -j"$jobs" joint_load_estimator_unit_tests >"$ws/build.log" 2>&1; then
@@ -40,7 +50,7 @@ while read -r t <&3; do
   [ -x "$t" ] && [ -f "$t" ] || { echo "FAIL  $name: listed but not built ($t)"; status=1; continue; }
   log="$ws/$name.log"
   start=$(date +%s)
-  if "$t" >"$log" 2>&1 && ! grep -qE "ERROR: (Address|Leak)Sanitizer|runtime error:" "$log"; then
+  if "$t" --gtest_output="xml:$results/gtest-$name.xml" >"$log" 2>&1 && ! grep -qE "ERROR: (Address|Leak)Sanitizer|runtime error:" "$log"; then
     echo "ok    $name ($(($(date +%s) - start)) s)"
   else
     echo "FAIL  $name (log: $log)"

@@ -11,8 +11,11 @@ stage install
 bash "$repo/tools/install_deps.sh"
 stage build
 # Warnings are errors in CI (the option JLE_WERROR of CMakeLists.txt, OFF by default).
-bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON
-bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON tests
+# This Release workspace builds the system tests (link test, Python bindings, node
+# tests, soaks); the unit tests are built and run once, under the sanitizers, by
+# tools/sanitize.sh below (their results join these in build/test_results).
+bash "$repo/tools/build.sh" -j2 -DJLE_WERROR=ON -DJLE_UNIT_TESTS=OFF -DJLE_SYSTEM_TESTS=ON
+bash "$repo/tools/build.sh" -j2 tests
 stage style
 # House style: no function over 80 lines in src/ and include/, every C++ file formatted
 # by the root .clang-format.
@@ -58,7 +61,7 @@ bash "$repo/bench/offline_throughput.sh" --quick >"$ws/offline_throughput_quick.
 # Robustness: the soaks (1e6 samples with bad messages mixed in, in process and
 # through the real node over ROS), the fuzzers
 # (regressions first, then 30 s each), the unit tests under ASan + UBSan (a second
-# workspace).
+# workspace: the only run of the unit tests).
 stage soak
 "$ws/devel/lib/joint_load_estimator/soak" >"$ws/soak.log" 2>&1 ||
   { tail -20 "$ws/soak.log"; echo "soak failed (log: $ws/soak.log)"; bench_status=1; }
@@ -72,7 +75,8 @@ bash "$repo/test/fuzz/build_and_run.sh" 30 >"$ws/fuzz.log" 2>&1 ||
   { tail -30 "$ws/fuzz.log"; echo "fuzzing failed (log: $ws/fuzz.log)"; bench_status=1; }
 grep -E "^(fuzz|#[0-9]+ +DONE)" "$ws/fuzz.log" | tail -6 || true
 stage sanitizers
-bash "$repo/tools/sanitize.sh" || { echo "sanitizer suite failed"; bench_status=1; }
+JLE_SAN_RESULTS="$ws/build/test_results/joint_load_estimator" bash "$repo/tools/sanitize.sh" ||
+  { echo "sanitizer suite failed"; bench_status=1; }
 grep -E "^\[  (FAILED|PASSED) |^\[ *FAILED *\]|^\[ROSTEST\]|FAILURE" "$ws/run_tests.log" | sort | uniq -c | sort -rn | head -40 || true
 stage results
 /usr/bin/python3 "$repo/tools/slowest_tests.py" build/test_results || true

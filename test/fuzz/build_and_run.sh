@@ -23,22 +23,28 @@ san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-fram
 common=(-std=c++17 -O1 -g $san -I"$repo/include" -I/usr/include/eigen3
         -DJLE_FUZZ_DATA="\"$repo/test/data\"" -Wall -Wextra)
 # Every target links the whole ROS-free core (compiled once, shared; without the fuzzer
-# runtime so that it holds no main): no list to keep up to date.
+# runtime so that it holds no main): no list to keep up to date. The objects compile
+# JLE_JOBS at a time (default 2), each rebuilt when its source or a header is newer.
 core_sources=$(cd "$repo" && ls src/core/*.cpp)
-object() {  # source -> object path, rebuilt when the source or a header is newer
-  local src=$1 obj="$work/obj/$(echo "$1" | tr / _).o"
+jobs=${JLE_JOBS:-2}
+objs=()
+build_failed=0
+for src in $core_sources; do
+  obj="$work/obj/$(echo "$src" | tr / _).o"
+  objs+=("$obj")
   if [ ! -f "$obj" ] || [ -n "$(find "$repo/$src" "$repo/include" -newer "$obj" -print -quit)" ]; then
-    "$cxx" "${common[@]}" -fsanitize=fuzzer-no-link -c "$repo/$src" -o "$obj"
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || build_failed=1; done
+    # Into a scratch file first: a failed compile leaves no object that looks current.
+    ("$cxx" "${common[@]}" -fsanitize=fuzzer-no-link -c "$repo/$src" -o "$obj.tmp" &&
+      mv "$obj.tmp" "$obj") &
   fi
-  echo "$obj"
-}
-
+done
+for pid in $(jobs -p); do wait "$pid" || build_failed=1; done
+[ "$build_failed" -eq 0 ] || { echo "FAIL  the core did not compile for the fuzzers"; exit 1; }
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=${JLE_FUZZ_LEAKS:-1}:allocator_may_return_null=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 status=0
 for t in "${targets[@]}"; do
-  objs=()
-  for s in $core_sources; do objs+=("$(object "$s")"); done
   "$cxx" "${common[@]}" -fsanitize=fuzzer "$here/$t.cpp" "${objs[@]}" -ltinyxml2 -o "$work/$t"
   # Regressions first: each must now run clean.
   reg="$here/regressions/$t"

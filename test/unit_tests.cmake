@@ -1,0 +1,142 @@
+# The unit tests (gtest, no master), included by CMakeLists.txt when JLE_UNIT_TESTS is on
+# (the default). tools/test.sh builds and runs them once, under ASan + UBSan
+# (tools/sanitize.sh), in a workspace of their own.
+
+# --- Unit tests of the core ---------------------------------------------------------
+jle_add_unit_test(test_urdf_reader unit/test_urdf_reader.cpp)
+target_link_libraries(test_urdf_reader ${urdf_LIBRARIES})
+target_include_directories(test_urdf_reader PRIVATE ${urdf_INCLUDE_DIRS})
+jle_add_unit_test(test_differentiation unit/test_differentiation.cpp)
+# The offline zero-phase smoother (zero_phase.hpp) against closed forms.
+jle_add_unit_test(test_zero_phase unit/test_zero_phase.cpp)
+# joint_loads on positions only against scipy (python3-scipy) and closed-form dynamics.
+jle_add_unit_test(test_zero_phase_reference unit/test_zero_phase_reference.cpp)
+target_compile_definitions(test_zero_phase_reference PRIVATE
+  JLE_TEST_SCRIPTS="${PROJECT_SOURCE_DIR}/test/scripts")
+add_dependencies(test_zero_phase_reference joint_loads)
+jle_add_unit_test(test_adaptive_differentiator unit/test_adaptive_differentiator.cpp)
+jle_add_unit_test(test_estimator unit/test_estimator.cpp)
+jle_add_unit_test(test_savings unit/test_savings.cpp)
+jle_add_unit_test(test_ground_truth unit/test_ground_truth.cpp)
+# The bounds of the stability sweeps (bench/stability.cpp, docs/stability.md).
+jle_add_unit_test(test_stability unit/test_stability.cpp)
+jle_add_unit_test(test_no_allocation unit/test_no_allocation.cpp)
+jle_add_unit_test(test_closed_form unit/test_closed_form.cpp)
+# The forward pass's sin and cos (trig.hpp) against long double.
+jle_add_unit_test(test_trig unit/test_trig.cpp)
+jle_add_unit_test(test_invariance unit/test_invariance.cpp)
+jle_add_unit_test(test_kdl unit/test_kdl.cpp)
+target_link_libraries(test_kdl ${orocos_kdl_LIBRARIES} ${kdl_parser_LIBRARIES})
+target_include_directories(test_kdl PRIVATE ${orocos_kdl_INCLUDE_DIRS} ${kdl_parser_INCLUDE_DIRS})
+# External efforts, the momentum observer and contact wrenches against exact contacts and KDL
+jle_add_unit_test(test_external_effort unit/test_external_effort.cpp)
+target_link_libraries(test_external_effort ${orocos_kdl_LIBRARIES} ${kdl_parser_LIBRARIES})
+target_include_directories(test_external_effort PRIVATE ${orocos_kdl_INCLUDE_DIRS}
+  ${kdl_parser_INCLUDE_DIRS})
+jle_add_unit_test(test_cli unit/test_cli.cpp)
+add_dependencies(test_cli joint_loads make_trajectory)
+# --help and --version of every executable; rviz_config (read with yaml-cpp and liburdf).
+set(JLE_EXECUTABLES joint_load_estimator_node joint_loads make_trajectory make_body_urdf
+  make_example_bag process_bag summarize_loads make_gait_bag dh_to_urdf csv_to_bag bag_to_csv)
+add_dependencies(test_cli ${JLE_EXECUTABLES})
+list(TRANSFORM JLE_EXECUTABLES REPLACE "(.+)" "$<TARGET_FILE:\\1>")
+list(APPEND JLE_EXECUTABLES ${PROJECT_SOURCE_DIR}/scripts/rviz_config
+  ${PROJECT_SOURCE_DIR}/scripts/plot_efforts)
+string(REPLACE ";" "|" JLE_EXECUTABLES_LIST "${JLE_EXECUTABLES}")
+target_compile_definitions(test_cli PRIVATE
+  "JLE_EXECUTABLES=\"${JLE_EXECUTABLES_LIST}\""
+  JLE_RVIZ_CONFIG="${PROJECT_SOURCE_DIR}/scripts/rviz_config"
+  JLE_PACKAGE_XML="${PROJECT_SOURCE_DIR}/package.xml")
+target_link_libraries(test_cli ${urdf_LIBRARIES} yaml-cpp)
+target_include_directories(test_cli PRIVATE ${urdf_INCLUDE_DIRS})
+jle_add_unit_test(test_frames unit/test_frames.cpp)
+jle_add_unit_test(test_sensor_bias unit/test_sensor_bias.cpp)
+jle_add_unit_test(test_pipeline unit/test_pipeline.cpp)
+jle_add_unit_test(test_sample_clock unit/test_sample_clock.cpp)
+# The estimator's parts, each against closed forms.
+jle_add_unit_test(test_input_buffer unit/test_input_buffer.cpp)
+jle_add_unit_test(test_plate_inputs unit/test_plate_inputs.cpp)
+# JointLoads beside the loads: q, q-dot, q-ddot and the friction motor effort.
+jle_add_unit_test(test_outputs unit/test_outputs.cpp)
+jle_add_unit_test(test_sensor_joints unit/test_sensor_joints.cpp)
+jle_add_unit_test(test_covariance_parts unit/test_covariance_parts.cpp)
+jle_add_unit_test(test_base_channels unit/test_base_channels.cpp)
+jle_add_unit_test(test_config unit/test_config.cpp)
+# The settings reader (ROS library, no master): ok and ko YAML per key family, the docs.
+catkin_add_gtest(test_settings unit/test_settings.cpp)
+target_link_libraries(test_settings joint_load_estimator_ros gtest_main)
+target_compile_definitions(test_settings PRIVATE
+  JLE_TEST_CONFIG="${PROJECT_SOURCE_DIR}/test/config"
+  JLE_DEFAULT_YAML="${PROJECT_SOURCE_DIR}/config/default.yaml"
+  JLE_README="${PROJECT_SOURCE_DIR}/README.md")
+# savings.planar: the planar 3x3 path against the 6x6 one and the paper's planar foot.
+jle_add_unit_test(test_planar unit/test_planar.cpp)
+# The human body model (make_body_urdf, docs/body_model.md), read by KDL too
+# (robot_state_publisher's reader), and the force-plate sign conventions.
+jle_add_unit_test(test_body unit/test_body.cpp)
+target_compile_definitions(test_body PRIVATE JLE_MAKE_BODY_URDF="$<TARGET_FILE:make_body_urdf>")
+add_dependencies(test_body make_body_urdf joint_loads)
+target_link_libraries(test_body ${orocos_kdl_LIBRARIES} ${kdl_parser_LIBRARIES})
+target_include_directories(test_body PRIVATE ${orocos_kdl_INCLUDE_DIRS} ${kdl_parser_INCLUDE_DIRS})
+jle_add_unit_test(test_force_plate unit/test_force_plate.cpp)
+# The estimator's force-plate path.
+jle_add_unit_test(test_plates unit/test_plates.cpp)
+# OpenSim storage files, joint_loads' floating base and force plates, process_bag's
+# storage output.
+jle_add_unit_test(test_offline_formats unit/test_offline_formats.cpp)
+target_compile_definitions(test_offline_formats PRIVATE
+  JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>"
+  JLE_MAKE_EXAMPLE_BAG="$<TARGET_FILE:make_example_bag>")
+add_dependencies(test_offline_formats joint_loads process_bag make_example_bag)
+# Covariance of the joint wrenches: the propagation, its Monte Carlo check and the
+# filters' noise gains.
+jle_add_unit_test(test_covariance unit/test_covariance.cpp)
+# The published sigma through the message path with the node's defaults: the default
+# period against every-sample propagation (start-up, gap, loop) and a Monte Carlo.
+jle_add_unit_test(test_covariance_pipeline unit/test_covariance_pipeline.cpp)
+# The core's sensor-joint substitution.
+jle_add_unit_test(test_sensor_joint unit/test_sensor_joint.cpp)
+# dh_to_urdf against Newton-Euler written in the test from the DH equations, and KDL.
+jle_add_unit_test(test_dh_to_urdf unit/test_dh_to_urdf.cpp)
+target_compile_definitions(test_dh_to_urdf PRIVATE JLE_DH_TO_URDF="$<TARGET_FILE:dh_to_urdf>")
+add_dependencies(test_dh_to_urdf dh_to_urdf)
+target_link_libraries(test_dh_to_urdf ${orocos_kdl_LIBRARIES} ${kdl_parser_LIBRARIES})
+target_include_directories(test_dh_to_urdf PRIVATE ${orocos_kdl_INCLUDE_DIRS}
+  ${kdl_parser_INCLUDE_DIRS})
+
+# The gait trial as a CSV file through joint_loads.
+jle_add_unit_test(test_gait_csv unit/test_gait_csv.cpp)
+target_compile_definitions(test_gait_csv PRIVATE
+  JLE_MAKE_GAIT_BAG="$<TARGET_FILE:make_gait_bag>")
+add_dependencies(test_gait_csv make_gait_bag joint_loads)
+
+# --- Unit tests of the ROS library and the bag tools (no master) --------------------
+catkin_add_gtest(test_process_bag unit/test_process_bag.cpp)
+target_link_libraries(test_process_bag joint_load_estimator_ros ${catkin_LIBRARIES})
+target_compile_definitions(test_process_bag PRIVATE
+  JLE_TEST_DATA="${JLE_TEST_DATA}"
+  JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>"
+  JLE_MAKE_EXAMPLE_BAG="$<TARGET_FILE:make_example_bag>")
+add_dependencies(test_process_bag process_bag make_example_bag)
+# csv_to_bag and bag_to_csv: the bag's contents, and CSV -> bag -> process_bag -> CSV
+# against joint_loads on the same CSV.
+catkin_add_gtest(test_csv_to_bag unit/test_csv_to_bag.cpp)
+target_link_libraries(test_csv_to_bag joint_load_estimator_ros joint_load_estimator_core
+  ${catkin_LIBRARIES} gtest_main)
+target_compile_definitions(test_csv_to_bag PRIVATE
+  JLE_TEST_DATA="${JLE_TEST_DATA}"
+  JLE_CSV_TO_BAG="$<TARGET_FILE:csv_to_bag>"
+  JLE_BAG_TO_CSV="$<TARGET_FILE:bag_to_csv>"
+  JLE_JOINT_LOADS="$<TARGET_FILE:joint_loads>"
+  JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>")
+add_dependencies(test_csv_to_bag csv_to_bag bag_to_csv joint_loads process_bag)
+# The node's per-input counts behind its diagnostics (loss by header.seq gaps).
+catkin_add_gtest(test_input_health unit/test_input_health.cpp)
+target_link_libraries(test_input_health joint_load_estimator_ros gtest_main)
+# The settings and process_bag with force plates.
+catkin_add_gtest(test_plates_offline unit/test_plates_offline.cpp)
+target_link_libraries(test_plates_offline joint_load_estimator_ros ${catkin_LIBRARIES} gtest_main)
+target_compile_definitions(test_plates_offline PRIVATE
+  JLE_ROSTEST_DIR="${JLE_ROSTEST_DIR}"
+  JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>")
+add_dependencies(test_plates_offline process_bag)
