@@ -44,7 +44,7 @@ const char* const kUsage =
     R"(usage: make_gait_bag --urdf BODY.urdf --output OUT.bag [--strides 3] [--noise 0]
                      [--seed 1]
 
-Writes a bag of a body walking at 1.2 m/s over two force plates (lanes side by side:
+Writes a bag of a body walking at 1.1 m/s over two force plates (lanes side by side:
 plate 1 under the right foot, plate 2 under the left; each foot lands on its own plate
 at every step), for the gait demo (docs/gait_demo.md):
   /joint_states         sensor_msgs/JointState, 200 Hz, positions of every coordinate
@@ -64,16 +64,16 @@ stamped t0 + i / rate (t0 = 1000 s); bag time = stamp for the joint states, stam
 ms for the poses and the plates (a reader in time order has the pose and the plate
 samples of an instant before its joint state).
 
-The trial (gait time g = t + 0.33 s, stride T = 1.1 s, w = 2 pi / T; the right heel
+The trial (gait time g = t + 0.36 s, stride T = 1.2 s, w = 2 pi / T; the right heel
 strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
-  pelvis  x = 1.2 g - 0.016 sin(2w (g - 0.3T)) + dx(g), y = -0.03 cos(w (g - 0.3T)) + dy(g),
+  pelvis  x = 1.1 g - 0.016 sin(2w (g - 0.3T)) + dx(g), y = -0.03 cos(w (g - 0.3T)) + dy(g),
           z = z0 + 0.02 cos(2w (g - 0.3T)), yaw = 0.07 cos(w g), roll = -0.05 sin(w g)
           (z0 = the standing height of the pelvis minus 0.06 m); dx, dy: Fourier series
           of period T, 20 harmonics, solved (12 relaxed fixed-point steps, each harmonic
           scaled by the inverted pendulum's 1 / (1 + (z_com / g) (k w)^2)) so that the
           centre of pressure of the model's inverse dynamics follows the plan:
   centre of pressure  single support: along the stance footprint from the heel (10 %)
-          to the toe (45 %) by a quintic smooth step, then at the toe; double support:
+          to the toe (40 %) by a quintic smooth step, then at the toe; double support:
           from the trailing toe to the leading heel by the split's smooth step
   feet    heel rocker (0 - 10 %: the foot turns down about the heel from 15 deg toe
           up), foot flat (10 - 35 %), toe rocker (35 - 60 %: the heel rises, the foot
@@ -120,8 +120,8 @@ constexpr std::int64_t kEpochNs = 1000000000000LL;  // t0 = 1000 s
 constexpr double kGravity = 9.80665;
 
 // The trial's parameters (kUsage).
-constexpr double kSpeed = 1.2;        // [m/s]
-constexpr double kStride = 1.1;       // [s]
+constexpr double kSpeed = 1.1;        // [m/s]
+constexpr double kStride = 1.2;       // [s]
 constexpr double kStartPhase = 0.3;   // the trial starts at 30 % of the right cycle
 constexpr double kHeelRocker = 0.10;  // end of the heel rocker, fraction of T
 constexpr double kHeelOff = 0.35;     // start of the toe rocker
@@ -140,8 +140,8 @@ constexpr double kJointRate = 200.0;   // [Hz]
 constexpr int kPlateDivisor = 5;       // plate samples per joint sample (1 kHz)
 constexpr int kDisplayDivisor = 10;    // plate samples per display sample (100 Hz)
 constexpr double kLaneWidth = 0.4;     // [m] each plate's width (y)
-constexpr int kHarmonics = 20;         // of the pelvis path's correction (18 Hz)
-constexpr double kCopArrival = 0.45;   // the centre of pressure reaches the toe (of T)
+constexpr int kHarmonics = 20;         // of the pelvis path's correction (17 Hz)
+constexpr double kCopArrival = 0.40;   // the centre of pressure reaches the toe (of T)
 constexpr int kPelvisIterations = 12;  // of solvePelvis
 constexpr double kRelaxation = 0.7;    // of its steps
 
