@@ -250,6 +250,13 @@ Config filterConfig(const std::string& name) {
 void filterBank(benchmark::State& state, const std::string& name) {
   runBank<jle::DifferentiatorBank>(state, filterConfig<jle::DifferentiatorConfig>(name));
 }
+// The Kalman smoother (differentiator/lag 0.1 s: 100 samples at 1 kHz), the defaults
+// otherwise: its cost beside filterBank/kalman_cj's in the same run.
+void smootherBank(benchmark::State& state) {
+  jle::DifferentiatorConfig c;
+  c.lag = 0.1;
+  runBank<jle::DifferentiatorBank>(state, c);
+}
 void legacyFilterBank(benchmark::State& state, const std::string& name) {
   runBank<jle_legacy_filter::DifferentiatorBank>(
       state, filterConfig<jle_legacy_filter::DifferentiatorConfig>(name));
@@ -473,5 +480,6 @@ JLE_FILTER(kalman_ca);
 JLE_FILTER(savitzky_golay_9);
 JLE_FILTER(finite_difference);
 JLE_FILTER(adaptive);
+BENCHMARK(smootherBank)->Arg(6)->Arg(7)->Arg(19)->Arg(50);
 
 BENCHMARK_MAIN();

@@ -569,19 +569,18 @@ class DifferentiatorBank {
     const double* start = filtered_.col(newest % ring_size_).data();
     for (int i = 0; i < N * channels_; ++i) back[i] = start[i];
     if (newest <= last) writeSmoothed<N>(newest, back);
+    // The states of all the channels as N x channels matrices, a fixed-size product per
+    // channel (no temporary on the heap).
+    using States = Eigen::Map<Eigen::Matrix<double, N, Eigen::Dynamic>>;
+    using ConstStates = Eigen::Map<const Eigen::Matrix<double, N, Eigen::Dynamic>>;
+    States x(back, N, channels_);
     for (int t = newest - 1; t >= oldest; --t) {
-      const double* f = filtered_.col(t % ring_size_).data();
-      const double* p = predicted_.col((t + 1) % ring_size_).data();
-      const double* g = gains_.col(t % ring_size_).data();  // column-major N x N
+      const ConstStates f(filtered_.col(t % ring_size_).data(), N, channels_);
+      const ConstStates p(predicted_.col((t + 1) % ring_size_).data(), N, channels_);
+      const Eigen::Map<const Eigen::Matrix<double, N, N>> g(gains_.col(t % ring_size_).data());
       for (int c = 0; c < channels_; ++c) {
-        double d[N], s[N];
-        for (int i = 0; i < N; ++i) d[i] = back[N * c + i] - p[N * c + i];
-        for (int i = 0; i < N; ++i) {
-          double v = f[N * c + i];
-          for (int j = 0; j < N; ++j) v += g[N * j + i] * d[j];
-          s[i] = v;
-        }
-        for (int i = 0; i < N; ++i) back[N * c + i] = s[i];
+        const Eigen::Matrix<double, N, 1> d = x.col(c) - p.col(c);
+        x.col(c).noalias() = f.col(c) + g * d;
       }
       if (t <= last) writeSmoothed<N>(t, back);
     }
