@@ -70,7 +70,7 @@ constexpr double kStaticAcceleration = 0.5;  // [rad/s^2]
 
 struct Differentiator {
   std::string label;   // e.g. "SG w9 o2 centred"
-  std::string family;  // fd, sg, kalman_ca, kalman_cj
+  std::string family;  // fd, sg, kalman_ca, kalman_cj, kalman_cj_smooth
   jle::DifferentiatorConfig config;
   /// Kalman: the measurement noise as configured [rad]; 0: the scene's (the encoder's
   /// count / sqrt(12) and noise, what a user who knows the encoder would set).
@@ -107,6 +107,7 @@ void addZeroPhase(bool quick, std::vector<Differentiator>& out) {
 }
 
 void addKalman(bool quick, std::vector<Differentiator>& out);
+void addSmoothers(bool quick, std::vector<Differentiator>& out);
 
 std::vector<Differentiator> differentiators(bool quick) {
   std::vector<Differentiator> out;
@@ -202,6 +203,29 @@ void addKalman(bool quick, std::vector<Differentiator>& out) {
             {label, ca ? "kalman_ca" : "kalman_cj", c, defaults.measurement_noise, false, {}});
       }
   }
+  addSmoothers(quick, out);
+}
+
+// The constant-jerk Kalman smoother (differentiator/lag) with the default's measurement
+// noise (untuned: what a user who sets only the lag runs), over lags and process noises.
+void addSmoothers(bool quick, std::vector<Differentiator>& out) {
+  const jle::DifferentiatorConfig defaults;
+  const std::vector<double> qs =
+      quick ? std::vector<double>{1e2} : std::vector<double>{1e2, 1e3, 1e4};
+  const std::vector<double> lags =
+      quick ? std::vector<double>{0.1} : std::vector<double>{0.02, 0.05, 0.1, 0.2};
+  for (double q : qs)
+    for (double lag : lags) {
+      jle::DifferentiatorConfig c;
+      c.type = jle::DifferentiatorType::kKalman;
+      c.kalman_model = jle::KalmanModel::kConstantJerk;
+      c.process_noise = q;
+      c.lag = lag;
+      char label[64];
+      std::snprintf(label, sizeof label, "KS-CJ q=%.0e lag=%.0fms r=%.0e", q, 1e3 * lag,
+                    defaults.measurement_noise);
+      out.push_back({label, "kalman_cj_smooth", c, defaults.measurement_noise, false, {}});
+    }
 }
 
 struct SavingsVariant {
@@ -807,6 +831,14 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
       continue;
     out.index.push_back(readingOf(scene, pipeline.record().stamp));
     out.newest.push_back(j.stamp);
+    recordLoads(pipeline.estimator().data(), segments, out);
+    out.qdd.col(published++) = pipeline.estimator().qdd();
+    if (pipeline.estimator().lastWasPlanar()) ++out.planar_published;
+  }
+  // The end of the stream: a smoother's last samples (Pipeline::flush).
+  while (n > 0 && pipeline.flush()) {
+    out.index.push_back(readingOf(scene, pipeline.record().stamp));
+    out.newest.push_back(r.joints.back().stamp);
     recordLoads(pipeline.estimator().data(), segments, out);
     out.qdd.col(published++) = pipeline.estimator().qdd();
     if (pipeline.estimator().lastWasPlanar()) ++out.planar_published;

@@ -29,6 +29,7 @@ FAMILY_NAMES = {
     "sg centred": "Savitzky-Golay centred",
     "kalman_ca": "Kalman const. acceleration",
     "kalman_cj": "Kalman const. jerk",
+    "kalman_cj_smooth": "Kalman smoother const. jerk (lag)",
     "adaptive": "adaptive (Kalman bank)",
     "zero_phase": "zero-phase Butterworth (offline)",
 }
@@ -40,6 +41,7 @@ COLOURS = {
     "sg centred": "tab:green",
     "kalman_ca": "tab:blue",
     "kalman_cj": "tab:purple",
+    "kalman_cj_smooth": "tab:pink",
     "adaptive": "tab:olive",
 }
 NUMERIC = [
@@ -280,8 +282,8 @@ def per_rate_section(rows, scenes):
 def losses_section(rows, scenes):
     """Per scene and family: the family's best RMS effort error over the scene's best
     (online or offline), and its overshoot; > 2 is where the family loses."""
-    families = ["default", "fd", "sg causal", "sg centred", "kalman_ca", "kalman_cj", "adaptive",
-                OFFLINE]
+    families = ["default", "fd", "sg causal", "sg centred", "kalman_ca", "kalman_cj",
+                "kalman_cj_smooth", "adaptive", OFFLINE]
     body = []
     for s in scored_scenes(scenes):
         every = overall(rows, s, precision="double") + overall(rows, s, precision="double", offline=True)

@@ -250,6 +250,13 @@ Config filterConfig(const std::string& name) {
 void filterBank(benchmark::State& state, const std::string& name) {
   runBank<jle::DifferentiatorBank>(state, filterConfig<jle::DifferentiatorConfig>(name));
 }
+// The Kalman smoother (differentiator/lag 0.1 s: 100 samples at 1 kHz), the defaults
+// otherwise: its cost beside filterBank/kalman_cj's in the same run.
+void smootherBank(benchmark::State& state) {
+  jle::DifferentiatorConfig c;
+  c.lag = 0.1;
+  runBank<jle::DifferentiatorBank>(state, c);
+}
 void legacyFilterBank(benchmark::State& state, const std::string& name) {
   runBank<jle_legacy_filter::DifferentiatorBank>(
       state, filterConfig<jle_legacy_filter::DifferentiatorConfig>(name));
@@ -361,6 +368,14 @@ void fullStep(benchmark::State& state, const std::string& file) {
   runEstimator(state, file, jle::EstimatorConfig(), false);
 }
 
+// The same with the Kalman smoother (differentiator/lag 0.1 s, 100 samples at 1 kHz):
+// its cost beside the causal filter's (the defaults') in the same run.
+void fullStepSmoother(benchmark::State& state, const std::string& file) {
+  jle::EstimatorConfig config;
+  config.differentiator.lag = 0.1;
+  runEstimator(state, file, config, false);
+}
+
 }  // namespace
 
 // Savings: each switched off (or on) against the defaults, where it applies and where
@@ -436,7 +451,8 @@ BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/pa
   BENCHMARK_CAPTURE(coreDouble, name, file);      \
   BENCHMARK_CAPTURE(coreDoubleWorld, name, file); \
   BENCHMARK_CAPTURE(legacyDouble, name, file);    \
-  BENCHMARK_CAPTURE(fullStep, name, file)
+  BENCHMARK_CAPTURE(fullStep, name, file);        \
+  BENCHMARK_CAPTURE(fullStepSmoother, name, file)
 JLE_PASSES(panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",
                   "panda_hand_tcp");
@@ -464,5 +480,6 @@ JLE_FILTER(kalman_ca);
 JLE_FILTER(savitzky_golay_9);
 JLE_FILTER(finite_difference);
 JLE_FILTER(adaptive);
+BENCHMARK(smootherBank)->Arg(6)->Arg(7)->Arg(19)->Arg(50);
 
 BENCHMARK_MAIN();

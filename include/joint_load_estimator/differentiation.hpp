@@ -8,6 +8,7 @@
 #include <joint_load_estimator/bandwidth_selection.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Householder>
 
@@ -50,6 +51,13 @@ struct DifferentiatorConfig {
   KalmanModel kalman_model = KalmanModel::kConstantJerk;
   double process_noise = 1e4;
   double measurement_noise = 1e-4;
+  /// Kalman: delay [s] of the smoothed estimate behind the newest sample (0: the causal
+  /// filter). With lag > 0 the filter runs forward as with 0, and every B samples a
+  /// Rauch-Tung-Striebel backward pass over its remembered states smooths the next B
+  /// estimates with the data that followed them: the estimate describes the sample
+  /// D = round(lag / h) before the newest (h: the first interval after a start), from
+  /// D - B + 1 .. D samples after it (B = D / 2; about two backward steps per sample).
+  double lag = 0.0;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
   /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
   /// noise [unit] if known (0: estimated online from the innovations), and the time
@@ -67,6 +75,7 @@ struct DifferentiatorConfig {
 /// config.hpp); throws std::invalid_argument naming the parameter as config/default.yaml
 /// spells it ("parameter 'differentiator/order' must be 2..5 ...").
 inline void validate(const DifferentiatorConfig& c) {
+  constexpr double kMaxLag = 10.0;  // [s] a smoother's delay: beyond it, an offline job
   const auto fail = [](const char* key, const std::string& what) {
     throw std::invalid_argument(std::string("parameter 'differentiator/") + key + "' " + what);
   };
@@ -78,12 +87,16 @@ inline void validate(const DifferentiatorConfig& c) {
     if (!(c.noise >= 0.0) || !std::isfinite(c.noise))
       fail("noise", "must be finite and >= 0 (0: estimated online)");
     if (!(c.memory > 0.0) || !std::isfinite(c.memory)) fail("memory", "must be finite and > 0 [s]");
+    if (c.lag != 0.0) fail("lag", "applies to type kalman only (it must be 0)");
   } else if (c.type == DifferentiatorType::kKalman) {
     if (!(c.process_noise > 0.0) || !std::isfinite(c.process_noise))
       fail("process_noise", "must be finite and > 0");
     if (!(c.measurement_noise > 0.0) || !std::isfinite(c.measurement_noise))
       fail("measurement_noise", "must be finite and > 0");
+    if (!(c.lag >= 0.0) || !(c.lag <= kMaxLag))
+      fail("lag", "must be 0..10 [s] (0: the causal filter)");
   } else {
+    if (c.lag != 0.0) fail("lag", "applies to type kalman only (it must be 0)");
     if (c.order < 2 || c.order > 5)
       fail("order", "must be 2..5 (a second derivative needs a quadratic), it is " +
                         std::to_string(c.order));
@@ -126,6 +139,7 @@ class DifferentiatorBank {
       P_.setZero(n_, n_);
       innovation_.setZero(channels_);
       if (config_.type == DifferentiatorType::kAdaptive) buildModels();
+      if (smoothing()) allocateRing(1);
     } else {
       n_ = config_.order + 1;
       coeff_.setZero(3, config_.window);
@@ -138,11 +152,50 @@ class DifferentiatorBank {
 
   const DifferentiatorConfig& config() const { return config_; }
   int channels() const { return channels_; }
-  /// Samples needed after a reset before the first estimate.
-  int warmup() const { return isKalman() ? n_ : config_.window; }
+  /// Samples needed after a reset before the first estimate (a smoother: known once its
+  /// delay is, after the second sample; before, that of the causal filter).
+  int warmup() const {
+    if (smoothing()) return std::max(n_, delay_ + 1);
+    return isKalman() ? n_ : config_.window;
+  }
+  /// Samples the estimate describes behind the newest: Savitzky-Golay's `delay`, a
+  /// smoother's D (0 before its second sample), 0 for the causal filters.
+  int delaySamples() const { return smoothing() ? delay_ : config_.delay; }
+  /// Smoother: samples taken and not yet estimated. finish() smooths them with the data
+  /// there is, after which each call of next() (true while one is left) makes the
+  /// oldest of them the estimate (stamp(), value(), ...): the end of a stream. update()
+  /// after finish() is a fresh start. A gap (max_gap) smooths the samples before it
+  /// alike, and they are the estimates of the first samples after it, in their order
+  /// (the restarted smoother has none yet): every sample is estimated once.
+  int pending() const {
+    const int own = smoothing() && count_ > 0 ? index_ + 1 - emitted_ : 0;
+    return own + carry_count_ - carry_next_;
+  }
+  void finish() {
+    if (finishing_ || !smoothing()) return;
+    if (count_ > 0 && emitted_ <= index_) smoothBack(index_, emitted_, index_);
+    finishing_ = true;
+  }
+  bool next() {
+    if (!finishing_) return false;
+    if (emitCarry()) return true;
+    if (count_ == 0 || emitted_ > index_) return false;
+    emitSmoothed();
+    return true;
+  }
 
   void reset() {
+    carry_count_ = carry_next_ = 0;
+    resetFilter();
+  }
+
+ private:
+  void resetFilter() {
     count_ = 0;
+    index_ = -1;
+    emitted_ = 0;
+    finishing_ = false;
+    delay_ = 0;
     head_ = 0;
     if (!isKalman()) tau_prev_.setConstant(std::nan(""));
     dt_prev_ = -1.0;  // a restarted filter is a fresh one, to the bit: no cached F, Q
@@ -150,6 +203,42 @@ class DifferentiatorBank {
     selection_.reset();
   }
 
+  // A gap: the smoother's pending estimates (and those still carried) into the carry,
+  // and a fresh filter.
+  void restart() {
+    if (smoothing() && pending() > 0) {
+      finish();
+      const int left = carry_count_ - carry_next_;
+      for (int k = 0; k < left; ++k) {
+        carry_.col(k) = carry_.col(carry_next_ + k);
+        carry_times_[k] = carry_times_[carry_next_ + k];
+      }
+      carry_count_ = left;
+      carry_next_ = 0;
+      const int total = left + (count_ > 0 ? index_ + 1 - emitted_ : 0);
+      if (carry_.cols() < total) {
+        carry_.conservativeResize(3 * channels_, total);
+        carry_times_.conservativeResize(total);
+      }
+      while (count_ > 0 && emitted_ <= index_) {
+        emitSmoothed();
+        carry_.col(carry_count_) = Eigen::Map<const Eigen::VectorXd>(out_.data(), 3 * channels_);
+        carry_times_[carry_count_++] = stamp_;
+      }
+    }
+    resetFilter();
+  }
+
+  // The oldest carried estimate, if any, as the estimate.
+  bool emitCarry() {
+    if (carry_next_ >= carry_count_) return false;
+    out_ = Eigen::Map<const Eigen::MatrixXd>(carry_.col(carry_next_).data(), 3, channels_);
+    stamp_ = carry_times_[carry_next_++];
+    if (carry_next_ == carry_count_) carry_count_ = carry_next_ = 0;
+    return true;
+  }
+
+ public:
   /// Adaptive: the bandwidth [Hz] of the filter in use, and the position noise's
   /// standard deviation [unit] of channel c it assumes (estimated or given; 0 before the
   /// first estimate).
@@ -163,10 +252,11 @@ class DifferentiatorBank {
   /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.
   /// Throws std::invalid_argument if t does not increase (the caller's duty).
   bool update(double t, const double* x) {
+    if (finishing_) reset();
     if (count_ > 0) {
       const double dt = t - last_time_;
       if (!(dt > 0.0)) throw std::invalid_argument("differentiator: sample time does not increase");
-      if (dt > config_.max_gap) reset();
+      if (dt > config_.max_gap) restart();
     }
     last_time_ = t;
     if (config_.type == DifferentiatorType::kKalman) return updateKalman(t, x);
@@ -195,6 +285,8 @@ class DifferentiatorBank {
   /// after which it is kept (cached) while dt and the gain stay. Adaptive: the selected
   /// filter's (pooled over the channels: the selection is common to the bank), which is
   /// exact for the filter that made the estimate, restarts from another one included.
+  /// A smoother (lag > 0): its forward filter's at the newest sample, not the smoothed
+  /// estimate's (which uses the samples after it too; not computed).
   Eigen::Matrix3d noiseGain() const {
     if (config_.type == DifferentiatorType::kAdaptive)
       return models_[selection_.selected()].noiseGain();
@@ -208,6 +300,8 @@ class DifferentiatorBank {
   }
 
  private:
+  bool smoothing() const { return config_.lag > 0.0; }
+
   bool isKalman() const {
     return config_.type == DifferentiatorType::kKalman ||
            config_.type == DifferentiatorType::kAdaptive;
@@ -378,7 +472,7 @@ class DifferentiatorBank {
     const int n = n_;
     if (count_ == 0) {
       startKalman(t, x);
-      return false;
+      return smoothing() && emitCarry();
     }
     const double dt = t - prev_t_;
     prev_t_ = t;
@@ -390,13 +484,120 @@ class DifferentiatorBank {
     if (!steady) updateKalmanGain();
     // Noise gain: kept once it no longer changes under a settled gain.
     if (!(steady && noise_settled_)) updateNoiseGain(steady);
+    double* predicted = nullptr;
+    if (smoothing()) {
+      if (index_ == 0) startSmoother(dt);
+      predicted = rememberGain();
+    }
     if (n == 3)
-      kalmanChannels<3>(x);
+      kalmanChannels<3>(x, predicted);
     else
-      kalmanChannels<4>(x);
+      kalmanChannels<4>(x, predicted);
     stamp_ = t;
     if (count_ < n) ++count_;
+    if (smoothing()) return smoothStep(t);
     return count_ >= n;
+  }
+
+  // Smoother: its delay from the first interval dt [s], and the ring of the forward
+  // filter's states, predictions and backward gains over the D + 1 newest samples
+  // (allocated only when a restart needs more than the last start did).
+  void startSmoother(double dt) {
+    // At least n samples after the oldest estimated: the state is observable.
+    // And no fewer than the estimates carried over a gap, the first ones it makes.
+    delay_ = std::max(n_, static_cast<int>(std::lround(config_.lag / dt)));
+    delay_ = std::max(delay_, carry_count_);
+    block_ = delay_ / 2;
+    ring_size_ = delay_ + 1;
+    if (filtered_.cols() < ring_size_) allocateRing(ring_size_);
+  }
+
+  // The ring's columns; the first sample's (slot 0) is kept.
+  void allocateRing(int size) {
+    const Eigen::Index states = static_cast<Eigen::Index>(n_) * channels_;
+    filtered_.conservativeResize(states, size);
+    predicted_.conservativeResize(states, size);
+    smoothed_.conservativeResize(3 * channels_, size);
+    gains_.conservativeResize(n_ * n_, size);
+    ring_times_.conservativeResize(size);
+    back_.resize(states);
+    if (carry_.cols() < size) {
+      carry_.conservativeResize(3 * channels_, size);
+      carry_times_.conservativeResize(size);
+    }
+  }
+
+  // The backward gain G_(k-1) = P_(k-1|k-1) F_k^T P_(k|k-1)^-1 of the sample before this
+  // one into the ring (computed with the filter's gain, kept while it is settled), and
+  // where this sample's prediction goes.
+  double* rememberGain() {
+    const int slot = (index_ + 1) % ring_size_;
+    gains_.col((index_) % ring_size_) =
+        Eigen::Map<const Eigen::VectorXd>(backward_gain_.data(), n_ * n_);
+    return predicted_.col(slot).data();
+  }
+
+  // After the forward step of sample index_ + 1 (time t): its state into the ring; every
+  // B samples once D are there the backward pass, then the estimate of the sample D
+  // before the newest.
+  bool smoothStep(double t) {
+    ++index_;  // the sample whose forward step was just taken
+    const int slot = index_ % ring_size_;
+    filtered_.col(slot) =
+        Eigen::Map<const Eigen::VectorXd>(state_.data(), static_cast<Eigen::Index>(n_) * channels_);
+    ring_times_[slot] = t;
+    if (index_ < delay_) return emitCarry();
+    if ((index_ - delay_) % block_ == 0)
+      smoothBack(index_, index_ - delay_, index_ - delay_ + block_ - 1);
+    emitSmoothed();
+    return true;
+  }
+
+  // Rauch-Tung-Striebel from sample `newest` (the filtered state) back to `oldest`:
+  // x_s(t) = x_f(t) + G_t (x_s(t+1) - x_p(t+1)); value, rate and accel of every
+  // sample from oldest to last into the ring smoothed_.
+  void smoothBack(int newest, int oldest, int last) {
+    if (n_ == 3)
+      smoothChannels<3>(newest, oldest, last);
+    else
+      smoothChannels<4>(newest, oldest, last);
+  }
+
+  template <int N>
+  void smoothChannels(int newest, int oldest, int last) {
+    double* back = back_.data();
+    const double* start = filtered_.col(newest % ring_size_).data();
+    for (int i = 0; i < N * channels_; ++i) back[i] = start[i];
+    if (newest <= last) writeSmoothed<N>(newest, back);
+    // The states of all the channels as N x channels matrices, a fixed-size product per
+    // channel (no temporary on the heap).
+    using States = Eigen::Map<Eigen::Matrix<double, N, Eigen::Dynamic>>;
+    using ConstStates = Eigen::Map<const Eigen::Matrix<double, N, Eigen::Dynamic>>;
+    States x(back, N, channels_);
+    for (int t = newest - 1; t >= oldest; --t) {
+      const ConstStates f(filtered_.col(t % ring_size_).data(), N, channels_);
+      const ConstStates p(predicted_.col((t + 1) % ring_size_).data(), N, channels_);
+      const Eigen::Map<const Eigen::Matrix<double, N, N>> g(gains_.col(t % ring_size_).data());
+      for (int c = 0; c < channels_; ++c) {
+        const Eigen::Matrix<double, N, 1> d = x.col(c) - p.col(c);
+        x.col(c).noalias() = f.col(c) + g * d;
+      }
+      if (t <= last) writeSmoothed<N>(t, back);
+    }
+  }
+
+  template <int N>
+  void writeSmoothed(int t, const double* back) {
+    double* out = smoothed_.col(t % ring_size_).data();
+    for (int c = 0; c < channels_; ++c)
+      for (int i = 0; i < 3; ++i) out[3 * c + i] = back[N * c + i];
+  }
+
+  void emitSmoothed() {
+    const int slot = emitted_ % ring_size_;
+    out_ = Eigen::Map<const Eigen::MatrixXd>(smoothed_.col(slot).data(), 3, channels_);
+    stamp_ = ring_times_[slot];
+    ++emitted_;
   }
 
   // The first sample: the state starts at the measurement, at rest, with a wide prior on
@@ -417,6 +618,14 @@ class DifferentiatorBank {
     prev_t_ = t;
     count_ = 1;
     stamp_ = t;
+    if (smoothing()) {
+      index_ = 0;
+      emitted_ = 0;
+      ring_size_ = 1;
+      filtered_.col(0) = Eigen::Map<const Eigen::VectorXd>(
+          state_.data(), static_cast<Eigen::Index>(n_) * channels_);
+      ring_times_[0] = t;
+    }
     out_.topRows(std::min(3, n)) = state_.topRows(std::min(3, n));
   }
 
@@ -452,7 +661,10 @@ class DifferentiatorBank {
   void updateKalmanGain() {
     const SmallMatrix& F = F_;
     const SmallMatrix& Q = Q_;
-    P_ = F * P_ * F.transpose() + Q;
+    const SmallMatrix FP = F * P_;  // F P_(k-1|k-1)
+    P_ = FP * F.transpose() + Q;
+    // Smoother: G = P_(k-1|k-1) F^T P_(k|k-1)^-1, as G^T = P_(k|k-1)^-1 F P_(k-1|k-1).
+    if (smoothing()) backward_gain_ = P_.ldlt().solve(FP).transpose();
     const double r2 = config_.measurement_noise * config_.measurement_noise;
     const double S = P_(0, 0) + r2;
     innovation_variance_ = S / r2;
@@ -481,7 +693,7 @@ class DifferentiatorBank {
   // chain is upper triangular with F(i, i + d) = dt^d / d!: the products by its zeros
   // and ones are skipped, the other terms added in the full product's order.
   template <int N>
-  void kalmanChannels(const double* x) {
+  void kalmanChannels(const double* x, double* predicted) {
     double f[N], k[N];
     for (int d = 0; d < N; ++d) {
       f[d] = F_(0, d);
@@ -497,6 +709,8 @@ class DifferentiatorBank {
         for (int j = i + 1; j < N; ++j) v += f[j - i] * state[j];
         s[i] = v;
       }
+      if (predicted)
+        for (int i = 0; i < N; ++i) predicted[N * c + i] = s[i];
       const double e = x[c] - s[0];
       innovation[c] = e;
       for (int i = 0; i < N; ++i) state[i] = s[i] + k[i] * e;
@@ -509,6 +723,27 @@ class DifferentiatorBank {
   int n_ = 3;
   int count_ = 0;
   int head_ = 0;
+  // Smoother: index of the newest sample since the start (-1: none), of the next to
+  // estimate, whether finish() was called; D, B and the ring's length (D + 1).
+  int index_ = -1;
+  int emitted_ = 0;
+  bool finishing_ = false;
+  int delay_ = 0;
+  int block_ = 1;
+  int ring_size_ = 1;
+  SmallMatrix backward_gain_;
+  // Per remembered sample (column: slot index % ring_size_): the filtered state
+  // (n x channels, channel-major), the prediction before its measurement, the backward
+  // gain to the next sample (n x n column-major), the smoothed (value, rate, accel) x
+  // channels, and its time [s]; back_: the backward pass's running state.
+  Eigen::MatrixXd filtered_, predicted_, gains_, smoothed_;
+  Eigen::VectorXd ring_times_, back_;
+  // Smoother: estimates made at a gap from the samples before it, (value, rate, accel)
+  // x channels per column, their times [s], how many, and the next to publish.
+  Eigen::MatrixXd carry_;
+  Eigen::VectorXd carry_times_;
+  int carry_count_ = 0;
+  int carry_next_ = 0;
   double last_time_ = 0.0;
   double stamp_ = 0.0;
   double prev_t_ = 0.0;

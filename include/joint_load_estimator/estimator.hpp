@@ -72,6 +72,12 @@ class Estimator {
   /// Forgets all history (a backward jump of time).
   void reset();
 
+  /// The end of a stream: with a smoother (differentiator/lag > 0) the samples taken and
+  /// not yet estimated are smoothed with the data there is; each call takes the next of
+  /// them as addJointSample would have (status: kPublished, kDecimated or kStale) and
+  /// returns true, false when none is left. Nothing to do for a causal filter.
+  bool flush(SampleStatus& status);
+
   /// Live tuning (the node's ~reconfigure). `decimation` (>= 1) applies in place: the
   /// filters and the decimation phase are kept, so the loads are those of an estimator
   /// started with it (exact). A `differentiator` other than the current one replaces
@@ -133,8 +139,11 @@ class Estimator {
   /// distal side exerts on its surroundings beyond what the model and the other inputs
   /// explain (e.g. a tool pushing on a surface), or a sensor bias. Zero when unused.
   Wrench<double> sensorResidual(int k) const;
-  /// Nominal delay of the estimate behind the newest sample, in samples.
-  int delaySamples() const { return bank_.config().delay; }
+  /// Samples taken and not yet estimated (a smoother's; flush()).
+  int pendingSamples() const { return bank_.pending(); }
+  /// Nominal delay of the estimate behind the newest sample, in samples (a smoother's:
+  /// known from its second sample on).
+  int delaySamples() const { return bank_.delaySamples(); }
   /// Segments whose loads are computed (all, or what the wanted joints need).
   const std::vector<int>& dynamicsSegments() const { return dynamics_segments_; }
   /// Whether wrench input k acts on a segment whose loads are computed.
@@ -186,6 +195,7 @@ class Estimator {
   // A joint sample: its checks (false: refused, and why), the bank's channels, the estimate.
   bool accept(double t, const double* q, const BasePose* base, SampleStatus& refused);
   void fillChannels(double t, const double* q, const BasePose* base);
+  SampleStatus publish();
   BaseState<double> readEstimate();
   // savings.reuse_unchanged: whether the filtered inputs are those of the last computation
   // (then recorded for the next sample).

@@ -151,6 +151,11 @@ class Pipeline {
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
                        const std::vector<double>& position, const std::vector<double>& velocity,
                        const std::vector<double>& effort);
+  /// The end of a stream (process_bag, joint_loads, a replay's last message): with a
+  /// smoother (differentiator/lag > 0) the joint states whose loads are still to come are
+  /// smoothed with the data there is; each call that returns true puts the next one's
+  /// loads in record(), false when none is left (each was counted when it came).
+  bool flush();
   /// A wrench of input k (settings.wrenches[k]) as the message carries it: force [N]
   /// and torque [N m] in `frame_id` (the configured frame, when set, wins), moment about
   /// its origin. Its stamp follows the rules of README, "Time stamps": stamp 0, and a
@@ -256,6 +261,7 @@ class Pipeline {
   Outcome sample(Stamp stamp, bool has_effort, const BasePose* base);
   Outcome staleProblem();
   void remember(double t, Stamp stamp, bool has_effort);
+  void growRing(std::size_t size);
   bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord();

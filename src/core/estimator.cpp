@@ -180,9 +180,9 @@ namespace {
 bool sameDifferentiator(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
   return a.type == b.type && a.window == b.window && a.order == b.order && a.delay == b.delay &&
          a.kalman_model == b.kalman_model && a.process_noise == b.process_noise &&
-         a.measurement_noise == b.measurement_noise && a.min_bandwidth == b.min_bandwidth &&
-         a.max_bandwidth == b.max_bandwidth && a.noise == b.noise && a.memory == b.memory &&
-         a.max_gap == b.max_gap;
+         a.measurement_noise == b.measurement_noise && a.lag == b.lag &&
+         a.min_bandwidth == b.min_bandwidth && a.max_bandwidth == b.max_bandwidth &&
+         a.noise == b.noise && a.memory == b.memory && a.max_gap == b.max_gap;
 }
 
 }  // namespace
@@ -234,6 +234,18 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
     covariance_.history = 0;  // the filter restarts: its noise gain too (uncertainty.period)
     return SampleStatus::kWarmingUp;
   }
+  return publish();
+}
+
+bool Estimator::flush(SampleStatus& status) {
+  bank_.finish();
+  if (!bank_.next()) return false;
+  status = publish();
+  return true;
+}
+
+// The loads of the bank's estimate (a sample taken now, or earlier for a delayed one).
+inline SampleStatus Estimator::publish() {
   if (sample_count_++ % config_.decimation != 0) return SampleStatus::kDecimated;
   for (const WrenchInput& input : inputs_)
     if (input.samples.stopped()) return SampleStatus::kStale;

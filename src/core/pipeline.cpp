@@ -13,7 +13,9 @@
 namespace jle {
 namespace {
 
-constexpr std::size_t kRing = 128;  // joint samples remembered: more than any filter's delay
+// Joint samples remembered (to publish a delayed estimate with its own stamp): more than
+// any Savitzky-Golay delay; a smoother grows the ring to its own (remember()).
+constexpr std::size_t kRing = 128;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr Stamp kReach = Stamp{1} << 52;  // [ns] of the time axis around its origin
 
@@ -460,6 +462,17 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   return count(kind, Outcome::kPublished);
 }
 
+bool Pipeline::flush() {
+  SampleStatus status = SampleStatus::kPublished;
+  while (estimator_.flush(status)) {
+    if (status != SampleStatus::kPublished) continue;
+    if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
+    fillRecord();
+    return true;
+  }
+  return false;
+}
+
 std::string Pipeline::stoppingInputs() const {
   // Only the inputs with the stop policy stop the loads; a stale hold or zero input
   // does not.
@@ -489,20 +502,32 @@ Outcome Pipeline::staleProblem() {
 }
 
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
+  // A smoother's delay is known from its second sample; over a gap its carried estimates
+  // add to it: the ring holds twice the delay (grown here, rarely: a new rate).
+  const std::size_t needed = 2 * static_cast<std::size_t>(estimator_.delaySamples()) + 2;
+  if (needed > ring_.size()) growRing(needed);
   Sample& s = ring_[ring_head_];
   s.t = t;
   s.stamp = stamp;
   s.has_effort = has_effort;
   if (has_effort) s.effort = joints_.effort();  // same size: no allocation
-  ring_head_ = (ring_head_ + 1) % kRing;
-  if (ring_count_ < kRing) ++ring_count_;
+  ring_head_ = (ring_head_ + 1) % ring_.size();
+  if (ring_count_ < ring_.size()) ++ring_count_;
+}
+
+void Pipeline::growRing(std::size_t size) {
+  std::vector<Sample> grown(size);
+  for (std::size_t i = 0; i < ring_count_; ++i)  // oldest first
+    grown[i] = ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()];
+  ring_head_ = ring_count_;
+  ring_.swap(grown);
 }
 
 const Pipeline::Sample* Pipeline::sampleAt(double t) const {
   // The estimate's time is one of the samples' own times (the filter's delay is a whole
   // number of samples); half a nanosecond separates it from any other.
   for (std::size_t i = 0; i < ring_count_; ++i) {
-    const Sample& s = ring_[(ring_head_ + kRing - 1 - i) % kRing];
+    const Sample& s = ring_[(ring_head_ + ring_.size() - 1 - i) % ring_.size()];
     if (std::abs(s.t - t) < 0.5e-9) return &s;
   }
   return nullptr;

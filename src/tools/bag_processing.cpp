@@ -261,8 +261,10 @@ void BagProcessor::run() {
     }
   }
   if (progress_shown) std::fputc('\n', stderr);
-  if (pipeline_.counters().count(jle::Outcome::kPublished) == 0)
-    throw std::runtime_error(noLoads());
+  // A smoother's last joint states (differentiator/lag): their loads too, numbered on.
+  long published = pipeline_.counters().count(jle::Outcome::kPublished);
+  for (; pipeline_.flush(); ++published) sink_.write(pipeline_.record(), published);
+  if (published == 0) throw std::runtime_error(noLoads());
   sink_.commit();
   if (options_.summary) summarize(std::chrono::duration<double>(Clock::now() - start).count());
 }

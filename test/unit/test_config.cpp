@@ -76,6 +76,7 @@ TEST(Config, DefaultsAreTheNodes) {
   EXPECT_EQ(d.kalman_model, jle::KalmanModel::kConstantJerk);
   EXPECT_EQ(d.process_noise, 1e4);
   EXPECT_EQ(d.measurement_noise, 1e-4);
+  EXPECT_EQ(d.lag, 0.0);
   EXPECT_EQ(d.max_gap, 0.5);
   EXPECT_EQ(d.min_bandwidth, 0.5);
   EXPECT_EQ(d.max_bandwidth, 50.0);
@@ -235,6 +236,16 @@ TEST(Config, Differentiator) {
         [&](Settings& s) {
           kalman(s);
           s.estimator.differentiator.measurement_noise = kInf;
+        }},
+       {"differentiator/lag",
+        [&](Settings& s) {
+          kalman(s);
+          s.estimator.differentiator.lag = -0.1;
+        }},
+       {"differentiator/lag",
+        [&](Settings& s) {
+          sg(s);
+          s.estimator.differentiator.lag = 0.1;
         }},
        {"differentiator/max_gap", [](Settings& s) { s.estimator.differentiator.max_gap = -1.0; }},
        {"differentiator/min_bandwidth",

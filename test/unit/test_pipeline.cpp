@@ -603,3 +603,39 @@ TEST(Pipeline, StaleStopNamesTheStoppingInputOnly) {
 }
 
 }  // namespace
+
+// The Kalman smoother (differentiator/lag): each joint state's loads once, with its own
+// stamp and measured effort, in order: during the stream with a delay of D samples
+// (100 at 1 kHz: beyond the ring the pipeline starts with), across a gap beyond max_gap
+// (the samples before it published as the first ones after it), and at the end
+// (flush()).
+TEST(Pipeline, SmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  settings.estimator.differentiator.lag = 0.1;
+  jle::Pipeline pipeline(model, settings, nullptr);
+  std::vector<Stamp> sent, published;
+  std::vector<double> measured;
+  const auto take = [&]() {
+    published.push_back(pipeline.record().stamp);
+    measured.push_back(pipeline.record().measured_effort[0]);
+  };
+  for (int k = 0; k < 400; ++k) {
+    // A 0.8 s gap after 150 samples (max_gap: 0.5 s).
+    const Stamp stamp = kStart + k * kMs + (k >= 150 ? 800 * kMs : 0);
+    const double t = 1e-3 * k;
+    std::vector<double> p(6), e(6, 0.0);
+    for (int i = 0; i < 6; ++i) p[static_cast<std::size_t>(i)] = q(i, t);
+    e[0] = k;  // the sample's own number, to pair it with its loads
+    sent.push_back(stamp);
+    if (pipeline.onJointState(stamp, stamp, model.coordinate_names, p, kNone, e) ==
+        Outcome::kPublished)
+      take();
+  }
+  EXPECT_EQ(pipeline.estimator().delaySamples(), 100);
+  EXPECT_EQ(pipeline.estimator().pendingSamples(), 100);
+  while (pipeline.flush()) take();
+  EXPECT_EQ(pipeline.estimator().pendingSamples(), 0);
+  EXPECT_EQ(published, sent);
+  for (std::size_t k = 0; k < measured.size(); ++k) EXPECT_EQ(measured[k], static_cast<double>(k));
+}

@@ -1,0 +1,213 @@
+// The Kalman smoother (differentiator/lag > 0) against a batch estimate written here:
+// the maximum a posteriori states of the same model given every measurement up to the
+// newest its backward pass used, solved as one dense least-squares problem (the normal
+// equations of all the states at once), which is what the Rauch-Tung-Striebel recursion
+// computes in another way. And: every sample is estimated once, across gaps and at the
+// end of a stream.
+#include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/portable_random.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace {
+
+using jle::DifferentiatorBank;
+using jle::DifferentiatorConfig;
+using jle::DifferentiatorType;
+using jle::KalmanModel;
+
+// The integrator chain of n states over dt: transition and integrated white noise of
+// density q on the highest derivative (closed forms).
+Eigen::MatrixXd transition(int n, double dt) {
+  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) F(i, j) = std::pow(dt, j - i) / std::tgamma(j - i + 1);
+  return F;
+}
+
+Eigen::MatrixXd processNoise(int n, double dt, double q) {
+  Eigen::MatrixXd Q(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int a = n - 1 - i, b = n - 1 - j;
+      Q(i, j) =
+          q * std::pow(dt, a + b + 1) / (std::tgamma(a + 1) * std::tgamma(b + 1) * (a + b + 1));
+    }
+  return Q;
+}
+
+// The MAP states 0..last (n x (last + 1)) of one channel: prior N((y0, 0, ..), P0) on
+// state 0 (the filter's start: P0 = diag(r^2, 1e12 r^2, ..)), the model between
+// samples, measurements y_1..y_last of the first state with variance r^2.
+Eigen::MatrixXd batchStates(const std::vector<double>& t, const std::vector<double>& y, int last,
+                            int n, double q, double r) {
+  const int m = n * (last + 1);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m, m);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(m);
+  Eigen::VectorXd p0 = Eigen::VectorXd::Constant(n, 1e12 * r * r);
+  p0[0] = r * r;
+  for (int i = 0; i < n; ++i) H(i, i) += 1.0 / p0[i];
+  b[0] += y[0] / p0[0];
+  for (int k = 0; k < last; ++k) {
+    const double dt = t[static_cast<std::size_t>(k + 1)] - t[static_cast<std::size_t>(k)];
+    // Residual z_(k+1) - F z_k = [-F I] (z_k; z_(k+1)), weight Q^-1.
+    Eigen::MatrixXd J(n, 2 * n);
+    J << -transition(n, dt), Eigen::MatrixXd::Identity(n, n);
+    const Eigen::MatrixXd W = processNoise(n, dt, q).inverse();
+    H.block(n * k, n * k, 2 * n, 2 * n) += J.transpose() * W * J;
+  }
+  for (int k = 1; k <= last; ++k) {
+    H(n * k, n * k) += 1.0 / (r * r);
+    b[n * k] += y[static_cast<std::size_t>(k)] / (r * r);
+  }
+  const Eigen::VectorXd z = H.ldlt().solve(b);
+  return Eigen::Map<const Eigen::MatrixXd>(z.data(), n, last + 1);
+}
+
+struct Stream {
+  std::vector<double> t;
+  std::vector<std::vector<double>> y;  // per channel
+};
+
+// Two channels of a smooth signal with noise at times about `h` apart (+-40% jitter
+// when jitter, the first interval exactly h).
+Stream makeStream(int count, double h, bool jitter) {
+  jle::PortableRandom random(11);
+  Stream s;
+  s.y.resize(2);
+  double now = 2.0;
+  for (int k = 0; k < count; ++k) {
+    s.t.push_back(now);
+    s.y[0].push_back(std::sin(0.2 * now) + 0.05 * random.uniform(-1.0, 1.0));
+    s.y[1].push_back(0.1 * now - std::cos(0.35 * now) + 0.05 * random.uniform(-1.0, 1.0));
+    now += k == 0 || !jitter ? h : h * random.uniform(0.6, 1.4);
+  }
+  return s;
+}
+
+// Runs the stream through the smoother (finish() at the end) and checks each estimate
+// against the batch states given the measurements up to the newest the backward pass
+// that made it used: D + B floor(j / B) for sample j of the stream, all for the ones
+// finish() estimated, from sample check_from on. Tolerance: 1e-8 on values, rates and
+// accelerations of order 1, the rounding of a dense solve of a few hundred states. The
+// first samples differ more (measured: 1.7e-5 at sample 0, below 1e-8 from the 15th):
+// the filter's start, a prior variance of 1e12 r^2 on the derivatives, cancels about
+// 12 digits in its first covariance updates, and that rounding decays with the prior.
+void expectBatch(KalmanModel model, bool jitter, int count, int check_from) {
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kKalman;
+  c.kalman_model = model;
+  c.process_noise = 1.0;
+  c.measurement_noise = 0.5;
+  c.max_gap = 10.0;
+  c.lag = 9.6;  // with h = 1: D = 10 samples, B = 5
+  const int n = model == KalmanModel::kConstantAcceleration ? 3 : 4;
+  const Stream s = makeStream(count, 1.0, jitter);
+  DifferentiatorBank bank(c, 2);
+  std::vector<int> newest;  // per estimate: the newest sample its pass used
+  std::vector<double> stamps;
+  std::vector<Eigen::MatrixXd> estimates;  // 3 x 2
+  auto record = [&](int used) {
+    newest.push_back(used);
+    stamps.push_back(bank.stamp());
+    Eigen::MatrixXd e(3, 2);
+    for (int ch = 0; ch < 2; ++ch) e.col(ch) << bank.value(ch), bank.rate(ch), bank.accel(ch);
+    estimates.push_back(e);
+  };
+  for (int k = 0; k < count; ++k) {
+    const double x[2] = {s.y[0][static_cast<std::size_t>(k)], s.y[1][static_cast<std::size_t>(k)]};
+    if (!bank.update(s.t[static_cast<std::size_t>(k)], x)) continue;
+    const int D = bank.delaySamples(), B = D / 2, j = static_cast<int>(stamps.size());
+    record(D + B * (j / B));
+  }
+  ASSERT_EQ(bank.delaySamples(), 10);
+  EXPECT_EQ(bank.pending(), 10);
+  bank.finish();
+  while (bank.next()) record(count - 1);
+  EXPECT_EQ(bank.pending(), 0);
+  // Every sample estimated once, in order, with its own time.
+  ASSERT_EQ(static_cast<int>(stamps.size()), count);
+  for (int j = 0; j < count; ++j)
+    EXPECT_EQ(stamps[static_cast<std::size_t>(j)], s.t[static_cast<std::size_t>(j)]);
+  int last_used = -1;
+  std::vector<Eigen::MatrixXd> batch(2);
+  for (int j = check_from; j < count; ++j) {
+    const int used = newest[static_cast<std::size_t>(j)];
+    if (used != last_used)
+      for (int ch = 0; ch < 2; ++ch)
+        batch[ch] = batchStates(s.t, s.y[ch], used, n, c.process_noise, c.measurement_noise);
+    last_used = used;
+    for (int ch = 0; ch < 2; ++ch)
+      for (int d = 0; d < 3; ++d)
+        EXPECT_NEAR(estimates[static_cast<std::size_t>(j)](d, ch), batch[ch](d, j), 1e-8)
+            << "sample " << j << " channel " << ch << " derivative " << d;
+  }
+}
+
+TEST(Smoother, ConstantJerkEqualsTheBatchEstimateAtIrregularStamps) {
+  expectBatch(KalmanModel::kConstantJerk, true, 60, 15);
+}
+
+TEST(Smoother, ConstantAccelerationEqualsTheBatchEstimateAtIrregularStamps) {
+  expectBatch(KalmanModel::kConstantAcceleration, true, 60, 15);
+}
+
+// At a steady rate the filter's gain settles and the backward gain is kept: the later
+// estimates check that path.
+TEST(Smoother, SettledGainEqualsTheBatchEstimate) {
+  expectBatch(KalmanModel::kConstantJerk, false, 160, 120);
+}
+
+// A gap beyond max_gap restarts the filter: the samples before it are smoothed with the
+// data there was and published in order as the first estimates after it; the end of the
+// stream publishes the rest (finish()). Every sample once, in order.
+TEST(Smoother, EverySampleIsEstimatedOnceAcrossGapsAndAtTheEnd) {
+  DifferentiatorConfig c;
+  c.lag = 0.02;
+  c.max_gap = 0.1;
+  DifferentiatorBank bank(c, 1);
+  std::vector<double> t;
+  double now = 1.0;
+  for (int k = 0; k < 300; ++k) {
+    t.push_back(now);
+    // Gaps after 3, 50 and 51 samples (the last two back to back), the rate changed
+    // from 1 kHz to 200 Hz at the second one (D: 20 samples, then 4 but the carry).
+    now += k == 2 || k == 49 || k == 50 ? 0.5 : (k < 50 ? 1e-3 : 5e-3);
+  }
+  std::vector<double> stamps;
+  for (double ti : t) {
+    const double x = std::sin(ti);
+    if (bank.update(ti, &x)) stamps.push_back(bank.stamp());
+  }
+  bank.finish();
+  while (bank.next()) stamps.push_back(bank.stamp());
+  EXPECT_EQ(stamps, t);
+  // The smoother at 200 Hz after the gaps: its delay is that of the carry (20 estimates:
+  // the 20 pending before the first of the two gaps, one of them published at the sample
+  // between them, which joined them), not round(0.02 / 5e-3) = 4.
+  EXPECT_EQ(bank.delaySamples(), 20);
+}
+
+TEST(Smoother, LagIsForKalmanOnly) {
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kSavitzkyGolay;
+  c.lag = 0.1;
+  try {
+    jle::validate(c);
+    FAIL() << "a Savitzky-Golay filter with a lag was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'differentiator/lag'"), std::string::npos) << e.what();
+  }
+  c.type = DifferentiatorType::kKalman;
+  c.lag = -1e-3;
+  EXPECT_THROW(jle::validate(c), std::invalid_argument);
+  c.lag = 0.1;
+  EXPECT_NO_THROW(jle::validate(c));
+}
+
+}  // namespace
