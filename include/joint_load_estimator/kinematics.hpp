@@ -118,6 +118,19 @@ void forwardRoot(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_
   data.n_ext[0].setZero();
 }
 
+// forwardRoot for BaseState's defaults (identity pose, at rest): the same values
+// without the products by the identity.
+template <typename Scalar>
+void forwardRootAtRest(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  data.R_world[0].setIdentity();
+  data.p_world[0].setZero();
+  data.omega[0].setZero();
+  data.alpha[0].setZero();
+  data.acc[0] = -gravity_world;
+  data.f_ext[0].setZero();
+  data.n_ext[0].setZero();
+}
+
 // R = R_parent_joint * (rotation by q about axis u): for u = +-e_k (sign = u_k) the
 // rotation leaves column k and mixes the other two, 12 products instead of Rodrigues'
 // and a 3x3 product's 39. Equal to the general product but for its rounding of
@@ -234,6 +247,17 @@ JLE_ALWAYS_INLINE void worldPose(const Model<Scalar>& model, Data<Scalar>& data,
   data.p_world[i].noalias() += data.R_world[p] * data.p_parent_child[i];
 }
 
+// The forward pass's segments, every one after the root.
+template <typename Scalar>
+void forwardSegments(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                     const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd) {
+  const int n = model.nsegments();
+  for (int i = 1; i < n; ++i) segmentCoordinates<Scalar, false>(model, data, i, q, qd, qdd);
+  sinCosMany(
+      n - 1, [](int j) { return j + 1; }, data.q.data(), data.sin_q.data(), data.cos_q.data());
+  for (int i = 1; i < n; ++i) forwardSegment<Scalar, false>(model, data, i);
+}
+
 }  // namespace detail
 
 /// The forward pass in the segment frames: fills data.q, qd, qdd, R_parent_child,
@@ -246,15 +270,22 @@ template <typename Scalar>
 void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
                      const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
                      const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                     const BaseState<Scalar>& base = BaseState<Scalar>()) {
+                     const BaseState<Scalar>& base) {
   checkCoordinates(model, q, qd, qdd);
   detail::checkAnalyzed(model);
   detail::forwardRoot(data, gravity_world, base);
-  const int n = model.nsegments();
-  for (int i = 1; i < n; ++i) detail::segmentCoordinates<Scalar, false>(model, data, i, q, qd, qdd);
-  sinCosMany(
-      n - 1, [](int j) { return j + 1; }, data.q.data(), data.sin_q.data(), data.cos_q.data());
-  for (int i = 1; i < n; ++i) detail::forwardSegment<Scalar, false>(model, data, i);
+  detail::forwardSegments(model, data, q, qd, qdd);
+}
+
+/// localKinematics with the base at rest at the world's origin (BaseState's defaults).
+template <typename Scalar>
+void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                     const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                     const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  checkCoordinates(model, q, qd, qdd);
+  detail::checkAnalyzed(model);
+  detail::forwardRootAtRest(data, gravity_world);
+  detail::forwardSegments(model, data, q, qd, qdd);
 }
 
 /// localKinematics over `segments` only: indices in increasing order, closed under
@@ -306,8 +337,17 @@ template <typename Scalar>
 void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
                        const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
                        const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                       const BaseState<Scalar>& base = BaseState<Scalar>()) {
+                       const BaseState<Scalar>& base) {
   localKinematics(model, data, q, qd, qdd, gravity_world, base);
+  worldPoses(model, data);
+}
+
+/// forwardKinematics with the base at rest at the world's origin (BaseState's defaults).
+template <typename Scalar>
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  localKinematics(model, data, q, qd, qdd, gravity_world);
   worldPoses(model, data);
 }
 
