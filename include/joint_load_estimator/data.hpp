@@ -22,6 +22,8 @@ struct Data {
     q.assign(n, Scalar(0));
     qd.assign(n, Scalar(0));
     qdd.assign(n, Scalar(0));
+    sin_q.assign(n, Scalar(0));
+    cos_q.assign(n, Scalar(1));
     R_parent_child.assign(n, Matrix3::Identity());
     p_parent_child.assign(n, Vector3::Zero());
     R_world.assign(n, Matrix3::Identity());
@@ -37,7 +39,10 @@ struct Data {
   }
 
   // Forward pass (kinematics.hpp), per segment.
-  std::vector<Scalar> q, qd, qdd;       ///< joint coordinate of the segment (mimics expanded)
+  std::vector<Scalar> q, qd, qdd;  ///< joint coordinate of the segment (mimics expanded)
+  /// sin and cos of q where the joint is revolute (elsewhere not meaningful), computed
+  /// for all joints before the forward pass's loop (trig.hpp, sinCosMany).
+  std::vector<Scalar> sin_q, cos_q;
   std::vector<Matrix3> R_parent_child;  ///< segment orientation in its parent segment
   std::vector<Vector3> p_parent_child;  ///< segment origin in its parent segment [m]
   /// World poses: forwardKinematics or worldPoses() (localKinematics sets the root's only).

@@ -48,11 +48,10 @@ struct BaseState {
   }
 };
 
-/// Rotation by angle q [rad] about the unit vector u (Rodrigues; sin and cos by sinCos).
+/// Rotation about the unit vector u by the angle whose sine and cosine are s and c
+/// (Rodrigues).
 template <typename Scalar>
-Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, Scalar q) {
-  Scalar s, c;
-  sinCos(q, s, c);
+Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, Scalar s, Scalar c) {
   const Scalar t = Scalar(1) - c;
   Eigen::Matrix<Scalar, 3, 3> R;
   R(0, 0) = t * u.x() * u.x() + c;
@@ -65,6 +64,14 @@ Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, S
   R(2, 1) = t * u.y() * u.z() + s * u.x();
   R(2, 2) = t * u.z() * u.z() + c;
   return R;
+}
+
+/// Rotation by angle q [rad] about the unit vector u (Rodrigues; sin and cos by sinCos).
+template <typename Scalar>
+Eigen::Matrix<Scalar, 3, 3> axisRotation(const Eigen::Matrix<Scalar, 3, 1>& u, Scalar q) {
+  Scalar s, c;
+  sinCos(q, s, c);
+  return axisRotation(u, s, c);
 }
 
 /// Checks the sizes of the coordinate vectors once, before the loops.
@@ -111,21 +118,32 @@ void forwardRoot(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_
   data.n_ext[0].setZero();
 }
 
+// forwardRoot for BaseState's defaults (identity pose, at rest): the same values
+// without the products by the identity.
+template <typename Scalar>
+void forwardRootAtRest(Data<Scalar>& data, const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  data.R_world[0].setIdentity();
+  data.p_world[0].setZero();
+  data.omega[0].setZero();
+  data.alpha[0].setZero();
+  data.acc[0] = -gravity_world;
+  data.f_ext[0].setZero();
+  data.n_ext[0].setZero();
+}
+
 // R = R_parent_joint * (rotation by q about axis u): for u = +-e_k (sign = u_k) the
 // rotation leaves column k and mixes the other two, 12 products instead of Rodrigues'
 // and a 3x3 product's 39. Equal to the general product but for its rounding of
 // (1 - cos q) + cos q, which is exactly 1 here.
 template <typename Scalar>
-JLE_ALWAYS_INLINE void jointRotation(const Model<Scalar>& model, int i, Scalar q,
+JLE_ALWAYS_INLINE void jointRotation(const Model<Scalar>& model, int i, Scalar s, Scalar c,
                                      Eigen::Matrix<Scalar, 3, 3>& R) {
   const Eigen::Matrix<Scalar, 3, 3>& R0 = model.R_parent_joint[i];
   const int k = model.axis_index[i];
   if (k < 0) {
-    R.noalias() = R0 * axisRotation(model.axis[i], q);
+    R.noalias() = R0 * axisRotation(model.axis[i], s, c);
     return;
   }
-  Scalar s, c;
-  sinCos(q, s, c);
   s *= model.axis[i][k];
   const int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;  // (k, a, b) cyclic
   R.col(k) = R0.col(k);
@@ -156,16 +174,12 @@ JLE_ALWAYS_INLINE void revoluteRates(const Model<Scalar>& model, int i, Scalar q
   al[b] -= w[a] * sqd;
 }
 
-// One segment of the forward pass (its parent done), in the segment frames only.
-// kStatic: the caller guarantees zero joint velocities and accelerations and a base at
-// rest (angular), so every omega and alpha is zero and only the pose and the origin
-// acceleration remain.
+// The joint coordinates of segment i (mimics expanded) into data.q, qd, qdd; kStatic:
+// the rates are zero.
 template <typename Scalar, bool kStatic>
-JLE_ALWAYS_INLINE void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i,
-                                      const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
-                                      const VectorX<Scalar>& qdd) {
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  const int p = model.parent[i];
+JLE_ALWAYS_INLINE void segmentCoordinates(const Model<Scalar>& model, Data<Scalar>& data, int i,
+                                          const VectorX<Scalar>& q, const VectorX<Scalar>& qd,
+                                          const VectorX<Scalar>& qdd) {
   const int k = model.coordinate[i];
   Scalar qi(0), qdi(0), qddi(0);
   if (k >= 0) {
@@ -178,13 +192,25 @@ JLE_ALWAYS_INLINE void forwardSegment(const Model<Scalar>& model, Data<Scalar>& 
   data.q[i] = qi;
   data.qd[i] = qdi;
   data.qdd[i] = qddi;
+}
+
+// One segment of the forward pass (its parent done, its coordinates and their sin and
+// cos in data), in the segment frames only.
+// kStatic: the caller guarantees zero joint velocities and accelerations and a base at
+// rest (angular), so every omega and alpha is zero and only the pose and the origin
+// acceleration remain.
+template <typename Scalar, bool kStatic>
+JLE_ALWAYS_INLINE void forwardSegment(const Model<Scalar>& model, Data<Scalar>& data, int i) {
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  const int p = model.parent[i];
+  const Scalar qi = data.q[i], qdi = data.qd[i], qddi = data.qdd[i];
 
   const JointType type = model.joint_type[i];
   Eigen::Matrix<Scalar, 3, 3>& R = data.R_parent_child[i];
   Vector3& r = data.p_parent_child[i];
   r = model.p_parent_joint[i];
   if (type == JointType::kRevolute)
-    jointRotation(model, i, qi, R);
+    jointRotation(model, i, data.sin_q[i], data.cos_q[i], R);
   else
     R = model.R_parent_joint[i];
   if (type == JointType::kPrismatic) r.noalias() += R * (model.axis[i] * qi);
@@ -221,6 +247,17 @@ JLE_ALWAYS_INLINE void worldPose(const Model<Scalar>& model, Data<Scalar>& data,
   data.p_world[i].noalias() += data.R_world[p] * data.p_parent_child[i];
 }
 
+// The forward pass's segments, every one after the root.
+template <typename Scalar>
+void forwardSegments(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                     const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd) {
+  const int n = model.nsegments();
+  for (int i = 1; i < n; ++i) segmentCoordinates<Scalar, false>(model, data, i, q, qd, qdd);
+  sinCosMany(
+      n - 1, [](int j) { return j + 1; }, data.q.data(), data.sin_q.data(), data.cos_q.data());
+  for (int i = 1; i < n; ++i) forwardSegment<Scalar, false>(model, data, i);
+}
+
 }  // namespace detail
 
 /// The forward pass in the segment frames: fills data.q, qd, qdd, R_parent_child,
@@ -233,12 +270,22 @@ template <typename Scalar>
 void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
                      const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
                      const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                     const BaseState<Scalar>& base = BaseState<Scalar>()) {
+                     const BaseState<Scalar>& base) {
   checkCoordinates(model, q, qd, qdd);
   detail::checkAnalyzed(model);
   detail::forwardRoot(data, gravity_world, base);
-  const int n = model.nsegments();
-  for (int i = 1; i < n; ++i) detail::forwardSegment<Scalar, false>(model, data, i, q, qd, qdd);
+  detail::forwardSegments(model, data, q, qd, qdd);
+}
+
+/// localKinematics with the base at rest at the world's origin (BaseState's defaults).
+template <typename Scalar>
+void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                     const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                     const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  checkCoordinates(model, q, qd, qdd);
+  detail::checkAnalyzed(model);
+  detail::forwardRootAtRest(data, gravity_world);
+  detail::forwardSegments(model, data, q, qd, qdd);
 }
 
 /// localKinematics over `segments` only: indices in increasing order, closed under
@@ -254,14 +301,20 @@ void localKinematics(const Model<Scalar>& model, Data<Scalar>& data, const Vecto
   checkCoordinates(model, q, qd, qdd);
   detail::checkAnalyzed(model);
   detail::forwardRoot(data, gravity_world, base);
+  const int count = static_cast<int>(segments.size()) - 1;
+  const auto listed = [&segments](int j) { return segments[j + 1]; };
   if (statics) {
     data.omega[0].setZero();
     data.alpha[0].setZero();
-    for (std::size_t j = 1; j < segments.size(); ++j)
-      detail::forwardSegment<Scalar, true>(model, data, segments[j], q, qd, qdd);
+    for (int j = 0; j < count; ++j)
+      detail::segmentCoordinates<Scalar, true>(model, data, listed(j), q, qd, qdd);
+    sinCosMany(count, listed, data.q.data(), data.sin_q.data(), data.cos_q.data());
+    for (int j = 0; j < count; ++j) detail::forwardSegment<Scalar, true>(model, data, listed(j));
   } else {
-    for (std::size_t j = 1; j < segments.size(); ++j)
-      detail::forwardSegment<Scalar, false>(model, data, segments[j], q, qd, qdd);
+    for (int j = 0; j < count; ++j)
+      detail::segmentCoordinates<Scalar, false>(model, data, listed(j), q, qd, qdd);
+    sinCosMany(count, listed, data.q.data(), data.sin_q.data(), data.cos_q.data());
+    for (int j = 0; j < count; ++j) detail::forwardSegment<Scalar, false>(model, data, listed(j));
   }
 }
 
@@ -284,8 +337,17 @@ template <typename Scalar>
 void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
                        const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
                        const Eigen::Matrix<Scalar, 3, 1>& gravity_world,
-                       const BaseState<Scalar>& base = BaseState<Scalar>()) {
+                       const BaseState<Scalar>& base) {
   localKinematics(model, data, q, qd, qdd, gravity_world, base);
+  worldPoses(model, data);
+}
+
+/// forwardKinematics with the base at rest at the world's origin (BaseState's defaults).
+template <typename Scalar>
+void forwardKinematics(const Model<Scalar>& model, Data<Scalar>& data, const VectorX<Scalar>& q,
+                       const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd,
+                       const Eigen::Matrix<Scalar, 3, 1>& gravity_world) {
+  localKinematics(model, data, q, qd, qdd, gravity_world);
   worldPoses(model, data);
 }
 

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace {
 
@@ -66,6 +67,46 @@ TEST(SinCos, BeyondTheLimitAndOtherTypesAreTheCLibrarys) {
   jle::sinCos(0.7f, sf, cf);
   EXPECT_EQ(sf, std::sin(0.7f));
   EXPECT_EQ(cf, std::cos(0.7f));
+}
+
+// sinCosMany takes the angles two at a time in one vector register: each lane must give
+// the bits of sinCos (the same operations), in every quadrant, over an odd count (the
+// last angle alone), through an index map, with a pair that has a large or non-finite
+// angle falling back to sinCos for both.
+TEST(SinCos, ManyAtOnceAreSinCosBitForBit) {
+  jle::PortableRandom random(11);
+  std::vector<double> q;
+  for (int k = 0; k < 4000; ++k) q.push_back(random.uniform(-20.0, 20.0));
+  for (int n = -8; n <= 8; ++n) q.push_back(n * M_PI / 2);
+  q.insert(q.end(), {0.0, -0.0, 1e-300, jle::kFastTrigLimit, -jle::kFastTrigLimit, 3e9, 0.25,
+                     std::numeric_limits<double>::quiet_NaN(), 0.5,
+                     std::numeric_limits<double>::infinity(), -1.0});
+  const int count = static_cast<int>(q.size());
+  ASSERT_EQ(count % 2, 0);
+  // All of them but the first (an odd count), in reverse through the index map.
+  std::vector<double> s(q.size(), 7.0), c(q.size(), 7.0);
+  jle::sinCosMany(
+      count - 1, [count](int j) { return count - 1 - j; }, q.data(), s.data(), c.data());
+  EXPECT_EQ(s[0], 7.0);  // not listed: untouched
+  for (int k = 1; k < count; ++k) {
+    double s1, c1;
+    jle::sinCos(q[k], s1, c1);
+    if (std::isnan(q[k]) || std::isinf(q[k])) {
+      EXPECT_TRUE(std::isnan(s[k]) && std::isnan(c[k])) << q[k];
+      continue;
+    }
+    EXPECT_EQ(s[k], s1) << "q = " << q[k];
+    EXPECT_EQ(c[k], c1) << "q = " << q[k];
+    EXPECT_EQ(std::signbit(s[k]), std::signbit(s1)) << "q = " << q[k];
+  }
+  // Other scalar types: sinCos one by one.
+  std::vector<float> qf = {0.1f, -2.0f, 3.0f}, sf(3), cf(3);
+  jle::sinCosMany(
+      3, [](int j) { return j; }, qf.data(), sf.data(), cf.data());
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(sf[k], std::sin(qf[k]));
+    EXPECT_EQ(cf[k], std::cos(qf[k]));
+  }
 }
 
 }  // namespace
