@@ -71,6 +71,15 @@ struct DifferentiatorConfig {
   double max_gap = 0.5;
 };
 
+/// Whether two configurations make the same filter (every field equal).
+inline bool sameDifferentiator(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
+  return a.type == b.type && a.window == b.window && a.order == b.order && a.delay == b.delay &&
+         a.kalman_model == b.kalman_model && a.process_noise == b.process_noise &&
+         a.measurement_noise == b.measurement_noise && a.lag == b.lag &&
+         a.min_bandwidth == b.min_bandwidth && a.max_bandwidth == b.max_bandwidth &&
+         a.noise == b.noise && a.memory == b.memory && a.max_gap == b.max_gap;
+}
+
 /// Checks a configuration once (the bank on construction, validate(EstimatorConfig) in
 /// config.hpp); throws std::invalid_argument naming the parameter as config/default.yaml
 /// spells it ("parameter 'differentiator/order' must be 2..5 ...").

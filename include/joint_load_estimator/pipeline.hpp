@@ -156,6 +156,13 @@ class Pipeline {
   /// smoothed with the data there is; each call that returns true puts the next one's
   /// loads in record(), false when none is left (each was counted when it came).
   bool flush();
+  /// With a smoother: the joint states whose loads were still to come when the timeline
+  /// restarted (a jump back of time, as a looping bag makes) or retune() replaced the
+  /// filter, smoothed with the data there was, before it was forgotten. Call after every
+  /// input call and retune() until it returns false: each true puts the next of them,
+  /// oldest first, in record() (each was counted when it came). The call that restarted
+  /// the timeline publishes nothing itself (the new filter is warming up).
+  bool takeDrained();
   /// A wrench of input k (settings.wrenches[k]) as the message carries it: force [N]
   /// and torque [N m] in `frame_id` (the configured frame, when set, wins), moment about
   /// its origin. Its stamp follows the rules of README, "Time stamps": stamp 0, and a
@@ -269,6 +276,7 @@ class Pipeline {
   void fillExternal();
   void fillCoordinates(std::size_t i, std::size_t segment);
   const Sample* sampleAt(double t) const;
+  void drainSmoother();
 
   Settings settings_;
   FrameSource* frames_;
@@ -277,6 +285,9 @@ class Pipeline {
   std::vector<double> external_variance_;     // the model efforts' variances, per joint
   JointStateMap joints_;
   LoadsRecord record_;
+  // A smoother's loads made before a reset or a retune (takeDrained), and the next one.
+  std::vector<LoadsRecord> drained_;
+  std::size_t drained_next_ = 0;
   PipelineCounters counters_;
   std::vector<WrenchInput> wrenches_;
   std::vector<PlateInput> plates_;

@@ -175,18 +175,6 @@ void Estimator::reset() {
   sample_count_ = 0;
 }
 
-namespace {
-
-bool sameDifferentiator(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
-  return a.type == b.type && a.window == b.window && a.order == b.order && a.delay == b.delay &&
-         a.kalman_model == b.kalman_model && a.process_noise == b.process_noise &&
-         a.measurement_noise == b.measurement_noise && a.lag == b.lag &&
-         a.min_bandwidth == b.min_bandwidth && a.max_bandwidth == b.max_bandwidth &&
-         a.noise == b.noise && a.memory == b.memory && a.max_gap == b.max_gap;
-}
-
-}  // namespace
-
 bool Estimator::retune(const DifferentiatorConfig& differentiator, int decimation) {
   EstimatorConfig config = config_;
   config.differentiator = differentiator;

@@ -266,6 +266,7 @@ void Pipeline::resetTimeline(Stamp stamp) {
   jumped_ = true;
   jump_from_ = last_stamp_;
   jump_to_ = stamp;
+  drainSmoother();
   estimator_.reset();
   if (external_) external_->reset();
   clock_.reset();
@@ -462,6 +463,22 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   return count(kind, Outcome::kPublished);
 }
 
+void Pipeline::drainSmoother() {
+  // Rare (a reset with a smoother): copies of the record are fine here.
+  if (estimator_.pendingSamples() == 0) return;
+  while (flush()) drained_.push_back(record_);
+}
+
+bool Pipeline::takeDrained() {
+  if (drained_next_ == drained_.size()) return false;
+  std::swap(record_, drained_[drained_next_++]);
+  if (drained_next_ == drained_.size()) {
+    drained_.clear();
+    drained_next_ = 0;
+  }
+  return true;
+}
+
 bool Pipeline::flush() {
   SampleStatus status = SampleStatus::kPublished;
   while (estimator_.flush(status)) {
@@ -579,6 +596,12 @@ void Pipeline::fillCoordinates(std::size_t i, std::size_t segment) {
 }
 
 bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation) {
+  // A new differentiator restarts the filters: a smoother's pending loads come first.
+  EstimatorConfig next = estimator_.config();
+  next.differentiator = differentiator;
+  next.decimation = decimation;
+  validate(next);  // throws naming the key, changing nothing
+  if (!sameDifferentiator(differentiator, estimator_.config().differentiator)) drainSmoother();
   const bool kept = estimator_.retune(differentiator, decimation);
   settings_.estimator.differentiator = differentiator;
   settings_.estimator.decimation = decimation;

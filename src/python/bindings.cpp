@@ -309,6 +309,8 @@ class PyEstimator {
   py::dict run(const Array& t, const Array& q, const py::list& wrenches);
 
  private:
+  void appendLoads(std::vector<double>& stamps, std::vector<double>& w,
+                   std::vector<double>& e) const;
   jle::Settings settings_;
   jle::Model<double> model_;
   std::unique_ptr<jle::Estimator> estimator_;
@@ -336,6 +338,18 @@ std::vector<WrenchSeries> wrenchSeries(const py::list& wrenches, int inputs) {
     series.push_back(std::move(s));
   }
   return series;
+}
+
+void PyEstimator::appendLoads(std::vector<double>& stamps, std::vector<double>& w,
+                              std::vector<double>& e) const {
+  stamps.push_back(estimator_->stamp());
+  const jle::Data<double>& d = estimator_->data();
+  for (int s : segments_) {
+    double out[6];
+    putWrench(jle::jointWrench(estimator_->model(), d, s, jle::WrenchFrame::kChild), out);
+    w.insert(w.end(), out, out + 6);
+    e.push_back(d.effort[static_cast<std::size_t>(s)]);
+  }
 }
 
 py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrenches) {
@@ -366,16 +380,12 @@ py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrench
         }
       const jle::SampleStatus st = estimator_->addJointSample(ti, q.data() + model_.nq * i);
       status[static_cast<std::size_t>(i)] = jle::toString(st);
-      if (st != jle::SampleStatus::kPublished) continue;
-      stamps.push_back(estimator_->stamp());
-      const jle::Data<double>& d = estimator_->data();
-      for (int s : segments_) {
-        double out[6];
-        putWrench(jle::jointWrench(estimator_->model(), d, s, jle::WrenchFrame::kChild), out);
-        w.insert(w.end(), out, out + 6);
-        e.push_back(d.effort[static_cast<std::size_t>(s)]);
-      }
+      if (st == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
     }
+    // A smoother's (differentiator/lag) last samples: smoothed with the data there is.
+    jle::SampleStatus st = jle::SampleStatus::kPublished;
+    while (estimator_->flush(st))
+      if (st == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
   }
   const auto rows = static_cast<py::ssize_t>(stamps.size()), cols = static_cast<py::ssize_t>(m);
   py::dict out;
@@ -597,6 +607,16 @@ void defineEstimator(py::module_& m) {
           },
           py::arg("k"), py::arg("t"), py::arg("force"), py::arg("moment"))
       .def("reset", [](PyEstimator& e) { e.estimator().reset(); })
+      .def(
+          "flush",
+          [](PyEstimator& e) -> py::object {
+            jle::SampleStatus st = jle::SampleStatus::kPublished;
+            if (!e.estimator().flush(st)) return py::none();
+            return py::str(jle::toString(st));
+          },
+          "The end of a stream: with a smoother (differentiator/lag > 0) the next sample "
+          "still to come, smoothed with the data there is: its status as add_joint_sample "
+          "gives it ('published': loads() and stamp hold it), None when none is left.")
       .def("loads", &PyEstimator::loads)
       .def("run", &PyEstimator::run, py::arg("t"), py::arg("q"), py::arg("wrenches") = py::list())
       .def_property_readonly("joints",

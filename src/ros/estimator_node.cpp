@@ -194,6 +194,7 @@ void EstimatorNode::onJointState(const JointStateEvent& event) {
                        ros::WallTime::now().toSec());
     report(outcome);
     if (outcome == Outcome::kPublished) publish(received);
+    publishDrained(received);
   } catch (const std::exception& e) {
     // Nothing may leave a callback; the next message is processed as usual.
     ++exceptions_;
@@ -206,10 +207,12 @@ void EstimatorNode::onWrench(std::size_t k, const WrenchEvent& event) {
   const geometry_msgs::WrenchStamped& msg = *event.getConstMessage();
   try {
     applyPendingBias();
-    const Outcome outcome = feedWrench(*pipeline_, static_cast<int>(k), msg, ros::Time::now());
+    const ros::Time received = ros::Time::now();
+    const Outcome outcome = feedWrench(*pipeline_, static_cast<int>(k), msg, received);
     wrench_topics_[k].health.take(event.getPublisherName(), msg.header.seq, outcome,
                                   ros::WallTime::now().toSec());
     report(outcome);
+    publishDrained(received);
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "wrench input %zu: %s", k, e.what());
@@ -220,10 +223,12 @@ void EstimatorNode::onPlate(std::size_t k, const WrenchEvent& event) {
   std::lock_guard<std::mutex> lock(callbacks_mutex_);
   const geometry_msgs::WrenchStamped& msg = *event.getConstMessage();
   try {
-    const Outcome outcome = feedPlate(*pipeline_, static_cast<int>(k), msg, ros::Time::now());
+    const ros::Time received = ros::Time::now();
+    const Outcome outcome = feedPlate(*pipeline_, static_cast<int>(k), msg, received);
     plate_topics_[k].health.take(event.getPublisherName(), msg.header.seq, outcome,
                                  ros::WallTime::now().toSec());
     report(outcome);
+    publishDrained(received);
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "force plate input %zu: %s", k, e.what());
@@ -269,6 +274,11 @@ void EstimatorNode::publish(const ros::Time& received) {
   latency_sum_ += latency;
   latency_max_ = std::max(latency_max_, latency);
   ++latency_count_;
+}
+
+void EstimatorNode::publishDrained(const ros::Time& received) {
+  // A smoother's loads still to come when time jumped back or the filter was replaced.
+  while (pipeline_->takeDrained()) publish(received);
 }
 
 void EstimatorNode::publishPlates(const ros::Time& stamp) {

@@ -5,6 +5,7 @@
 // a new differentiator restarts the filters (Pipeline::retune).
 #include <joint_load_estimator/ros/estimator_node.hpp>
 
+#include <mutex>
 #include <stdexcept>
 
 namespace jle {
@@ -40,6 +41,7 @@ joint_load_estimator::EstimatorConfig toConfig(const Settings& settings) {
   c.differentiator_max_bandwidth = d.max_bandwidth;
   c.differentiator_noise = d.noise;
   c.differentiator_memory = d.memory;
+  c.differentiator_lag = d.lag;
   c.decimation = settings.estimator.decimation;
   c.base_residual_threshold = settings.base_residual_threshold;
   c.still_velocity = settings.still_velocity;
@@ -64,6 +66,7 @@ XmlRpc::XmlRpcValue withConfig(XmlRpc::XmlRpcValue params,
   d["max_bandwidth"] = c.differentiator_max_bandwidth;
   d["noise"] = c.differentiator_noise;
   d["memory"] = c.differentiator_memory;
+  d["lag"] = c.differentiator_lag;
   params["decimation"] = c.decimation;
   params["base_residual_threshold"] = c.base_residual_threshold;
   params["still_velocity"] = c.still_velocity;
@@ -84,6 +87,8 @@ void EstimatorNode::setUpReconfigure() {
 
 void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
                                   std::uint32_t /*level*/) {
+  // The input callbacks may run in other threads (inline_callbacks, a nodelet manager's).
+  std::lock_guard<std::mutex> lock(callbacks_mutex_);
   try {
     XmlRpc::XmlRpcValue params = withConfig(params_, config);
     const Settings next = parseSettings(params);  // throws naming the key
@@ -91,6 +96,7 @@ void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
                       next.base_residual_threshold == settings_.base_residual_threshold &&
                       next.still_velocity == settings_.still_velocity;
     const bool kept = pipeline_->retune(next.estimator.differentiator, next.estimator.decimation);
+    publishDrained(ros::Time::now());
     settings_.estimator.differentiator = next.estimator.differentiator;
     settings_.estimator.decimation = next.estimator.decimation;
     settings_.base_residual_threshold = next.base_residual_threshold;

@@ -206,6 +206,7 @@ class BagProcessor {
   void dispatch(const rosbag::MessageInstance& m);
   void onTf(const rosbag::MessageInstance& m, bool is_static);
   void note(jle::Outcome outcome);
+  void write();
   std::string noLoads() const;
   void summarize(double total_s) const;
   void printDrops() const;
@@ -219,6 +220,7 @@ class BagProcessor {
   std::string joint_topic_;
   std::vector<std::string> wrench_topics_, plate_topics_;  // settings order
   bool have_tf_ = false;                                   // the bag has /tf or /tf_static
+  long written_ = 0;                                       // loads given to the sink
   ReuseBuffer buffer_;
   sensor_msgs::JointState joint_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
@@ -262,9 +264,8 @@ void BagProcessor::run() {
   }
   if (progress_shown) std::fputc('\n', stderr);
   // A smoother's last joint states (differentiator/lag): their loads too, numbered on.
-  long published = pipeline_.counters().count(jle::Outcome::kPublished);
-  for (; pipeline_.flush(); ++published) sink_.write(pipeline_.record(), published);
-  if (published == 0) throw std::runtime_error(noLoads());
+  while (pipeline_.flush()) write();
+  if (written_ == 0) throw std::runtime_error(noLoads());
   sink_.commit();
   if (options_.summary) summarize(std::chrono::duration<double>(Clock::now() - start).count());
 }
@@ -286,18 +287,21 @@ void BagProcessor::dispatch(const rosbag::MessageInstance& m) {
     const jle::Outcome outcome = jle::feed(pipeline_, joint_msg_, m.getTime());
     compute_ += Clock::now() - c0;
     note(outcome);
-    if (outcome == jle::Outcome::kPublished)
-      sink_.write(pipeline_.record(), pipeline_.counters().count(jle::Outcome::kPublished) - 1);
-    return;
+    if (outcome == jle::Outcome::kPublished) write();
+  } else {
+    for (std::size_t k = 0; k < wrench_topics_.size(); ++k)
+      if (topic == wrench_topics_[k])
+        note(jle::feedWrench(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
+    for (std::size_t k = 0; k < plate_topics_.size(); ++k)
+      if (topic == plate_topics_[k])
+        note(jle::feedPlate(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
+    compute_ += Clock::now() - c0;
   }
-  for (std::size_t k = 0; k < wrench_topics_.size(); ++k)
-    if (topic == wrench_topics_[k])
-      note(jle::feedWrench(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
-  for (std::size_t k = 0; k < plate_topics_.size(); ++k)
-    if (topic == plate_topics_[k])
-      note(jle::feedPlate(pipeline_, static_cast<int>(k), wrench_msg_, m.getTime()));
-  compute_ += Clock::now() - c0;
+  // A smoother's loads still to come when the bag looped back in time (Pipeline::takeDrained).
+  while (pipeline_.takeDrained()) write();
 }
+
+void BagProcessor::write() { sink_.write(pipeline_.record(), written_++); }
 
 // --zero-phase: the whole bag's inputs read and smoothed before the message path runs.
 void BagProcessor::smoothInputs(rosbag::View& view) {

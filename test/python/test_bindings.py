@@ -270,13 +270,16 @@ SENSOR_CONFIG = """wrenches:
 """
 
 
-def test_estimator_is_process_bag(tmp_path, example_bag):
+@pytest.mark.parametrize("lag", [0.0, 0.05])
+def test_estimator_is_process_bag(tmp_path, example_bag, lag):
     """The online estimator with the node's defaults, fed the bag's samples in the bag's
-    order, gives process_bag's loads (the node's message path around the same estimator)."""
+    order, gives process_bag's loads (the node's message path around the same estimator).
+    With a smoother (lag > 0) both give the last samples' loads at the end too (flush)."""
     import rosbag
     config = str(tmp_path / "sensor.yaml")
     with open(config, "w") as f:
         f.write(SENSOR_CONFIG)  # the sensor's own frame: no transform in the message path
+        f.write("differentiator:\n  lag: %r\n" % lag)
     columns = process_bag(tmp_path, example_bag, ["--config", config])
     model = jle.Model(PANDA)
     joints, wrenches = [], []
@@ -300,7 +303,11 @@ def test_estimator_is_process_bag(tmp_path, example_bag):
     assert np.abs(loads.t + t0 * 1e-9 - columns["t"]).max() < 1e-6
     compare_with_columns(loads, columns)
     # The sensor's readings matter: without them the efforts are others.
-    unloaded = jle.estimate(jle.Estimator(model), seconds(joints[:, 0]), joints[:, 1:].astype(float))
+    bare = str(tmp_path / "bare.yaml")
+    with open(bare, "w") as f:
+        f.write("differentiator:\n  lag: %r\n" % lag)
+    unloaded = jle.estimate(jle.Estimator(model, bare), seconds(joints[:, 0]),
+                            joints[:, 1:].astype(float))
     assert np.abs(unloaded.effort - loads.effort).max() > 0.1
     # One sample at a time, from the start again: the same loads.
     estimator.reset()
@@ -314,6 +321,14 @@ def test_estimator_is_process_bag(tmp_path, example_bag):
             k += 1
         if estimator.add_joint_sample(t[i], q[i]) == "published":
             published.append(estimator.loads()["effort"])
+    pending = estimator.delay_samples if lag > 0 else 0
+    flushed = []
+    while (status := estimator.flush()) is not None:
+        flushed.append(status)
+        if status == "published":
+            published.append(estimator.loads()["effort"])
+    assert len(flushed) == pending and (lag == 0 or pending > 10), flushed
+    assert estimator.flush() is None
     assert_same(np.array(published), loads.effort, "sample by sample")
 
 

@@ -111,6 +111,12 @@ int intValue(const dynamic_reconfigure::Config& c, const std::string& name) {
   return -1;
 }
 
+double doubleValue(const dynamic_reconfigure::Config& c, const std::string& name) {
+  for (const auto& p : c.doubles)
+    if (p.name == name) return p.value;
+  return -1.0;
+}
+
 std::string strValue(const dynamic_reconfigure::Config& c, const std::string& name) {
   for (const auto& p : c.strs)
     if (p.name == name) return p.value;
@@ -187,6 +193,24 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
   before = loads1_.size();
   send(20);
   EXPECT_EQ(loads1_.size(), before + 20);
+
+  // 5. The Kalman smoother live (differentiator_lag 0.1 s: D = 20 samples at 200 Hz),
+  // then back to the causal filter: the retune publishes the smoother's 20 pending
+  // joint states first, so every joint state sent to the smoother has its loads, once,
+  // in order.
+  c = reconfigure({}, {{"differentiator_lag", 0.1}}, {{"differentiator_type", "kalman"}});
+  EXPECT_EQ(doubleValue(c, "differentiator_lag"), 0.1);
+  before = loads1_.size();
+  const long smoothed = sent_;
+  send(100);
+  EXPECT_EQ(loads1_.size(), before + 80);  // 20 still to come
+  c = reconfigure({}, {{"differentiator_lag", 0.0}}, {});
+  EXPECT_EQ(doubleValue(c, "differentiator_lag"), 0.0);
+  jle_test::spinUntilQuiet([&] { return loads1_.size(); });
+  ASSERT_EQ(loads1_.size(), before + 100);
+  for (std::size_t i = 0; i < 100; ++i)
+    EXPECT_EQ(stamps_.at(loads1_.msgs()[before + i]->header.stamp.toNSec()),
+              smoothed + static_cast<long>(i));
 }
 
 }  // namespace

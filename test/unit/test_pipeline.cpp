@@ -639,3 +639,95 @@ TEST(Pipeline, SmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
   EXPECT_EQ(published, sent);
   for (std::size_t k = 0; k < measured.size(); ++k) EXPECT_EQ(measured[k], static_cast<double>(k));
 }
+
+namespace {
+
+// One loads record as the test compares them: stamp, measured effort, every effort.
+struct Taken {
+  Stamp stamp;
+  double measured;
+  std::vector<double> effort;
+};
+
+Taken taken(const jle::Pipeline& pipeline) {
+  const jle::LoadsRecord& r = pipeline.record();
+  return {r.stamp, r.measured_effort[0], r.effort};
+}
+
+// Joint state k of a 1 kHz stream starting at `start`, its number as joint 0's effort.
+Outcome feedNumbered(jle::Pipeline& pipeline, const jle::Model<double>& model, Stamp start, int k) {
+  const Stamp stamp = start + k * kMs;
+  const double t = 1e-3 * k;
+  std::vector<double> p(6), e(6, 0.0);
+  for (int i = 0; i < 6; ++i) p[static_cast<std::size_t>(i)] = q(i, t);
+  e[0] = k;
+  return pipeline.onJointState(stamp, stamp, model.coordinate_names, p, kNone, e);
+}
+
+}  // namespace
+
+// The smoother's pending joint states when time jumps back (a looping bag) or the filter
+// is replaced (retune): their loads come out of takeDrained(), oldest first, equal to
+// those the end of the stream (flush()) would have given; then the new timeline's own,
+// every one once. Nothing is lost and nothing is counted twice.
+TEST(Pipeline, SmootherDrainsItsPendingSamplesOnAJumpBackAndOnRetune) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  settings.estimator.differentiator.lag = 0.1;  // D = 100 samples at 1 kHz
+  constexpr int kFirst = 300;
+  // The reference: the first timeline alone, ended by flush().
+  std::vector<Taken> ended;
+  {
+    jle::Pipeline pipeline(model, settings, nullptr);
+    for (int k = 0; k < kFirst; ++k) feedNumbered(pipeline, model, kStart, k);
+    while (pipeline.flush()) ended.push_back(taken(pipeline));
+  }
+  ASSERT_EQ(ended.size(), 100u);
+  const auto expectSame = [&](const std::vector<Taken>& got, const char* what) {
+    ASSERT_EQ(got.size(), ended.size()) << what;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].stamp, ended[i].stamp) << what << " " << i;
+      EXPECT_EQ(got[i].measured, static_cast<double>(kFirst - 100 + static_cast<int>(i))) << what;
+      EXPECT_EQ(got[i].effort, ended[i].effort) << what << " " << i;
+    }
+  };
+
+  // A jump back: the first timeline again from its start (stamps and clock go back).
+  jle::Pipeline pipeline(model, settings, nullptr);
+  std::vector<Stamp> published;
+  for (int k = 0; k < kFirst; ++k)
+    if (feedNumbered(pipeline, model, kStart, k) == Outcome::kPublished)
+      published.push_back(pipeline.record().stamp);
+  EXPECT_FALSE(pipeline.takeDrained());
+  EXPECT_EQ(published.size(), static_cast<std::size_t>(kFirst - 100));
+  EXPECT_NE(feedNumbered(pipeline, model, kStart, 0), Outcome::kPublished);
+  EXPECT_EQ(pipeline.counters().resets, 1);
+  std::vector<Taken> drained;
+  while (pipeline.takeDrained()) drained.push_back(taken(pipeline));
+  expectSame(drained, "jump back");
+  EXPECT_FALSE(pipeline.takeDrained());
+  // The new timeline: each of its joint states once, from the first.
+  std::vector<Stamp> second;
+  for (int k = 1; k < kFirst; ++k)
+    if (feedNumbered(pipeline, model, kStart, k) == Outcome::kPublished)
+      second.push_back(pipeline.record().stamp);
+  while (pipeline.flush()) second.push_back(pipeline.record().stamp);
+  ASSERT_EQ(second.size(), static_cast<std::size_t>(kFirst));
+  for (int k = 0; k < kFirst; ++k) EXPECT_EQ(second[static_cast<std::size_t>(k)], kStart + k * kMs);
+
+  // retune to the causal filter: the smoother's pending loads first.
+  jle::Pipeline tuned(model, settings, nullptr);
+  for (int k = 0; k < kFirst; ++k) feedNumbered(tuned, model, kStart, k);
+  jle::DifferentiatorConfig causal = settings.estimator.differentiator;
+  causal.lag = 0.0;
+  jle::DifferentiatorConfig bad = causal;
+  bad.lag = -1.0;
+  EXPECT_THROW(tuned.retune(bad, 1), std::invalid_argument);
+  EXPECT_FALSE(tuned.takeDrained());  // a refused retune changes nothing
+  EXPECT_EQ(tuned.estimator().pendingSamples(), 100);
+  EXPECT_FALSE(tuned.retune(causal, 1));
+  drained.clear();
+  while (tuned.takeDrained()) drained.push_back(taken(tuned));
+  expectSame(drained, "retune");
+  EXPECT_EQ(tuned.estimator().pendingSamples(), 0);
+}

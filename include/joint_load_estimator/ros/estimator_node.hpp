@@ -89,6 +89,7 @@ class EstimatorNode {
   // Logs what the pipeline said of the last message, each problem throttled on its own.
   void report(Outcome outcome);
   void publish(const ros::Time& received);
+  void publishDrained(const ros::Time& received);
   // A ~joint_loads message to fill: one of the pool that no subscriber holds any more,
   // else a new one (published as a shared pointer, so that a subscriber in the same
   // process gets the message itself, not a serialised copy).
