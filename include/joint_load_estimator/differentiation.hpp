@@ -205,6 +205,9 @@ class DifferentiatorBank {
     emitted_ = 0;
     finishing_ = false;
     delay_ = 0;
+    pass_newest_ = emitted_steps_ = 0;
+    emitted_carried_ = false;
+    smoothed_gains_valid_ = false;
     head_ = 0;
     if (!isKalman()) tau_prev_.setConstant(std::nan(""));
     dt_prev_ = -1.0;  // a restarted filter is a fresh one, to the bit: no cached F, Q
@@ -220,6 +223,7 @@ class DifferentiatorBank {
       const int left = carry_count_ - carry_next_;
       for (int k = 0; k < left; ++k) {
         carry_.col(k) = carry_.col(carry_next_ + k);
+        carry_gains_.col(k) = carry_gains_.col(carry_next_ + k);
         carry_times_[k] = carry_times_[carry_next_ + k];
       }
       carry_count_ = left;
@@ -227,11 +231,14 @@ class DifferentiatorBank {
       const int total = left + (count_ > 0 ? index_ + 1 - emitted_ : 0);
       if (carry_.cols() < total) {
         carry_.conservativeResize(3 * channels_, total);
+        carry_gains_.conservativeResize(9, total);
         carry_times_.conservativeResize(total);
       }
       while (count_ > 0 && emitted_ <= index_) {
         emitSmoothed();
         carry_.col(carry_count_) = Eigen::Map<const Eigen::VectorXd>(out_.data(), 3 * channels_);
+        const Eigen::Matrix3d gain = smoothedNoiseGain();
+        carry_gains_.col(carry_count_) = Eigen::Map<const Eigen::VectorXd>(gain.data(), 9);
         carry_times_[carry_count_++] = stamp_;
       }
     }
@@ -242,6 +249,8 @@ class DifferentiatorBank {
   bool emitCarry() {
     if (carry_next_ >= carry_count_) return false;
     out_ = Eigen::Map<const Eigen::MatrixXd>(carry_.col(carry_next_).data(), 3, channels_);
+    carried_gain_ = Eigen::Map<const Eigen::Matrix3d>(carry_gains_.col(carry_next_).data());
+    emitted_carried_ = true;
     stamp_ = carry_times_[carry_next_++];
     if (carry_next_ == carry_count_) carry_count_ = carry_next_ = 0;
     return true;
@@ -294,11 +303,20 @@ class DifferentiatorBank {
   /// after which it is kept (cached) while dt and the gain stay. Adaptive: the selected
   /// filter's (pooled over the channels: the selection is common to the bank), which is
   /// exact for the filter that made the estimate, restarts from another one included.
-  /// A smoother (lag > 0): its forward filter's at the newest sample, not the smoothed
-  /// estimate's (which uses the samples after it too; not computed).
+  /// A smoother (lag > 0): the smoothed estimate's, which the samples after it shrink:
+  /// with m the backward steps from the pass's newest sample to the estimate, the
+  /// estimate's noise is P_m e_f + r_m (e_f the forward filter's noise there, r_m that
+  /// of the m measurements after it), from P_0 = I, r_0 = 0 by
+  /// r_(k+1) = G (P_k K (P_k K)^T + r_k) G^T, P_(k+1) = I - G F + G P_k A, and the gain is
+  /// P_m S P_m^T + r_m; exact at a steady rate (its gains settled: then computed once for
+  /// every m), and until the filter has settled the forward filter's (larger). An
+  /// estimate carried over a gap keeps the one it was made with.
   Eigen::Matrix3d noiseGain() const {
     if (config_.type == DifferentiatorType::kAdaptive)
       return models_[selection_.selected()].noiseGain();
+    if (config_.type == DifferentiatorType::kKalman && smoothing() && emitted_carried_)
+      return carried_gain_;
+    if (config_.type == DifferentiatorType::kKalman && smoothing()) return smoothedNoiseGain();
     if (config_.type == DifferentiatorType::kKalman) return S_.topLeftCorner(3, 3);
     Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
     for (int k = 0; k < config_.window; ++k) {
@@ -310,6 +328,31 @@ class DifferentiatorBank {
 
  private:
   bool smoothing() const { return config_.lag > 0.0; }
+
+  // noiseGain() of the smoothed estimate emitted last (emitted_steps_ backward steps).
+  Eigen::Matrix3d smoothedNoiseGain() const {
+    if (!(gain_settled_ && noise_settled_)) return S_.topLeftCorner(3, 3);
+    const std::size_t m = static_cast<std::size_t>(std::max(emitted_steps_, 0));
+    if (!smoothed_gains_valid_ || smoothed_gains_.size() <= m) {
+      const int n = n_;
+      const SmallMatrix& G = backward_gain_;
+      const SmallMatrix A = F_ - K_ * F_.row(0);  // (I - K H) F
+      const SmallMatrix I = SmallMatrix::Identity(n, n);
+      const SmallMatrix base = I - G * F_;
+      SmallMatrix P = I, r = SmallMatrix::Zero(n, n);
+      smoothed_gains_.resize(std::max<std::size_t>(m, static_cast<std::size_t>(delay_)) + 1);
+      for (std::size_t k = 0; k < smoothed_gains_.size(); ++k) {
+        if (k > 0) {
+          const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> PK = P * K_;
+          r = G * (PK * PK.transpose() + r) * G.transpose();
+          P = base + G * P * A;
+        }
+        smoothed_gains_[k] = (P * S_ * P.transpose() + r).topLeftCorner(3, 3);
+      }
+      smoothed_gains_valid_ = true;
+    }
+    return smoothed_gains_[m];
+  }
 
   bool isKalman() const {
     return config_.type == DifferentiatorType::kKalman ||
@@ -492,7 +535,10 @@ class DifferentiatorBank {
     const bool steady = !changed && gain_settled_;
     if (!steady) updateKalmanGain();
     // Noise gain: kept once it no longer changes under a settled gain.
-    if (!(steady && noise_settled_)) updateNoiseGain(steady);
+    if (!(steady && noise_settled_)) {
+      updateNoiseGain(steady);
+      smoothed_gains_valid_ = false;
+    }
     double* predicted = nullptr;
     if (smoothing()) {
       if (index_ == 0) startSmoother(dt);
@@ -532,6 +578,7 @@ class DifferentiatorBank {
     back_.resize(states);
     if (carry_.cols() < size) {
       carry_.conservativeResize(3 * channels_, size);
+      carry_gains_.conservativeResize(9, size);
       carry_times_.conservativeResize(size);
     }
   }
@@ -574,6 +621,7 @@ class DifferentiatorBank {
 
   template <int N>
   void smoothChannels(int newest, int oldest, int last) {
+    pass_newest_ = newest;
     double* back = back_.data();
     const double* start = filtered_.col(newest % ring_size_).data();
     for (int i = 0; i < N * channels_; ++i) back[i] = start[i];
@@ -603,6 +651,8 @@ class DifferentiatorBank {
   }
 
   void emitSmoothed() {
+    emitted_steps_ = pass_newest_ - emitted_;
+    emitted_carried_ = false;
     const int slot = emitted_ % ring_size_;
     out_ = Eigen::Map<const Eigen::MatrixXd>(smoothed_.col(slot).data(), 3, channels_);
     stamp_ = ring_times_[slot];
@@ -749,8 +799,17 @@ class DifferentiatorBank {
   Eigen::VectorXd ring_times_, back_;
   // Smoother: estimates made at a gap from the samples before it, (value, rate, accel)
   // x channels per column, their times [s], how many, and the next to publish.
-  Eigen::MatrixXd carry_;
+  Eigen::MatrixXd carry_, carry_gains_;  // carry_gains_: their noise gains (3x3 per column)
   Eigen::VectorXd carry_times_;
+  // Smoother's noise gain: the newest sample of the last backward pass, the steps from
+  // it to the estimate emitted last or whether that one was carried (and its gain), and
+  // the gains by steps at a steady rate (smoothedNoiseGain()).
+  int pass_newest_ = 0;
+  int emitted_steps_ = 0;
+  bool emitted_carried_ = false;
+  Eigen::Matrix3d carried_gain_ = Eigen::Matrix3d::Zero();
+  mutable std::vector<Eigen::Matrix3d> smoothed_gains_;
+  mutable bool smoothed_gains_valid_ = false;
   int carry_count_ = 0;
   int carry_next_ = 0;
   double last_time_ = 0.0;

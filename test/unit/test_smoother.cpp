@@ -193,6 +193,63 @@ TEST(Smoother, EverySampleIsEstimatedOnceAcrossGapsAndAtTheEnd) {
   EXPECT_EQ(bank.delaySamples(), 20);
 }
 
+// noiseGain() of the smoothed estimate against its definition: the estimate is linear
+// in the measurements, so with a unit impulse at sample j in channel j (zeros elsewhere)
+// channel j's estimate is the estimate's weight w_j of measurement j, and the noise gain
+// (unit white measurement noise) is the sum of w_j w_j^T over every measurement. Checked
+// at a steady rate for every number of backward steps of the block scheme (D - B + 1
+// .. D) and at the end of the stream (finish(): D - 1 .. 0 steps).
+TEST(Smoother, NoiseGainIsTheSumOfTheSquaredWeights) {
+  DifferentiatorConfig c;
+  c.lag = 0.05;  // D = 50, B = 25 at 1 kHz
+  constexpr int kSamples = 1200;
+  DifferentiatorBank bank(c, kSamples);
+  std::vector<double> x(kSamples, 0.0);
+  const auto check = [&](const char* where) {
+    Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+    for (int j = 0; j < kSamples; ++j) {
+      const Eigen::Vector3d w(bank.value(j), bank.rate(j), bank.accel(j));
+      sum += w * w.transpose();
+    }
+    const Eigen::Matrix3d gain = bank.noiseGain();
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(gain(r, k), sum(r, k), 1e-9 * std::sqrt(sum(r, r) * sum(k, k)))
+            << where << " at " << bank.stamp() << " (" << r << ", " << k << ")";
+    return gain;
+  };
+  int checked = 0, emitted = 0;  // the i-th estimate is sample i's
+  Eigen::Matrix3d smoothed = Eigen::Matrix3d::Zero();
+  for (int k = 0; k < kSamples; ++k) {
+    x[static_cast<std::size_t>(k)] = 1.0;
+    if (k > 0) x[static_cast<std::size_t>(k - 1)] = 0.0;
+    if (!bank.update(1e-3 * k, x.data())) continue;
+    EXPECT_EQ(bank.stamp(), 1e-3 * emitted);
+    if (emitted >= 900 && emitted < 927) {  // more than B in a row: every step count
+      smoothed = check("steady");
+      ++checked;
+    }
+    ++emitted;
+  }
+  EXPECT_EQ(checked, 27);
+  EXPECT_EQ(bank.delaySamples(), 50);
+  bank.finish();
+  Eigen::Matrix3d last = Eigen::Matrix3d::Zero();
+  for (checked = 0; bank.next(); ++checked) last = check("finish");
+  EXPECT_EQ(checked, 50);
+  // The newest sample's estimate uses no later one: the causal filter's gain; the
+  // smoothed estimates' are far smaller (here the rate's by more than 10 times).
+  DifferentiatorConfig causal = c;
+  causal.lag = 0.0;
+  DifferentiatorBank forward(causal, 1);
+  for (int k = 0; k < kSamples; ++k) {
+    const double zero = 0.0;
+    forward.update(1e-3 * k, &zero);
+  }
+  EXPECT_NEAR(last(1, 1), forward.noiseGain()(1, 1), 1e-9 * last(1, 1));
+  EXPECT_LT(10.0 * smoothed(1, 1), last(1, 1));
+}
+
 TEST(Smoother, LagIsForKalmanOnly) {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kSavitzkyGolay;
