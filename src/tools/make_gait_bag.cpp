@@ -44,7 +44,7 @@ const char* const kUsage =
     R"(usage: make_gait_bag --urdf BODY.urdf --output OUT.bag [--strides 3] [--noise 0]
                      [--seed 1]
 
-Writes a bag of a body walking at 1.1 m/s over two force plates (lanes side by side:
+Writes a bag of a body walking at 1.1 m/s, 114 steps/min, over two force plates (lanes side by side:
 plate 1 under the right foot, plate 2 under the left; each foot lands on its own plate
 at every step), for the gait demo (docs/gait_demo.md):
   /joint_states         sensor_msgs/JointState, 200 Hz, positions of every coordinate
@@ -64,33 +64,41 @@ stamped t0 + i / rate (t0 = 1000 s); bag time = stamp for the joint states, stam
 ms for the poses and the plates (a reader in time order has the pose and the plate
 samples of an instant before its joint state).
 
-The trial (gait time g = t + 0.36 s, stride T = 1.2 s, w = 2 pi / T; the right heel
+The trial (gait time g = t + 0.315 s, stride T = 1.05 s, w = 2 pi / T; the right heel
 strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
   pelvis  x = 1.1 g - 0.016 sin(2w (g - 0.3T)) + dx(g), y = -0.03 cos(w (g - 0.3T)) + dy(g),
-          z = z0 + 0.02 cos(2w (g - 0.3T)), yaw = 0.07 cos(w g), roll = -0.05 sin(w g)
-          (z0 = the standing height of the pelvis minus 0.06 m); dx, dy: Fourier series
-          of period T, 20 harmonics, solved (12 relaxed fixed-point steps, each harmonic
-          scaled by the inverted pendulum's 1 / (1 + (z_com / g) (k w)^2)) so that the
-          centre of pressure of the model's inverse dynamics follows the plan:
+          z(g), yaw = 0.07 cos(w g), roll = -0.05 sin(w g); dx, dy: Fourier series of
+          period T, 20 harmonics, solved (20 fixed-point steps relaxed by 0.5, each
+          harmonic scaled by the inverted pendulum's 1 / (1 + (z_com / g) (k w)^2); the
+          step of the smallest miss kept) so that the centre of pressure of the model's
+          inverse dynamics follows the plan below; z: fitted at each step (2 harmonics)
+          to the height that gives the stance knee its planned flexion (5 deg at heel
+          strike, 18 deg at 12 %, 5 deg from 40 to 50 %, 40 deg at toe off; in double
+          support the two legs' heights blended by the force's split), then lowered by
+          its largest excess over the height at which either knee (the swing leg's too)
+          would straighten beyond 15 deg
   centre of pressure  single support: along the stance footprint from the heel (10 %)
-          to the toe (40 %) by a quintic smooth step, then at the toe; double support:
-          from the trailing toe to the leading heel by the split's smooth step
-  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 15 deg toe
-          up), foot flat (10 - 35 %), toe rocker (35 - 60 %: the heel rises, the foot
-          turns about the toe to 50 deg), swing (heel position and foot pitch from
-          toe off to the next heel strike; heel lifted by 0.05 m * 64 s^3 (1 - s)^3);
-          every motion a quintic smooth step S(s) = 10 s^3 - 15 s^4 + 6 s^5, so that
-          the feet are at rest at heel strike and toe off; footprints 0.66 m apart,
-          the heel 0.2 m ahead of the hip at heel strike, 5 deg toe-out, the
-          heels at 0.6 times their standing distance from the midline
+          to 0.77 of heel -> toe (30 %) by a quintic smooth step, then there; double
+          support: from the trailing foot (its point moving on to its toe as it
+          unloads) to the leading heel by the split's smooth step
+  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 25 deg toe
+          up), foot flat (10 - 35 %), forefoot rocker (35 - 60 %: the heel rises, the
+          foot turns about its metatarsal heads, 0.75 of heel -> toe, to 50 deg, by
+          S(s) + 3 (-4 s^3 + 7 s^4 - 3 s^5): it leaves the ground turning at 3 times
+          the rocker's mean rate), swing (quintic Hermite curves of the heel and the
+          pitch from toe off, matching its position, velocity and acceleration, to the
+          next heel strike at rest, the pitch there by 85 % of the swing; heel lifted
+          by 0.08 m s^3 (1 - s)^6 / max); the other motions quintic smooth steps
+          S(s) = 10 s^3 - 15 s^4 + 6 s^5; footprints 0.5775 m apart, 5 deg toe-out,
+          the heels at 0.6 times their standing distance from the midline
   joints  the leg's 5 angles that put heel_s and toe_s where the foot is (inverse
           kinematics to 1e-12 m on a 1 kHz grid); velocities and accelerations by
           5-point central differences on that grid
   plates  the wrench the world must apply to the pelvis for that motion (the model's
           floating-base inverse dynamics, gravity 0 0 -9.80665), on the stance foot; in
           double support split by a quintic smooth step of the force from the trailing
-          to the leading foot, each foot's centre of pressure the nominal point (toe of
-          the trailing foot, heel of the leading) shifted by the same vector, so that
+          to the leading foot, each foot's centre of pressure the nominal point (the
+          trailing foot's, above; the leading heel) shifted by the same vector, so that
           the two sum to the whole wrench; free moment split like the force
   noise   with --noise SIGMA: Gaussian noise (Box-Muller on jle::PortableRandom(seed), the
           cosine of each pair) of SIGMA
@@ -713,13 +721,12 @@ std::array<Leg, 2> findLegs(const jle::Model<double>& model, const std::string& 
   return legs;
 }
 
-// The standing body (q = 0, pelvis at the origin): each foot's length and footprint, and
-// the sole's height (returned).
-double measureFeet(const jle::Model<double>& model, jle::Data<double>& data,
-                   std::array<Leg, 2>& legs, const std::string& urdf) {
+// The standing body (q = 0, pelvis at the origin): each foot's length and footprint, its
+// hip joint centre, thigh and shank lengths and its ankle's place on the foot.
+void measureFeet(const jle::Model<double>& model, jle::Data<double>& data, std::array<Leg, 2>& legs,
+                 const std::string& urdf) {
   const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
   jle::forwardKinematics(model, data, zero, zero, zero, Vector3d(0.0, 0.0, -kGravity));
-  double sole = 0.0;
   for (Leg& leg : legs) {
     const Vector3d heel = framePosition(model, data, leg.heel);
     const Vector3d toe = framePosition(model, data, leg.toe);
@@ -735,12 +742,10 @@ double measureFeet(const jle::Model<double>& model, jle::Data<double>& data,
     leg.thigh = (knee - hip).norm();
     leg.shank = (ankle - knee).norm();
     leg.ankle_heel = footAxes(heel, toe).transpose() * (ankle - heel);
-    sole = std::min({sole, heel.z(), toe.z()});
     if (!(leg.foot_length > 0.05))
       throw std::runtime_error(urdf + ": heel_" + std::string(1, leg.side) + " and toe_" +
                                std::string(1, leg.side) + " are less than 5 cm apart");
   }
-  return sole;
 }
 
 // The whole trial: the body, its legs, their gait, the pelvis path.
@@ -1080,8 +1085,8 @@ void printReport(const jle::Model<double>& model, const Options& options, const 
       "%.3f m beside that line\n",
       figures.cop_min, figures.cop_max, figures.cop_side);
   std::printf(
-      "  double support: each foot's centre of pressure within %.3f m of its heel "
-      "(leading) or toe (trailing)\n",
+      "  double support: each foot's centre of pressure within %.3f m of its nominal "
+      "point (leading heel, trailing forefoot)\n",
       figures.cop_shift);
   std::printf("  centre of pressure: planned path missed by %.3f m at most\n", trial.cop_error);
   std::printf(
