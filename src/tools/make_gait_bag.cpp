@@ -44,7 +44,7 @@ const char* const kUsage =
     R"(usage: make_gait_bag --urdf BODY.urdf --output OUT.bag [--strides 3] [--noise 0]
                      [--seed 1]
 
-Writes a bag of a body walking at 1.1 m/s over two force plates (lanes side by side:
+Writes a bag of a body walking at 1.1 m/s, 114 steps/min, over two force plates (lanes side by side:
 plate 1 under the right foot, plate 2 under the left; each foot lands on its own plate
 at every step), for the gait demo (docs/gait_demo.md):
   /joint_states         sensor_msgs/JointState, 200 Hz, positions of every coordinate
@@ -64,33 +64,41 @@ stamped t0 + i / rate (t0 = 1000 s); bag time = stamp for the joint states, stam
 ms for the poses and the plates (a reader in time order has the pose and the plate
 samples of an instant before its joint state).
 
-The trial (gait time g = t + 0.36 s, stride T = 1.2 s, w = 2 pi / T; the right heel
+The trial (gait time g = t + 0.315 s, stride T = 1.05 s, w = 2 pi / T; the right heel
 strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
   pelvis  x = 1.1 g - 0.016 sin(2w (g - 0.3T)) + dx(g), y = -0.03 cos(w (g - 0.3T)) + dy(g),
-          z = z0 + 0.02 cos(2w (g - 0.3T)), yaw = 0.07 cos(w g), roll = -0.05 sin(w g)
-          (z0 = the standing height of the pelvis minus 0.06 m); dx, dy: Fourier series
-          of period T, 20 harmonics, solved (12 relaxed fixed-point steps, each harmonic
-          scaled by the inverted pendulum's 1 / (1 + (z_com / g) (k w)^2)) so that the
-          centre of pressure of the model's inverse dynamics follows the plan:
+          z(g), yaw = 0.07 cos(w g), roll = -0.05 sin(w g); dx, dy: Fourier series of
+          period T, 20 harmonics, solved (20 fixed-point steps relaxed by 0.5, each
+          harmonic scaled by the inverted pendulum's 1 / (1 + (z_com / g) (k w)^2); the
+          step of the smallest miss kept) so that the centre of pressure of the model's
+          inverse dynamics follows the plan below; z: fitted at each step (2 harmonics)
+          to the height that gives the stance knee its planned flexion (5 deg at heel
+          strike, 18 deg at 12 %, 5 deg from 40 to 50 %, 40 deg at toe off; in double
+          support the two legs' heights blended by the force's split), then lowered by
+          its largest excess over the height at which either knee (the swing leg's too)
+          would straighten beyond 15 deg
   centre of pressure  single support: along the stance footprint from the heel (10 %)
-          to the toe (40 %) by a quintic smooth step, then at the toe; double support:
-          from the trailing toe to the leading heel by the split's smooth step
-  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 15 deg toe
-          up), foot flat (10 - 35 %), toe rocker (35 - 60 %: the heel rises, the foot
-          turns about the toe to 50 deg), swing (heel position and foot pitch from
-          toe off to the next heel strike; heel lifted by 0.05 m * 64 s^3 (1 - s)^3);
-          every motion a quintic smooth step S(s) = 10 s^3 - 15 s^4 + 6 s^5, so that
-          the feet are at rest at heel strike and toe off; footprints 0.66 m apart,
-          the heel 0.2 m ahead of the hip at heel strike, 5 deg toe-out, the
-          heels at 0.6 times their standing distance from the midline
+          to 0.77 of heel -> toe (30 %) by a quintic smooth step, then there; double
+          support: from the trailing foot (its point moving on to its toe as it
+          unloads) to the leading heel by the split's smooth step
+  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 25 deg toe
+          up), foot flat (10 - 35 %), forefoot rocker (35 - 60 %: the heel rises, the
+          foot turns about its metatarsal heads, 0.75 of heel -> toe, to 50 deg, by
+          S(s) + 3 (-4 s^3 + 7 s^4 - 3 s^5): it leaves the ground turning at 3 times
+          the rocker's mean rate), swing (quintic Hermite curves of the heel and the
+          pitch from toe off, matching its position, velocity and acceleration, to the
+          next heel strike at rest, the pitch there by 85 % of the swing; heel lifted
+          by 0.08 m s^3 (1 - s)^6 / max); the other motions quintic smooth steps
+          S(s) = 10 s^3 - 15 s^4 + 6 s^5; footprints 0.5775 m apart, 5 deg toe-out,
+          the heels at 0.6 times their standing distance from the midline
   joints  the leg's 5 angles that put heel_s and toe_s where the foot is (inverse
           kinematics to 1e-12 m on a 1 kHz grid); velocities and accelerations by
           5-point central differences on that grid
   plates  the wrench the world must apply to the pelvis for that motion (the model's
           floating-base inverse dynamics, gravity 0 0 -9.80665), on the stance foot; in
           double support split by a quintic smooth step of the force from the trailing
-          to the leading foot, each foot's centre of pressure the nominal point (toe of
-          the trailing foot, heel of the leading) shifted by the same vector, so that
+          to the leading foot, each foot's centre of pressure the nominal point (the
+          trailing foot's, above; the leading heel) shifted by the same vector, so that
           the two sum to the whole wrench; free moment split like the force
   noise   with --noise SIGMA: Gaussian noise (Box-Muller on jle::PortableRandom(seed), the
           cosine of each pair) of SIGMA
@@ -118,32 +126,41 @@ unwritable bag); 2 a usage error.
 constexpr double kPi = 3.141592653589793;
 constexpr std::int64_t kEpochNs = 1000000000000LL;  // t0 = 1000 s
 constexpr double kGravity = 9.80665;
+constexpr double kDeg = kPi / 180.0;
 
-// The trial's parameters (kUsage).
-constexpr double kSpeed = 1.1;        // [m/s]
-constexpr double kStride = 1.2;       // [s]
-constexpr double kStartPhase = 0.3;   // the trial starts at 30 % of the right cycle
-constexpr double kHeelRocker = 0.10;  // end of the heel rocker, fraction of T
-constexpr double kHeelOff = 0.35;     // start of the toe rocker
-constexpr double kToeOff = 0.60;      // end of stance
-constexpr double kHeelStrikePitch = 15.0 * kPi / 180.0;  // toe up at heel strike
-constexpr double kToeOffPitch = -50.0 * kPi / 180.0;     // heel up at toe off
-constexpr double kToeOut = 5.0 * kPi / 180.0;
-constexpr double kClearance = 0.05;   // [m] heel lift in mid-swing
-constexpr double kPelvisDrop = 0.06;  // [m] mean pelvis height below standing
-constexpr double kHeelAhead = 0.20;   // [m] heel ahead of the hip at heel strike
-constexpr double kSwayX = 0.016;
-constexpr double kSwayY = 0.03;  // [m] lateral sway (amplitude of y)
-constexpr double kStepWidthRatio =
-    0.6;  // footprint y / standing heel y         // [m] forward speed modulation (amplitude of x)
-constexpr double kJointRate = 200.0;   // [Hz]
-constexpr int kPlateDivisor = 5;       // plate samples per joint sample (1 kHz)
-constexpr int kDisplayDivisor = 10;    // plate samples per display sample (100 Hz)
-constexpr double kLaneWidth = 0.4;     // [m] each plate's width (y)
-constexpr int kHarmonics = 20;         // of the pelvis path's correction (17 Hz)
-constexpr double kCopArrival = 0.40;   // the centre of pressure reaches the toe (of T)
-constexpr int kPelvisIterations = 12;  // of solvePelvis
-constexpr double kRelaxation = 0.7;    // of its steps
+// The trial's parameters (kUsage; the sources of the normative ones in docs/gait_demo.md).
+constexpr double kSpeed = 1.1;                    // [m/s]
+constexpr double kStride = 1.05;                  // [s] 114 steps/min
+constexpr double kStartPhase = 0.3;               // the trial starts at 30 % of the right cycle
+constexpr double kHeelRocker = 0.10;              // end of the heel rocker, fraction of T
+constexpr double kHeelOff = 0.35;                 // start of the forefoot rocker
+constexpr double kToeOff = 0.60;                  // end of stance
+constexpr double kHeelStrikePitch = 25.0 * kDeg;  // toe up at heel strike
+constexpr double kToeOffPitch = -50.0 * kDeg;     // heel up at toe off
+constexpr double kToeOut = 5.0 * kDeg;
+constexpr double kToeOffRate = 3.0;     // the foot's pitch rate at toe off / the rocker's mean
+constexpr double kPitchArrival = 0.85;  // the swing foot's pitch is the heel strike's from here
+constexpr double kClearance = 0.08;     // [m] the swing heel's lift at its peak
+constexpr double kLiftTail = 6.0;       // its shape: s^3 (1 - s)^6, the peak at 1/3 of swing
+constexpr double kKneeStraight = 15.0 * kDeg;  // the pelvis never straightens a knee more
+constexpr int kHeightHarmonics = 2;            // of the pelvis height (1.9 Hz)
+constexpr double kHeelAhead = 0.20;      // [m] heel ahead of the hip at heel strike (first guess)
+constexpr double kSwayX = 0.016;         // [m] forward speed modulation (amplitude of x)
+constexpr double kSwayY = 0.03;          // [m] lateral sway (amplitude of y)
+constexpr double kStepWidthRatio = 0.6;  // footprint y / standing heel y
+constexpr double kJointRate = 200.0;     // [Hz]
+constexpr int kPlateDivisor = 5;         // plate samples per joint sample (1 kHz)
+constexpr int kDisplayDivisor = 10;      // plate samples per display sample (100 Hz)
+constexpr double kLaneWidth = 0.4;       // [m] each plate's width (y)
+constexpr int kHarmonics = 20;           // of the pelvis path's correction (19 Hz)
+// The metatarsal heads (the forefoot rocker's pivot), as a fraction of heel -> toe:
+// Dempster's distal end of the foot (docs/body_model.md A3).
+constexpr double kBall = 0.75;
+constexpr double kCopArrival = 0.30;   // the centre of pressure reaches kCopEnd (of T)
+constexpr double kCopEnd = 0.77;       // where it stays in single support, of heel -> toe
+constexpr double kTrailToToe = 1.0;    // the trailing foot's share reaches its toe at toe off
+constexpr int kPelvisIterations = 20;  // of solvePelvis
+constexpr double kRelaxation = 0.5;    // of its steps
 
 struct Options {
   std::string urdf, output;
@@ -175,17 +192,46 @@ double smoothStep(double s) {
   return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
 }
 
+// The forefoot rocker's pitch profile: 0 at s = 0 with zero first and second derivative
+// (from foot flat), 1 at s = 1 with the rate kToeOffRate (the foot leaves the ground
+// turning, so that it does not linger behind the body in early swing) and no second
+// derivative: the quintic S(s) + kToeOffRate (-4 s^3 + 7 s^4 - 3 s^5).
+double rockerStep(double s) {
+  s = std::min(1.0, std::max(0.0, s));
+  return smoothStep(s) + kToeOffRate * s * s * s * (-4.0 + 7.0 * s - 3.0 * s * s);
+}
+
+// The swing heel's lift over s in [0, 1]: s^3 (1 - s)^kLiftTail scaled to a peak of 1,
+// zero with its first and second derivatives at both ends; a tail longer than 3 puts
+// the peak early in swing (at 3 / (3 + tail)), where the foot is still turned heel up.
+double liftBump(double s) {
+  const double peak = 3.0 / (3.0 + kLiftTail);
+  const auto shape = [](double x) { return x * x * x * std::pow(1.0 - x, kLiftTail); };
+  return shape(s) / shape(peak);
+}
+
+// Quintic Hermite curve over a duration d [s] at s = t / d in [0, 1]: from x0 with
+// velocity v0 and acceleration a0 to x1 at rest (no velocity, no acceleration).
+template <typename T>
+T hermite(const T& x0, const T& v0, const T& a0, const T& x1, double s, double d) {
+  const double s2 = s * s, s3 = s2 * s;
+  const double h1 = s - 6.0 * s3 + 8.0 * s3 * s - 3.0 * s3 * s2;
+  const double h2 = 0.5 * s2 - 1.5 * s3 + 1.5 * s3 * s - 0.5 * s3 * s2;
+  return x0 + (x1 - x0) * smoothStep(s) + v0 * (d * h1) + a0 * (d * d * h2);
+}
+
 // Pelvis pose, twist and acceleration at gait time g (kUsage), world frame.
-// The horizontal correction of the pelvis path (x, y), solved by solvePelvis so that the
-// centre of pressure follows the planned one: a Fourier series of period T in gait time,
-// d(g) = sum_k a_k cos(k w g) + b_k sin(k w g), k = 0 .. kHarmonics.
+// The correction of the pelvis path, a Fourier series of period T in gait time,
+// d(g) = sum_k a_k cos(k w g) + b_k sin(k w g), k = 0 .. kHarmonics: its x and y solved
+// by solvePelvis so that the centre of pressure follows the planned one, its z (the
+// pelvis height itself) fitted by fitHeight to the planned stance knee.
 struct Correction {
-  std::array<Eigen::Matrix<double, 2, 1>, kHarmonics + 1> a{}, b{};
+  std::array<Vector3d, kHarmonics + 1> a{}, b{};
   Correction() {
     for (int k = 0; k <= kHarmonics; ++k) a[k].setZero(), b[k].setZero();
   }
   // Value, first and second derivative at gait time g.
-  void at(double g, Eigen::Vector2d& d, Eigen::Vector2d& d1, Eigen::Vector2d& d2) const {
+  void at(double g, Vector3d& d, Vector3d& d1, Vector3d& d2) const {
     const double w = 2.0 * kPi / kStride;
     d = a[0];
     d1.setZero();
@@ -200,22 +246,21 @@ struct Correction {
 };
 
 struct Pelvis {
-  double z0 = 0.0;
   double x_offset = 0.0;
   Correction correction;
   jle::BaseState<double> at(double g) const {
     const double w = 2.0 * kPi / kStride, w2 = 2.0 * w;
     const double c = g - kStartPhase * kStride;
-    Eigen::Vector2d d, d1, d2;
+    Vector3d d, d1, d2;
     correction.at(g, d, d1, d2);
     jle::BaseState<double> b;
-    b.p_world_base = Vector3d(x_offset + kSpeed * g - kSwayX * std::sin(w2 * c) + d.x(),
-                              -kSwayY * std::cos(w * c) + d.y(), z0 + 0.02 * std::cos(w2 * c));
-    b.v_world = Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c) + d1.x(),
-                         kSwayY * w * std::sin(w * c) + d1.y(), -0.02 * w2 * std::sin(w2 * c));
+    b.p_world_base = Vector3d(x_offset + kSpeed * g - kSwayX * std::sin(w2 * c),
+                              -kSwayY * std::cos(w * c), 0.0) +
+                     d;
+    b.v_world =
+        Vector3d(kSpeed - kSwayX * w2 * std::cos(w2 * c), kSwayY * w * std::sin(w * c), 0.0) + d1;
     b.a_world =
-        Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c) + d2.x(),
-                 kSwayY * w * w * std::cos(w * c) + d2.y(), -0.02 * w2 * w2 * std::cos(w2 * c));
+        Vector3d(kSwayX * w2 * w2 * std::sin(w2 * c), kSwayY * w * w * std::cos(w * c), 0.0) + d2;
     const double yaw = 0.07 * std::cos(w * g), yaw_d = -0.07 * w * std::sin(w * g),
                  yaw_dd = -0.07 * w * w * std::cos(w * g);
     const double roll = -0.05 * std::sin(w * g), roll_d = -0.05 * w * std::cos(w * g),
@@ -237,9 +282,12 @@ struct Leg {
   double y_sign = -1.0;        // -1 right, +1 left
   double strike_offset = 0.0;  // gait time of its first heel strike in the cycle [s]
   std::array<int, 5> coordinate{};
-  int heel = 0, toe = 0;     // frame indices
-  double y_footprint = 0.0;  // [m] heel's y at standing (footprints' lateral place)
-  double foot_length = 0.0;  // [m] heel to toe
+  int heel = 0, toe = 0;                   // frame indices
+  double y_footprint = 0.0;                // [m] heel's y at standing (footprints' lateral place)
+  double foot_length = 0.0;                // [m] heel to toe
+  Vector3d hip_pelvis = Vector3d::Zero();  // [m] hip joint centre in the pelvis frame
+  double thigh = 0.0, shank = 0.0;         // [m] hip to knee, knee to ankle
+  Vector3d ankle_heel = Vector3d::Zero();  // [m] ankle from the heel in footAxes
 };
 
 // Heel and toe points of a leg at gait time g, and whether it is in stance; also the
@@ -247,6 +295,7 @@ struct Leg {
 struct FootState {
   Vector3d heel, toe;
   Vector3d print_heel, print_toe;  // in stance: the footprint's heel and toe (z = 0)
+  Vector3d print_ball;             // and its metatarsal heads (kBall of heel -> toe)
   bool stance = false;
   double since_strike = 0.0;
 };
@@ -281,6 +330,7 @@ struct Gait {
     f.since_strike = tau;
     f.print_heel = H;
     f.print_toe = H + l * direction(leg, 0.0);
+    f.print_ball = H + kBall * l * direction(leg, 0.0);
     const double t1 = kHeelRocker * T, t2 = kHeelOff * T, t3 = kToeOff * T;
     if (tau < t1) {  // heel rocker: pitch = p_hs (1 - S(s)) about the heel
       f.heel = H;
@@ -290,25 +340,70 @@ struct Gait {
       f.heel = H;
       f.toe = H + l * direction(leg, 0.0);
       f.stance = true;
-    } else if (tau < t3) {  // toe rocker: pitch = p_to S(s) about the toe
-      f.toe = H + l * direction(leg, 0.0);
-      f.heel = f.toe - l * direction(leg, kToeOffPitch * smoothStep((tau - t2) / (t3 - t2)));
+    } else if (tau < t3) {  // forefoot rocker: pitch = p_to R(s) about the metatarsal heads
+      const Vector3d u = direction(leg, kToeOffPitch * rockerStep((tau - t2) / (t3 - t2)));
+      f.heel = f.print_ball - kBall * l * u;
+      f.toe = f.print_ball + (1.0 - kBall) * l * u;
       f.stance = true;
     } else {  // swing: quintic from toe off to the next heel strike
-      // Both ends at rest (the smooth steps of the rockers): quintic smooth steps.
+      // From the forefoot rocker's end (its position, velocity and acceleration) to the
+      // next heel strike at rest: quintic Hermite curves of the heel and the pitch.
       const double d = T - t3;
-      const Vector3d toe = H + l * direction(leg, 0.0);
-      const Vector3d h0 = toe - l * direction(leg, kToeOffPitch);
+      const double rate = kToeOffPitch * kToeOffRate / (t3 - t2);  // pitch rate at toe off
+      const double r = kBall * l;
+      const Vector3d h0 = f.print_ball - r * direction(leg, kToeOffPitch);
+      const Vector3d v0 = -r * directionRate(leg, kToeOffPitch) * rate;
+      const Vector3d a0 = r * direction(leg, kToeOffPitch) * rate * rate;
       const Vector3d h1 = footprint(leg, strike + T);
       const double s = (tau - t3) / d;
-      const double pitch = kToeOffPitch + (kHeelStrikePitch - kToeOffPitch) * smoothStep(s);
-      f.heel = h0 + (h1 - h0) * smoothStep(s);
-      f.heel.z() += kClearance * 64.0 * std::pow(s * (1.0 - s), 3);
+      // The pitch reaches the heel strike's by kPitchArrival of the swing and holds it.
+      const double pitch = hermite(kToeOffPitch, rate, 0.0, kHeelStrikePitch,
+                                   std::min(1.0, s / kPitchArrival), kPitchArrival * d);
+      f.heel = hermite(h0, v0, a0, h1, s, d);
+      f.heel.z() += kClearance * liftBump(s);
       f.toe = f.heel + l * direction(leg, pitch);
     }
     return f;
   }
 };
+
+// A foot's axes from its heel and toe points: along the sole (heel to toe), to the left
+// and horizontal, and their cross product (up from the sole); as columns.
+Matrix3d footAxes(const Vector3d& heel, const Vector3d& toe) {
+  const Vector3d u = (toe - heel).normalized();
+  const Vector3d v = Vector3d::UnitZ().cross(u).normalized();
+  Matrix3d axes;
+  axes << u, v, u.cross(v);
+  return axes;
+}
+
+// The planned knee flexion [rad] of a leg at fraction s of its cycle since heel strike,
+// stance only (J. Perry, J. M. Burnfield, Gait Analysis, 2nd ed., 2010, the knee's
+// curve): about 5 deg at initial contact, 18 deg at the end of the loading response
+// (12 %), 5 deg from terminal stance (40 %) to the other foot's heel strike (50 %), 40
+// deg at toe off (60 %); quintic smooth steps between.
+double plannedKnee(double s) {
+  const double deg = kPi / 180.0;
+  if (s < 0.12) return (5.0 + 13.0 * smoothStep(s / 0.12)) * deg;
+  if (s < 0.40) return (18.0 - 13.0 * smoothStep((s - 0.12) / 0.28)) * deg;
+  if (s < 0.50) return 5.0 * deg;
+  return (5.0 + 35.0 * smoothStep((s - 0.50) / (kToeOff - 0.50))) * deg;
+}
+
+// The pelvis height [m] that bends the leg's knee to knee [rad] with its foot where foot
+// has it, the pelvis horizontally where base has it and turned as base: the hip-to-ankle
+// distance depends on the knee alone (the three hip axes meet at the joint centre, the
+// knee's is across the thigh and the shank).
+double heightForKnee(const Leg& leg, const FootState& foot, const jle::BaseState<double>& base,
+                     double knee) {
+  const Vector3d ankle = foot.heel + footAxes(foot.heel, foot.toe) * leg.ankle_heel;
+  const Vector3d hip = Vector3d(base.p_world_base.x(), base.p_world_base.y(), 0.0) +
+                       base.R_world_base * leg.hip_pelvis;
+  const double reach2 =
+      leg.thigh * leg.thigh + leg.shank * leg.shank + 2.0 * leg.thigh * leg.shank * std::cos(knee);
+  const double flat2 = (hip - ankle).head<2>().squaredNorm();
+  return ankle.z() - hip.z() + std::sqrt(std::max(reach2 - flat2, 0.0));
+}
 
 Vector3d framePosition(const jle::Model<double>& model, const jle::Data<double>& data, int frame) {
   const jle::Frame<double>& f = model.frames[static_cast<std::size_t>(frame)];
@@ -318,9 +413,9 @@ Vector3d framePosition(const jle::Model<double>& model, const jle::Data<double>&
 
 // Puts the leg's heel and toe frames on the targets (Gauss-Newton, numerical Jacobian,
 // damped); q holds the start and receives the solution. Returns the remaining error [m].
-double solveLeg(const jle::Model<double>& model, jle::Data<double>& data, const Leg& leg,
-                const jle::BaseState<double>& base, const Vector3d& heel, const Vector3d& toe,
-                jle::VectorX<double>& q) {
+double solveLegFrom(const jle::Model<double>& model, jle::Data<double>& data, const Leg& leg,
+                    const jle::BaseState<double>& base, const Vector3d& heel, const Vector3d& toe,
+                    jle::VectorX<double>& q) {
   const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
   const Vector3d gravity(0.0, 0.0, -kGravity);
   auto error = [&](const jle::VectorX<double>& qq) {
@@ -353,6 +448,21 @@ double solveLeg(const jle::Model<double>& model, jle::Data<double>& data, const 
     if (step.norm() < 1e-15) break;
   }
   return norm;
+}
+
+// solveLegFrom from q; where that stalls (a knee gone straight has no gradient to bend
+// it again), once more from the knee bent by 0.5 rad, keeping the better solution.
+double solveLeg(const jle::Model<double>& model, jle::Data<double>& data, const Leg& leg,
+                const jle::BaseState<double>& base, const Vector3d& heel, const Vector3d& toe,
+                jle::VectorX<double>& q) {
+  jle::VectorX<double> start = q;
+  const double norm = solveLegFrom(model, data, leg, base, heel, toe, q);
+  if (norm < 1e-10) return norm;
+  start[leg.coordinate[3]] = 0.5;
+  const double again = solveLegFrom(model, data, leg, base, heel, toe, start);
+  if (again >= norm) return norm;
+  q = start;
+  return again;
 }
 
 int coordinateIndex(const jle::Model<double>& model, const std::string& name,
@@ -396,6 +506,14 @@ struct Share {
   double free_moment = 0.0;
 };
 
+// The trailing foot's nominal centre of pressure in double support, as the leading foot
+// takes the share w_lead of the force: from its metatarsal heads towards its toes
+// (kTrailToToe of the way at toe off), where the unloading foot pushes off last.
+Vector3d trailingPoint(const FootState& f, double w_lead) {
+  const Vector3d end = f.print_heel + kCopEnd * (f.print_toe - f.print_heel);
+  return end + kTrailToToe * w_lead * (f.print_toe - end);
+}
+
 // The planned centre of pressure (ground, x y) for the feet at one instant: in single
 // support along the stance footprint from the heel (at the end of the heel rocker) to
 // the toe (at kCopArrival of the cycle, before the heel rises fully), by a quintic smooth
@@ -408,13 +526,13 @@ Eigen::Vector2d plannedCop(const std::array<FootState, 2>& feet) {
     const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
     const double w_lead =
         smoothStep(feet[static_cast<std::size_t>(lead)].since_strike / ((kToeOff - 0.5) * kStride));
-    p = (1.0 - w_lead) * feet[static_cast<std::size_t>(1 - lead)].print_toe +
+    p = (1.0 - w_lead) * trailingPoint(feet[static_cast<std::size_t>(1 - lead)], w_lead) +
         w_lead * feet[static_cast<std::size_t>(lead)].print_heel;
   } else {
     const FootState& f = feet[0].stance ? feet[0] : feet[1];
     const double u = smoothStep((f.since_strike - kHeelRocker * kStride) /
                                 ((kCopArrival - kHeelRocker) * kStride));
-    p = f.print_heel + u * (f.print_toe - f.print_heel);
+    p = f.print_heel + u * kCopEnd * (f.print_toe - f.print_heel);
   }
   return p.head<2>();
 }
@@ -457,9 +575,67 @@ void correctPelvis(const std::vector<Eigen::Vector2d>& error, double g0, double 
       B += error[static_cast<std::size_t>(k)] * std::sin(m * w * g);
     }
     const double response = 1.0 + z_com / kGravity * (m * w) * (m * w);
-    pelvis.correction.a[m] += kRelaxation * (m == 0 ? 1.0 : 2.0) / n * A / response;
-    pelvis.correction.b[m] += kRelaxation * (m == 0 ? 0.0 : 2.0) / n * B / response;
+    pelvis.correction.a[m].head<2>() += kRelaxation * (m == 0 ? 1.0 : 2.0) / n * A / response;
+    pelvis.correction.b[m].head<2>() += kRelaxation * (m == 0 ? 0.0 : 2.0) / n * B / response;
   }
+}
+
+// The pelvis height wanted over the stride's grid (gait times g0 + k h, k = 0 .. n - 1)
+// for the planned knee (plannedKnee): in single support the stance leg's, in double
+// support the two legs' heights blended by the force's split (the trailing leg's at
+// first, the leading leg's at the end); and the cap: the height that bends either knee
+// to kKneeStraight only (the swing leg's too, reaching for its heel strike), above which
+// a leg no longer reaches its foot.
+void heightTargets(const std::array<Leg, 2>& legs, const Gait& gait, const Pelvis& pelvis,
+                   double g0, double h, std::vector<double>& target, std::vector<double>& cap) {
+  for (std::size_t k = 0; k < target.size(); ++k) {
+    const double g = g0 + static_cast<double>(k) * h;
+    const jle::BaseState<double> base = pelvis.at(g);
+    const std::array<FootState, 2> feet = {gait.at(legs[0], g), gait.at(legs[1], g)};
+    const auto height = [&](int i, double knee) {
+      return heightForKnee(legs[static_cast<std::size_t>(i)], feet[static_cast<std::size_t>(i)],
+                           base, knee);
+    };
+    const auto planned = [&](int i) {
+      return height(i, plannedKnee(feet[static_cast<std::size_t>(i)].since_strike / kStride));
+    };
+    cap[k] = std::min(height(0, kKneeStraight), height(1, kKneeStraight));
+    if (feet[0].stance && feet[1].stance) {
+      const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
+      const double w_lead = smoothStep(feet[static_cast<std::size_t>(lead)].since_strike /
+                                       ((kToeOff - 0.5) * kStride));
+      target[k] = (1.0 - w_lead) * planned(1 - lead) + w_lead * planned(lead);
+    } else {
+      target[k] = planned(feet[0].stance ? 0 : 1);
+    }
+    target[k] = std::min(target[k], cap[k]);
+  }
+}
+
+// Fits the pelvis height (the z of the correction) to heightTargets over the stride's
+// grid of n points: its harmonics up to kHeightHarmonics (a smooth path: the vertical
+// ground reaction is the body's vertical acceleration), then the whole path down by its
+// largest overshoot of the cap, so that both legs reach their feet everywhere.
+void fitHeight(const std::array<Leg, 2>& legs, const Gait& gait, double g0, double h, int n,
+               Pelvis& pelvis) {
+  std::vector<double> target(static_cast<std::size_t>(n)), cap(target.size());
+  heightTargets(legs, gait, pelvis, g0, h, target, cap);
+  const double w = 2.0 * kPi / kStride;
+  for (int m = 0; m <= kHarmonics; ++m) {
+    double A = 0.0, B = 0.0;
+    for (std::size_t k = 0; m <= kHeightHarmonics && k < target.size(); ++k) {
+      const double g = g0 + static_cast<double>(k) * h;
+      A += target[k] * std::cos(m * w * g);
+      B += target[k] * std::sin(m * w * g);
+    }
+    pelvis.correction.a[m].z() = (m == 0 ? 1.0 : 2.0) / n * A;
+    pelvis.correction.b[m].z() = m == 0 ? 0.0 : 2.0 / n * B;
+  }
+  double overshoot = 0.0;
+  for (std::size_t k = 0; k < target.size(); ++k)
+    overshoot =
+        std::max(overshoot, pelvis.at(g0 + static_cast<double>(k) * h).p_world_base.z() - cap[k]);
+  if (overshoot > 0.0) pelvis.correction.a[0].z() -= overshoot + 1e-4;
 }
 
 // Puts the feet of both legs where the gait has them at every point of a grid (gait
@@ -497,8 +673,10 @@ double solvePelvis(const jle::Model<double>& model, jle::Data<double>& data,
   std::vector<jle::VectorX<double>> grid(static_cast<std::size_t>(n + 4), q_start);
   std::vector<Eigen::Vector2d> error(static_cast<std::size_t>(n));
   jle::VectorX<double> qd(model.nq), qdd(model.nq);
-  double largest = 0.0;
+  double largest = 0.0, best_error = 1e300;
+  Pelvis best = pelvis;  // the path of the smallest error
   for (int iteration = 0;; ++iteration) {
+    fitHeight(legs, gait, g0, h, n, pelvis);
     // Warm start: from the last solution (first: the previous sample's).
     solveGridLegs(model, data, legs, gait, pelvis, g0, h, -2, iteration == 0, grid);
     largest = 0.0;
@@ -516,10 +694,12 @@ double solvePelvis(const jle::Model<double>& model, jle::Data<double>& data,
       for (std::size_t i = 0; i < model.com.size(); ++i)
         z_com += model.mass[i] * jle::comWorld(model, data, static_cast<int>(i)).z() / (mass * n);
     }
+    if (largest < best_error) best_error = largest, best = pelvis;
     if (iteration == iterations) break;
     correctPelvis(error, g0, h, z_com, pelvis);
   }
-  return largest;
+  pelvis = best;
+  return best_error;
 }
 
 // The legs' coordinates and sole frames (the body model of docs/gait_demo.md).
@@ -541,24 +721,31 @@ std::array<Leg, 2> findLegs(const jle::Model<double>& model, const std::string& 
   return legs;
 }
 
-// The standing body (q = 0, pelvis at the origin): each foot's length and footprint, and
-// the sole's height (returned).
-double measureFeet(const jle::Model<double>& model, jle::Data<double>& data,
-                   std::array<Leg, 2>& legs, const std::string& urdf) {
+// The standing body (q = 0, pelvis at the origin): each foot's length and footprint, its
+// hip joint centre, thigh and shank lengths and its ankle's place on the foot.
+void measureFeet(const jle::Model<double>& model, jle::Data<double>& data, std::array<Leg, 2>& legs,
+                 const std::string& urdf) {
   const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
   jle::forwardKinematics(model, data, zero, zero, zero, Vector3d(0.0, 0.0, -kGravity));
-  double sole = 0.0;
   for (Leg& leg : legs) {
     const Vector3d heel = framePosition(model, data, leg.heel);
     const Vector3d toe = framePosition(model, data, leg.toe);
     leg.foot_length = (toe - heel).norm();
     leg.y_footprint = kStepWidthRatio * heel.y();
-    sole = std::min({sole, heel.z(), toe.z()});
+    const std::string s(1, leg.side);
+    const auto joint = [&](const char* name) {
+      return data.p_world[static_cast<std::size_t>(model.segmentOfJoint(name + s))];
+    };
+    const Vector3d hip = joint("hip_flexion_"), knee = joint("knee_flexion_"),
+                   ankle = joint("ankle_flexion_");
+    leg.hip_pelvis = hip;
+    leg.thigh = (knee - hip).norm();
+    leg.shank = (ankle - knee).norm();
+    leg.ankle_heel = footAxes(heel, toe).transpose() * (ankle - heel);
     if (!(leg.foot_length > 0.05))
       throw std::runtime_error(urdf + ": heel_" + std::string(1, leg.side) + " and toe_" +
                                std::string(1, leg.side) + " are less than 5 cm apart");
   }
-  return sole;
 }
 
 // The whole trial: the body, its legs, their gait, the pelvis path.
@@ -573,10 +760,9 @@ Trial planTrial(const jle::Model<double>& model, jle::Data<double>& data, const 
                 jle::VectorX<double>& q) {
   Trial trial;
   trial.legs = findLegs(model, urdf);
-  const double sole = measureFeet(model, data, trial.legs, urdf);
+  measureFeet(model, data, trial.legs, urdf);
   const int hip_segment = model.segmentOfJoint("hip_flexion_r");
   trial.gait.hip_x = data.p_world[static_cast<std::size_t>(hip_segment)].x();
-  trial.pelvis.z0 = -sole - kPelvisDrop;
   trial.gait.x_offset = trial.pelvis.x_offset = 0.0;
   // Knees slightly bent: the inverse kinematics stays on the bent-knee branch.
   q = jle::VectorX<double>::Zero(model.nq);
@@ -666,7 +852,7 @@ void splitDoubleSupport(const std::array<FootState, 2>& feet, Reaction& r, Figur
   const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
   const int trail = 1 - lead;
   const double w_lead = smoothStep(feet[lead].since_strike / ((kToeOff - 0.5) * kStride));
-  const Vector3d a(feet[trail].toe.x(), feet[trail].toe.y(), 0.0);
+  const Vector3d a = trailingPoint(feet[static_cast<std::size_t>(trail)], w_lead);
   const Vector3d b(feet[lead].heel.x(), feet[lead].heel.y(), 0.0);
   const Vector3d e = r.cop - ((1.0 - w_lead) * a + w_lead * b);
   figures.cop_shift = std::max(figures.cop_shift, e.norm());
@@ -899,8 +1085,8 @@ void printReport(const jle::Model<double>& model, const Options& options, const 
       "%.3f m beside that line\n",
       figures.cop_min, figures.cop_max, figures.cop_side);
   std::printf(
-      "  double support: each foot's centre of pressure within %.3f m of its heel "
-      "(leading) or toe (trailing)\n",
+      "  double support: each foot's centre of pressure within %.3f m of its nominal "
+      "point (leading heel, trailing forefoot)\n",
       figures.cop_shift);
   std::printf("  centre of pressure: planned path missed by %.3f m at most\n", trial.cop_error);
   std::printf(

@@ -52,7 +52,14 @@ constexpr double kFootMass = 0.0145, kFootGyration = 0.475;  // COM at 0.50
 constexpr double kHatMass = 0.678, kHatCom = 0.626;
 // Drillis & Contini (Winter Fig. 4.1), fractions of height.
 constexpr double kThighLength = 0.245, kShankLength = 0.246, kAnkleHeight = 0.039,
-                 kFootLength = 0.152, kHipWidth = 0.191, kHatLength = 0.818 - 0.530;
+                 kFootLength = 0.152, kHatLength = 0.818 - 0.530;
+// Hara et al. (2016), Sci. Rep. 6, 37707, on leg length LL (ASIS to medial malleolus)
+// alone: each hip joint centre 8 mm + 0.086 LL lateral of the mid-ASIS and 9 mm +
+// 0.078 LL below it; LL = hip-to-ankle + that drop (docs/body_model.md A4).
+double hipSpacing(double hip_to_ankle) {
+  const double leg_length = (hip_to_ankle + 0.009) / (1.0 - 0.078);
+  return 2.0 * (0.008 + 0.086 * leg_length);
+}
 
 using jle_test::Result;
 using jle_test::readFile;
@@ -203,7 +210,9 @@ TEST(Body, StandingGeometryAtZero) {
   const jle::Data<double> data = pose(model, "", 0.0);
   const double lt = kThighLength * kHeight, ls = kShankLength * kHeight;
   const double lf = kFootLength * kHeight, hf = kAnkleHeight * kHeight;
-  const double w = kHipWidth * kHeight;
+  const double w = hipSpacing(lt + ls);
+  // For 1.75 m by hand: LL = (0.85925 + 0.009) / 0.922 = 0.94170 m, 2 (0.008 + 0.086 LL).
+  EXPECT_NEAR(w, 0.17797, 1e-5);
   const double tol = 1e-14;  // [m] sums of a few lengths under 1 m
   for (const double side : {1.0, -1.0}) {
     const std::string s = side > 0 ? "r" : "l";
@@ -444,7 +453,7 @@ double comX(double lf) { return 2.0 * kFootMass * 0.25 * lf; }
 // (a) W/2 on each plate, each COP under its hip at x_G: the moments about the COM cancel.
 TEST(Standing, SymmetricStanceBalancesTheBodyWeight) {
   const jle::Model<double> model = bundled(true);
-  const double lf = kFootLength * kHeight, w = kHipWidth * kHeight;
+  const double lf = kFootLength * kHeight, w = hipSpacing((kThighLength + kShankLength) * kHeight);
   const double xg = comX(lf);
   Plate right{{}, 0.5, Vector3d(xg, -0.5 * w, 0.0)};
   right.config.p_world_plate = Vector3d(0.2, -0.3, 0.0);

@@ -64,13 +64,14 @@ TEST_F(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
     max_moment = std::max(max_moment, std::sqrt(m2));
     ++rows;
   }
-  EXPECT_EQ(rows, 720);  // 3 strides of 1.2 s at 200 Hz
+  EXPECT_EQ(rows, 630);  // 3 strides of 1.05 s at 200 Hz
   // Bound: the CSV's velocities and accelerations are 5-point central differences on a
   // 1 kHz grid, exact to O(h^4) where the motion is smooth; at the junctions of the
-  // quintic smooth steps (a jump J of the third derivative) the second difference errs
-  // by J h / 9: the swing (1.32 m in 0.48 s, J = 720 m/s^3) 0.08 m/s^2 on the 4.6 kg of
-  // shank and foot, 0.4 N; the heel rocker (15 deg in 0.12 s, J = 9.1e3 rad/s^3) 1.0
-  // rad/s^2 on the 1.1 kg foot 0.1 m from the ankle, 0.11 N; the legs' angles follow
+  // quintic pieces (a jump J of the third derivative) the second difference errs by
+  // J h / 9: the swing (about 1.2 m in 0.42 s, J = 60 x 1.2 / 0.42^3 = 970 m/s^3) 0.11
+  // m/s^2 on the 4.6 kg of shank and foot, 0.5 N; the heel rocker (25 deg in 0.105 s,
+  // J = 60 x 0.436 / 0.105^3 = 2.3e4 rad/s^3) 2.5 rad/s^2 on the 1.1 kg foot 0.1 m from
+  // the ankle, 0.3 N (the pelvis path is a Fourier series, smooth); the legs' angles follow
   // the feet through the inverse kinematics with errors of the same kind: 2 N in all.
   // (A plate pressed by less than the threshold, 1 N, at the ends of each contact acts
   // as measured: nothing more.) 3 N; the moment about the pelvis, the same forces at the
