@@ -223,14 +223,18 @@ void Pipeline::fillExternal() {
 
 void Pipeline::anchor(Stamp stamp) {
   // The time axis resolves 1 ns within 2^52 ns (52 days) of its origin: a stamp farther
-  // away (taken at the start or after a reset) starts it again.
-  if (have_ref_ && std::abs(stamp - time_ref_) <= kReach) return;
+  // away starts it again, but only while no time on it has been handed out since the
+  // start or the last reset. Under the estimator's samples a new origin would turn time
+  // back, and every later sample would be refused as out of order; on the axis kept,
+  // times beyond the reach stay in order and lose resolution slowly (2 ns to 104 days).
+  if (have_ref_ && (axis_used_ || std::abs(stamp - time_ref_) <= kReach)) return;
   time_ref_ = stamp;
   have_ref_ = true;
 }
 
 double Pipeline::relative(Stamp stamp) {
   anchor(stamp);
+  axis_used_ = true;
   return static_cast<double>(stamp - time_ref_) * 1e-9;
 }
 
@@ -272,7 +276,7 @@ void Pipeline::resetTimeline(Stamp stamp) {
   clock_.reset();
   ring_count_ = 0;
   last_stamp_ = 0;
-  have_ref_ = false;
+  have_ref_ = axis_used_ = false;
   pending_ = clock_back_ = 0;
   ++counters_.resets;
 }
