@@ -297,7 +297,7 @@ class Pipeline {
   Stamp time_ref_ = 0;
   bool have_ref_ = false;
   bool axis_used_ = false;  // a time on the axis was handed out (relative) since its origin
-  Stamp last_stamp_ = 0;  // last joint state taken (0 after a reset)
+  Stamp last_stamp_ = 0;    // last joint state taken (0 after a reset)
   Stamp last_clock_ = 0;
   Stamp last_taken_clock_ = 0;  // the clock when the last joint state was taken
   SampleClock clock_;           // the joint-state stream's
