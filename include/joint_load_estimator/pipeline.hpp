@@ -67,6 +67,8 @@ struct PipelineCounters {
       outcomes{};
   long unknown_joints = 0;  ///< joint states naming a joint the model does not have
   long resets = 0;          ///< jumps of time, back or confirmed forward (the filters were reset)
+  long forward_jumps = 0;   ///< of the resets, the confirmed jumps forward
+  long backJumps() const { return resets - forward_jumps; }
   /// joint states with a non-finite effort (that joint's measured effort is none; the
   /// loads are computed)
   long nonfinite_efforts = 0;
@@ -203,6 +205,8 @@ class Pipeline {
   bool jumped() const { return jumped_; }
   Stamp jumpFrom() const { return jump_from_; }
   Stamp jumpTo() const { return jump_to_; }
+  /// Whether that jump went forward (stamps far ahead, confirmed), not back.
+  bool jumpedForward() const { return jumped_ && jump_from_ != 0 && jump_to_ > jump_from_; }
 
   const LoadsRecord& record() const { return record_; }
   const PipelineCounters& counters() const { return counters_; }

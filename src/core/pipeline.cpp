@@ -279,6 +279,7 @@ void Pipeline::resetTimeline(Stamp stamp) {
   have_ref_ = axis_used_ = false;
   pending_ = clock_back_ = 0;
   ++counters_.resets;
+  if (jumpedForward()) ++counters_.forward_jumps;
 }
 
 Outcome Pipeline::checkJointStamp(Stamp stamp, Stamp clock) {

@@ -140,7 +140,8 @@ void EstimatorNode::subscribe() {
 
 void EstimatorNode::report(Outcome outcome) {
   if (pipeline_->jumped())
-    ROS_WARN("time jumped back (from %.6f to %.6f): resetting the filters",
+    ROS_WARN("time jumped %s (from %.6f to %.6f): resetting the filters",
+             pipeline_->jumpedForward() ? "forward" : "back",
              toRosTime(pipeline_->jumpFrom()).toSec(), toRosTime(pipeline_->jumpTo()).toSec());
   if (!pipeline_->unknownJoint().empty())
     ROS_WARN_THROTTLE(kThrottle, "%s: joint '%s' is not in the model: ignored",
@@ -407,7 +408,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("messages with unknown joints", c.unknown_joints);
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
   status.add("not published: stale input", c.count(Outcome::kStale));
-  status.add("time jumps back", c.resets);
+  status.add("time jumps back", c.backJumps());
+  status.add("time jumps forward", c.forward_jumps);
   status.add("force plate samples received", c.received(InputKind::kPlate));
 }
 

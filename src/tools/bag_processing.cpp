@@ -418,8 +418,10 @@ void BagProcessor::printDrops() const {
   if (c.unknown_joints)
     drops +=
         (drops.empty() ? "" : ", ") + std::to_string(c.unknown_joints) + " with unknown joints";
-  if (c.resets)
-    drops += (drops.empty() ? "" : ", ") + std::to_string(c.resets) + " time jumps back";
+  if (c.backJumps())
+    drops += (drops.empty() ? "" : ", ") + std::to_string(c.backJumps()) + " time jumps back";
+  if (c.forward_jumps)
+    drops += (drops.empty() ? "" : ", ") + std::to_string(c.forward_jumps) + " time jumps forward";
   if (!drops.empty()) std::fprintf(stderr, "process_bag: not used: %s\n", drops.c_str());
 }
 

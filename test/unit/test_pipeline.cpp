@@ -287,6 +287,7 @@ TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
   EXPECT_EQ(pipeline.counters().resets, 0);
   EXPECT_EQ(feed(kStart - 1998 * kMs, kStart + 8 * kMs), Outcome::kUsed);
   EXPECT_TRUE(pipeline.jumped());
+  EXPECT_FALSE(pipeline.jumpedForward());
   EXPECT_EQ(pipeline.jumpFrom(), kStart + 4 * kMs);
   EXPECT_EQ(pipeline.jumpTo(), kStart - 1998 * kMs);
   EXPECT_EQ(pipeline.timeOrigin(), kStart - 1998 * kMs);
@@ -308,6 +309,8 @@ TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
                                                           : k < 4 ? Outcome::kUsed
                                                                   : Outcome::kPublished);
   EXPECT_EQ(pipeline.counters().resets, 3);
+  EXPECT_EQ(pipeline.counters().forward_jumps, 1);
+  EXPECT_EQ(pipeline.counters().backJumps(), 2);
   EXPECT_EQ(pipeline.timeOrigin(), far + 2 * kMs + 1);
   EXPECT_EQ(pipeline.record().stamp, far + (4 - pipeline.estimator().delaySamples()) * kMs + 1);
 }
