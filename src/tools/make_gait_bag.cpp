@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -75,25 +76,28 @@ strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
           to the height that gives the stance knee its planned flexion (5 deg at heel
           strike, 18 deg at 12 %, 5 deg from 40 to 50 %, 40 deg at toe off; in double
           support the two legs' heights blended by the force's split), then lowered by
-          its largest excess over the height at which either knee (the swing leg's too)
-          would straighten beyond 15 deg
+          its largest excess over the height at which a stance leg's knee would
+          straighten beyond 15 deg
   centre of pressure  single support: along the stance footprint from the heel (10 %)
-          to 0.77 of heel -> toe (30 %) by a quintic smooth step, then there; double
+          to 0.74 of heel -> toe (30 %) by a quintic smooth step, then there; double
           support: from the trailing foot (its point moving on to its toe as it
           unloads) to the leading heel by the split's smooth step
-  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 25 deg toe
+  feet    heel rocker (0 - 10 %: the foot turns down about the heel from 24 deg toe
           up), foot flat (10 - 35 %), forefoot rocker (35 - 60 %: the heel rises, the
           foot turns about its metatarsal heads, 0.75 of heel -> toe, to 50 deg, by
           S(s) + 3 (-4 s^3 + 7 s^4 - 3 s^5): it leaves the ground turning at 3 times
-          the rocker's mean rate), swing (quintic Hermite curves of the heel and the
-          pitch from toe off, matching its position, velocity and acceleration, to the
-          next heel strike at rest, the pitch there by 85 % of the swing; heel lifted
-          by 0.08 m s^3 (1 - s)^6 / max); the other motions quintic smooth steps
+          the rocker's mean rate); the other motions quintic smooth steps
           S(s) = 10 s^3 - 15 s^4 + 6 s^5; footprints 0.5775 m apart, 5 deg toe-out,
           the heels at 0.6 times their standing distance from the midline
-  joints  the leg's 5 angles that put heel_s and toe_s where the foot is (inverse
-          kinematics to 1e-12 m on a 1 kHz grid); velocities and accelerations by
-          5-point central differences on that grid
+  joints  in stance, the leg's 5 angles that put heel_s and toe_s where the foot is
+          (inverse kinematics to 1e-12 m on a 1 kHz grid); in swing (s = 0 at toe
+          off .. 1 at heel strike), each angle on a quintic Hermite curve from its
+          toe-off state to its heel-strike state (angle, velocity and acceleration, by
+          one-sided 5-point differences of the stance's inverse kinematics 1 ms
+          apart), plus A s^3 (1 - s)^k / max + B s^p (1 - s)^3 / max: hip flexion A
+          16.57 deg, k 4.43, B 5.84 deg, p 7.39; knee A 29.18, k 5.65, B 10.51, p
+          4.03; ankle A 83.12, k 5.51, B 4.66, p 3.56; velocities and
+          accelerations by 5-point central differences on the grid
   plates  the wrench the world must apply to the pelvis for that motion (the model's
           floating-base inverse dynamics, gravity 0 0 -9.80665), on the stance foot; in
           double support split by a quintic smooth step of the force from the trailing
@@ -118,7 +122,8 @@ strikes at g = 0, the left at T/2; stance 60 %, double support 2 x 10 %):
   --help         this text
 
 Prints the trial's figures (duration, mass, peak vertical ground reaction, centre of
-pressure along the footprint and its miss of the plan, inverse-kinematics error, toe clearance, joint ranges).
+pressure along the footprint and its miss of the plan, inverse-kinematics error, the
+lowest heel or toe from 10 to 35 % of the cycle after toe off, joint ranges).
 Exit status: 0 success; 1 a data error (unreadable URDF, a body the trial does not fit,
 unwritable bag); 2 a usage error.
 )";
@@ -135,13 +140,11 @@ constexpr double kStartPhase = 0.3;               // the trial starts at 30 % of
 constexpr double kHeelRocker = 0.10;              // end of the heel rocker, fraction of T
 constexpr double kHeelOff = 0.35;                 // start of the forefoot rocker
 constexpr double kToeOff = 0.60;                  // end of stance
-constexpr double kHeelStrikePitch = 25.0 * kDeg;  // toe up at heel strike
+constexpr double kHeelStrikePitch = 24.0 * kDeg;  // toe up at heel strike
 constexpr double kToeOffPitch = -50.0 * kDeg;     // heel up at toe off
 constexpr double kToeOut = 5.0 * kDeg;
-constexpr double kToeOffRate = 3.0;     // the foot's pitch rate at toe off / the rocker's mean
-constexpr double kPitchArrival = 0.85;  // the swing foot's pitch is the heel strike's from here
-constexpr double kClearance = 0.08;     // [m] the swing heel's lift at its peak
-constexpr double kLiftTail = 6.0;       // its shape: s^3 (1 - s)^6, the peak at 1/3 of swing
+constexpr double kToeOffRate = 3.0;  // the foot's pitch rate at toe off / the rocker's mean
+constexpr double kEndStep = 1e-3;    // [s] spacing of the swing's end states' differences
 constexpr double kKneeStraight = 15.0 * kDeg;  // the pelvis never straightens a knee more
 constexpr int kHeightHarmonics = 2;            // of the pelvis height (1.9 Hz)
 constexpr double kHeelAhead = 0.20;      // [m] heel ahead of the hip at heel strike (first guess)
@@ -157,10 +160,23 @@ constexpr int kHarmonics = 20;           // of the pelvis path's correction (19 
 // Dempster's distal end of the foot (docs/body_model.md A3).
 constexpr double kBall = 0.75;
 constexpr double kCopArrival = 0.30;   // the centre of pressure reaches kCopEnd (of T)
-constexpr double kCopEnd = 0.77;       // where it stays in single support, of heel -> toe
+constexpr double kCopEnd = 0.74;       // where it stays in single support, of heel -> toe
 constexpr double kTrailToToe = 1.0;    // the trailing foot's share reaches its toe at toe off
 constexpr int kPelvisIterations = 20;  // of solvePelvis
 constexpr double kRelaxation = 0.5;    // of its steps
+
+// The swing's shape (placeLeg): two bumps added to the curve of a leg coordinate,
+// early * s^3 (1 - s)^tail / max and late * s^power (1 - s)^3 / max, the peaks at
+// 3 / (3 + tail) and power / (power + 3) of the swing. Their values were searched
+// (docs/gait_demo.md) for joint moments inside the ranges of normal walking with the
+// heel and toe at least 1 cm above the floor in mid-swing.
+struct SwingBump {
+  int joint;           // in Leg::coordinate: 0 hip flexion, 3 knee, 4 ankle
+  double early, tail;  // [deg], exponent
+  double late, power;  // [deg], exponent
+};
+constexpr std::array<SwingBump, 3> kSwingBumps = {
+    {{0, 16.57, 4.43, 5.84, 7.39}, {3, 29.18, 5.65, 10.51, 4.03}, {4, 83.12, 5.51, 4.66, 3.56}}};
 
 struct Options {
   std::string urdf, output;
@@ -201,23 +217,24 @@ double rockerStep(double s) {
   return smoothStep(s) + kToeOffRate * s * s * s * (-4.0 + 7.0 * s - 3.0 * s * s);
 }
 
-// The swing heel's lift over s in [0, 1]: s^3 (1 - s)^kLiftTail scaled to a peak of 1,
-// zero with its first and second derivatives at both ends; a tail longer than 3 puts
-// the peak early in swing (at 3 / (3 + tail)), where the foot is still turned heel up.
-double liftBump(double s) {
-  const double peak = 3.0 / (3.0 + kLiftTail);
-  const auto shape = [](double x) { return x * x * x * std::pow(1.0 - x, kLiftTail); };
-  return shape(s) / shape(peak);
+// A bump over s in [0, 1]: s^p (1 - s)^r scaled to a peak of 1 (at p / (p + r)); with
+// p, r >= 3 zero with its first and second derivatives at both ends.
+double bump(double s, double p, double r) {
+  const double peak = p / (p + r);
+  return std::pow(s, p) * std::pow(1.0 - s, r) / (std::pow(peak, p) * std::pow(1.0 - peak, r));
 }
 
 // Quintic Hermite curve over a duration d [s] at s = t / d in [0, 1]: from x0 with
-// velocity v0 and acceleration a0 to x1 at rest (no velocity, no acceleration).
-template <typename T>
-T hermite(const T& x0, const T& v0, const T& a0, const T& x1, double s, double d) {
-  const double s2 = s * s, s3 = s2 * s;
-  const double h1 = s - 6.0 * s3 + 8.0 * s3 * s - 3.0 * s3 * s2;
-  const double h2 = 0.5 * s2 - 1.5 * s3 + 1.5 * s3 * s - 0.5 * s3 * s2;
-  return x0 + (x1 - x0) * smoothStep(s) + v0 * (d * h1) + a0 * (d * d * h2);
+// velocity v0 and acceleration a0 to x1 with v1 and a1.
+double hermite5(double x0, double v0, double a0, double x1, double v1, double a1, double s,
+                double d) {
+  const double s2 = s * s, s3 = s2 * s, s4 = s3 * s, s5 = s4 * s;
+  const double h0 = 1.0 - 10.0 * s3 + 15.0 * s4 - 6.0 * s5;
+  const double h1 = s - 6.0 * s3 + 8.0 * s4 - 3.0 * s5;
+  const double h2 = 0.5 * s2 - 1.5 * s3 + 1.5 * s4 - 0.5 * s5;
+  const double h3 = 0.5 * s3 - s4 + 0.5 * s5;
+  const double h4 = -4.0 * s3 + 7.0 * s4 - 3.0 * s5;
+  return x0 * h0 + x1 * (1.0 - h0) + d * (v0 * h1 + v1 * h4) + d * d * (a0 * h2 + a1 * h3);
 }
 
 // Pelvis pose, twist and acceleration at gait time g (kUsage), world frame.
@@ -298,6 +315,7 @@ struct FootState {
   Vector3d print_ball;             // and its metatarsal heads (kBall of heel -> toe)
   bool stance = false;
   double since_strike = 0.0;
+  double strike = 0.0;  // gait time of the heel strike that started this cycle [s]
 };
 
 struct Gait {
@@ -309,25 +327,35 @@ struct Gait {
     return Vector3d(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
                     std::sin(pitch));
   }
-  Vector3d directionRate(const Leg& leg, double pitch) const {  // d/dpitch
-    const double yaw = leg.y_sign * kToeOut;
-    return Vector3d(-std::sin(pitch) * std::cos(yaw), -std::sin(pitch) * std::sin(yaw),
-                    std::cos(pitch));
-  }
   // Heel at heel strike number n (gait time n T + offset).
   Vector3d footprint(const Leg& leg, double strike_time) const {
     return Vector3d(x_offset + kSpeed * strike_time + hip_x + kHeelAhead, leg.y_footprint, 0.0);
   }
 
+  // The foot at gait time g: in stance its heel and toe; in swing (stance false) the
+  // leg's coordinates come from swingCoordinates, and heel and toe are not set.
   FootState at(const Leg& leg, double g) const {
-    const double T = kStride;
-    const double n = std::floor((g - leg.strike_offset) / T);
-    const double strike = n * T + leg.strike_offset;
+    const double n = std::floor((g - leg.strike_offset) / kStride);
+    const double strike = n * kStride + leg.strike_offset;
     const double tau = g - strike;
+    if (tau < kToeOff * kStride) return stanceAt(leg, strike, tau);
+    FootState f = stanceAt(leg, strike, 0.0);
+    f.heel = f.toe = Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    f.stance = false;
+    f.since_strike = tau;
+    return f;
+  }
+
+  // The stance foot of the cycle that started with the heel strike at gait time strike,
+  // tau [s] after it, 0 <= tau <= toe off (toe off included: the swing starts from it).
+  FootState stanceAt(const Leg& leg, double strike, double tau) const {
+    const double T = kStride;
     const Vector3d H = footprint(leg, strike);
     const double l = leg.foot_length;
     FootState f;
     f.since_strike = tau;
+    f.strike = strike;
+    f.stance = true;
     f.print_heel = H;
     f.print_toe = H + l * direction(leg, 0.0);
     f.print_ball = H + kBall * l * direction(leg, 0.0);
@@ -335,33 +363,14 @@ struct Gait {
     if (tau < t1) {  // heel rocker: pitch = p_hs (1 - S(s)) about the heel
       f.heel = H;
       f.toe = H + l * direction(leg, kHeelStrikePitch * (1.0 - smoothStep(tau / t1)));
-      f.stance = true;
     } else if (tau < t2) {
       f.heel = H;
       f.toe = H + l * direction(leg, 0.0);
-      f.stance = true;
-    } else if (tau < t3) {  // forefoot rocker: pitch = p_to R(s) about the metatarsal heads
-      const Vector3d u = direction(leg, kToeOffPitch * rockerStep((tau - t2) / (t3 - t2)));
+    } else {  // forefoot rocker: pitch = p_to R(s) about the metatarsal heads
+      const Vector3d u =
+          direction(leg, kToeOffPitch * rockerStep(std::min(1.0, (tau - t2) / (t3 - t2))));
       f.heel = f.print_ball - kBall * l * u;
       f.toe = f.print_ball + (1.0 - kBall) * l * u;
-      f.stance = true;
-    } else {  // swing: quintic from toe off to the next heel strike
-      // From the forefoot rocker's end (its position, velocity and acceleration) to the
-      // next heel strike at rest: quintic Hermite curves of the heel and the pitch.
-      const double d = T - t3;
-      const double rate = kToeOffPitch * kToeOffRate / (t3 - t2);  // pitch rate at toe off
-      const double r = kBall * l;
-      const Vector3d h0 = f.print_ball - r * direction(leg, kToeOffPitch);
-      const Vector3d v0 = -r * directionRate(leg, kToeOffPitch) * rate;
-      const Vector3d a0 = r * direction(leg, kToeOffPitch) * rate * rate;
-      const Vector3d h1 = footprint(leg, strike + T);
-      const double s = (tau - t3) / d;
-      // The pitch reaches the heel strike's by kPitchArrival of the swing and holds it.
-      const double pitch = hermite(kToeOffPitch, rate, 0.0, kHeelStrikePitch,
-                                   std::min(1.0, s / kPitchArrival), kPitchArrival * d);
-      f.heel = hermite(h0, v0, a0, h1, s, d);
-      f.heel.z() += kClearance * liftBump(s);
-      f.toe = f.heel + l * direction(leg, pitch);
     }
     return f;
   }
@@ -463,6 +472,69 @@ double solveLeg(const jle::Model<double>& model, jle::Data<double>& data, const 
   if (again >= norm) return norm;
   q = start;
   return again;
+}
+
+// A leg's 5 coordinates at one instant, with their first two time derivatives.
+struct LegState {
+  Eigen::Matrix<double, 5, 1> q, qd, qdd;
+};
+
+// The leg at an end of a stance phase: at its toe off (side -1, from the stance's last 5
+// instants) or at its heel strike (side +1, from the first 5), the inverse kinematics at
+// instants kEndStep apart and one-sided 5-point differences. q: the start of the first
+// solution (not changed).
+LegState stanceEnd(const jle::Model<double>& model, jle::Data<double>& data, const Leg& leg,
+                   const Gait& gait, const Pelvis& pelvis, double strike, double side,
+                   jle::VectorX<double> q) {
+  const double tau0 = side < 0.0 ? kToeOff * kStride : 0.0;
+  std::array<Eigen::Matrix<double, 5, 1>, 5> x;
+  for (int k = 0; k < 5; ++k) {
+    const double tau = tau0 + side * k * kEndStep;
+    const FootState foot = gait.stanceAt(leg, strike, tau);
+    solveLeg(model, data, leg, pelvis.at(strike + tau), foot.heel, foot.toe, q);
+    for (int j = 0; j < 5; ++j) x[k][j] = q[leg.coordinate[static_cast<std::size_t>(j)]];
+  }
+  const double h = kEndStep;
+  LegState e;
+  e.q = x[0];
+  e.qd = side * (-25.0 * x[0] + 48.0 * x[1] - 36.0 * x[2] + 16.0 * x[3] - 3.0 * x[4]) / (12.0 * h);
+  e.qdd = (35.0 * x[0] - 104.0 * x[1] + 114.0 * x[2] - 56.0 * x[3] + 11.0 * x[4]) / (12.0 * h * h);
+  return e;
+}
+
+// A leg's swing: its ends, from the stance phases either side (stanceEnd), for the swing
+// that follows the heel strike at gait time strike.
+struct Swing {
+  double strike = std::numeric_limits<double>::quiet_NaN();
+  LegState off, on;
+};
+
+// Puts a leg where the gait has it at gait time g, in q: in stance its heel and toe on
+// the foot's (the inverse kinematics; returns its error [m]); in swing each coordinate on
+// a quintic Hermite curve from the toe off's state to the next heel strike's (position,
+// velocity and acceleration, so that the motion is smooth to the second derivative at
+// both), plus kSwingBumps (returns 0). swing caches the ends for one swing; its
+// pelvis path must stay that of the first call.
+double placeLeg(const jle::Model<double>& model, jle::Data<double>& data, const Leg& leg,
+                const Gait& gait, const Pelvis& pelvis, double g, Swing& swing,
+                jle::VectorX<double>& q) {
+  const FootState foot = gait.at(leg, g);
+  if (foot.stance) return solveLeg(model, data, leg, pelvis.at(g), foot.heel, foot.toe, q);
+  if (!(swing.strike == foot.strike)) {
+    swing.strike = foot.strike;
+    swing.off = stanceEnd(model, data, leg, gait, pelvis, foot.strike, -1.0, q);
+    swing.on = stanceEnd(model, data, leg, gait, pelvis, foot.strike + kStride, 1.0, q);
+  }
+  const double d = (1.0 - kToeOff) * kStride;
+  const double s = (foot.since_strike - kToeOff * kStride) / d;
+  for (int j = 0; j < 5; ++j)
+    q[leg.coordinate[static_cast<std::size_t>(j)]] =
+        hermite5(swing.off.q[j], swing.off.qd[j], swing.off.qdd[j], swing.on.q[j], swing.on.qd[j],
+                 swing.on.qdd[j], s, d);
+  for (const SwingBump& b : kSwingBumps)
+    q[leg.coordinate[static_cast<std::size_t>(b.joint)]] +=
+        kDeg * (b.early * bump(s, 3.0, b.tail) + b.late * bump(s, b.power, 3.0));
+  return 0.0;
 }
 
 int coordinateIndex(const jle::Model<double>& model, const std::string& name,
@@ -583,9 +655,9 @@ void correctPelvis(const std::vector<Eigen::Vector2d>& error, double g0, double 
 // The pelvis height wanted over the stride's grid (gait times g0 + k h, k = 0 .. n - 1)
 // for the planned knee (plannedKnee): in single support the stance leg's, in double
 // support the two legs' heights blended by the force's split (the trailing leg's at
-// first, the leading leg's at the end); and the cap: the height that bends either knee
-// to kKneeStraight only (the swing leg's too, reaching for its heel strike), above which
-// a leg no longer reaches its foot.
+// first, the leading leg's at the end); and the cap: the height that bends a stance
+// leg's knee to kKneeStraight only, above which it no longer reaches its foot (the
+// swing leg's angles follow their own curves, placeLeg).
 void heightTargets(const std::array<Leg, 2>& legs, const Gait& gait, const Pelvis& pelvis,
                    double g0, double h, std::vector<double>& target, std::vector<double>& cap) {
   for (std::size_t k = 0; k < target.size(); ++k) {
@@ -599,7 +671,10 @@ void heightTargets(const std::array<Leg, 2>& legs, const Gait& gait, const Pelvi
     const auto planned = [&](int i) {
       return height(i, plannedKnee(feet[static_cast<std::size_t>(i)].since_strike / kStride));
     };
-    cap[k] = std::min(height(0, kKneeStraight), height(1, kKneeStraight));
+    cap[k] = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 2; ++i)
+      if (feet[static_cast<std::size_t>(i)].stance)
+        cap[k] = std::min(cap[k], height(i, kKneeStraight));
     if (feet[0].stance && feet[1].stance) {
       const int lead = feet[0].since_strike < feet[1].since_strike ? 0 : 1;
       const double w_lead = smoothStep(feet[static_cast<std::size_t>(lead)].since_strike /
@@ -645,13 +720,12 @@ void solveGridLegs(const jle::Model<double>& model, jle::Data<double>& data,
                    const std::array<Leg, 2>& legs, const Gait& gait, const Pelvis& pelvis,
                    double g0, double h, int first, bool warm,
                    std::vector<jle::VectorX<double>>& grid) {
+  std::array<Swing, 2> swings;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const double g = g0 + (first + static_cast<int>(i)) * h;
     if (warm && i > 0) grid[i] = grid[i - 1];
-    for (const Leg& leg : legs) {
-      const FootState foot = gait.at(leg, g);
-      solveLeg(model, data, leg, pelvis.at(g), foot.heel, foot.toe, grid[i]);
-    }
+    for (std::size_t l = 0; l < legs.size(); ++l)
+      placeLeg(model, data, legs[l], gait, pelvis, g, swings[l], grid[i]);
   }
 }
 
@@ -779,8 +853,8 @@ struct Grid {
   double g0 = kStartPhase * kStride;
   long long samples = 0;  // k = 0 .. samples - 1
   std::vector<jle::VectorX<double>> q;
-  double ik_error = 0.0;  // [m]
-  double min_toe = 1e9;   // [m] the lowest toe in mid-swing
+  double ik_error = 0.0;   // [m]
+  double clearance = 1e9;  // [m] the lowest heel or toe from 10 to 35 % of T after toe off
 };
 
 Grid solveGrid(const jle::Model<double>& model, jle::Data<double>& data, const Trial& trial,
@@ -788,15 +862,21 @@ Grid solveGrid(const jle::Model<double>& model, jle::Data<double>& data, const T
   Grid grid;
   grid.samples = std::llround(strides * kStride / grid.h);
   grid.q.reserve(static_cast<std::size_t>(grid.samples + 4));
+  const jle::VectorX<double> zero = jle::VectorX<double>::Zero(model.nq);
+  std::array<Swing, 2> swings;
   for (long long k = -2; k < grid.samples + 2; ++k) {
     const double g = grid.g0 + static_cast<double>(k) * grid.h;
-    const jle::BaseState<double> base = trial.pelvis.at(g);
+    for (std::size_t l = 0; l < trial.legs.size(); ++l)
+      grid.ik_error = std::max(grid.ik_error, placeLeg(model, data, trial.legs[l], trial.gait,
+                                                       trial.pelvis, g, swings[l], q));
+    jle::forwardKinematics(model, data, q, zero, zero, Vector3d(0.0, 0.0, -kGravity),
+                           trial.pelvis.at(g));
     for (const Leg& leg : trial.legs) {
-      const FootState foot = trial.gait.at(leg, g);
-      grid.ik_error =
-          std::max(grid.ik_error, solveLeg(model, data, leg, base, foot.heel, foot.toe, q));
-      const double swing = foot.since_strike / kStride - kToeOff;  // fraction of T into swing
-      if (swing > 0.1 && swing < 0.3) grid.min_toe = std::min(grid.min_toe, foot.toe.z());
+      // fraction of T into the swing
+      const double swing = trial.gait.at(leg, g).since_strike / kStride - kToeOff;
+      if (swing > 0.1 && swing < 0.35)
+        grid.clearance = std::min({grid.clearance, framePosition(model, data, leg.heel).z(),
+                                   framePosition(model, data, leg.toe).z()});
     }
     grid.q.push_back(q);
   }
@@ -1090,9 +1170,9 @@ void printReport(const jle::Model<double>& model, const Options& options, const 
       figures.cop_shift);
   std::printf("  centre of pressure: planned path missed by %.3f m at most\n", trial.cop_error);
   std::printf(
-      "  inverse kinematics error %.1e m, split error %.1e, lowest toe in mid-swing "
-      "%.3f m\n",
-      grid.ik_error, figures.max_residual_split, grid.min_toe);
+      "  inverse kinematics error %.1e m, split error %.1e, lowest heel or toe in "
+      "mid-swing %.3f m\n",
+      grid.ik_error, figures.max_residual_split, grid.clearance);
   for (const Leg& leg : trial.legs)
     for (int j : leg.coordinate)
       std::printf("  %-18s %7.1f .. %6.1f deg\n",

@@ -100,14 +100,15 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   // - the truncation error of the centred cubic Savitzky-Golay fit over 11 samples at
   //   200 Hz (h = 5 ms): its second derivative misses 2.08 h^2 x'''' (the least-squares
   //   quadratic coefficient of t^4 over k = -5..5 is 25 h^2), i.e. 5.2e-5 s^2 x''''; the
-  //   swing foot (about 1.2 m in 0.42 s, a quintic: |x''''| <= 360 x 1.2 / 0.42^4 =
-  //   1.4e4 m/s^4, 0.72 m/s^2 on its 4.6 kg of shank and foot: 3 N), the heel rocker (25
-  //   deg in 105 ms: 1.3e6 rad/s^4, 6.7 m/s^2 on the 1.1 kg foot 0.1 m from the ankle:
-  //   7 N), the pelvis (50.9 kg; its horizontal path is solved for the centre of
-  //   pressure: |x''''| <= 6.3e3 m/s^4, measured on the exact accelerations of
+  //   swing leg (its angles on smooth curves joined to the stance with their angle,
+  //   velocity and acceleration: in single support, where it and the pelvis are what
+  //   the fit can miss, tools/gait_demo.sh measured 5.4 N at most for both: 5 N), the
+  //   heel rocker (24 deg in 105 ms: 1.3e6 rad/s^4, 6.7 m/s^2 on the 1.1 kg foot 0.1 m
+  //   from the ankle: 7 N), the pelvis (50.9 kg; its horizontal path is solved for the
+  //   centre of pressure: |x''''| <= 6.3e3 m/s^4, measured on the exact accelerations of
   //   make_gait_bag --csv) 0.33 m/s^2: 17 N; each plate signal, a sum of those
   //   accelerations, is filtered alike and contributes errors of the same size.
-  //   Together up to about 27 N (3 + 7 + 17);
+  //   Together up to about 29 N (5 + 7 + 17);
   // so 40 N (5.4 % of body weight). The moment about the pelvis origin: the same forces
   // at the feet, up to 1 m below the pelvis: 40 N m.
   double max_force = 0.0, max_moment = 0.0;
