@@ -146,11 +146,12 @@ JLE_ALWAYS_INLINE void jointRotation(const Model<Scalar>& model, int i, Scalar s
   }
   s *= model.axis[i][k];
   const int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;  // (k, a, b) cyclic
+  // Whole columns, as the products that read R next load them: a column written entry
+  // by entry and then read as a packet stalls the load (no store forwarding).
+  const Eigen::Matrix<Scalar, 3, 1> ca = R0.col(a), cb = R0.col(b);
   R.col(k) = R0.col(k);
-  for (int r = 0; r < 3; ++r) {
-    R(r, a) = R0(r, a) * c + R0(r, b) * s;
-    R(r, b) = R0(r, b) * c - R0(r, a) * s;
-  }
+  R.col(a) = ca * c + cb * s;
+  R.col(b) = cb * c - ca * s;
 }
 
 // The joint's own terms added to omega and alpha (revolute, rate qd, acceleration qdd):
