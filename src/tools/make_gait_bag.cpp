@@ -333,7 +333,7 @@ struct Gait {
   }
 
   // The foot at gait time g: in stance its heel and toe; in swing (stance false) the
-  // leg's coordinates come from swingCoordinates, and heel and toe are not set.
+  // leg's angles come from placeLeg's curves, and heel and toe are NaN.
   FootState at(const Leg& leg, double g) const {
     const double n = std::floor((g - leg.strike_offset) / kStride);
     const double strike = n * kStride + leg.strike_offset;
