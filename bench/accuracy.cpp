@@ -70,7 +70,7 @@ constexpr double kStaticAcceleration = 0.5;  // [rad/s^2]
 
 struct Differentiator {
   std::string label;   // e.g. "SG w9 o2 centred"
-  std::string family;  // fd, sg, kalman_ca, kalman_cj, kalman_cj_smooth
+  std::string family;  // fd, sg, kalman_ca, kalman_cj, kalman_cj_smooth, adaptive(_smooth)
   jle::DifferentiatorConfig config;
   /// Kalman: the measurement noise as configured [rad]; 0: the scene's (the encoder's
   /// count / sqrt(12) and noise, what a user who knows the encoder would set).
@@ -226,6 +226,16 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
                     defaults.measurement_noise);
       out.push_back({label, "kalman_cj_smooth", c, defaults.measurement_noise, false, {}});
     }
+  // The adaptive smoother (type: adaptive with a lag): the bandwidth chosen by likelihood,
+  // the noise estimated, nothing tuned.
+  for (double lag : lags) {
+    jle::DifferentiatorConfig c;
+    c.type = jle::DifferentiatorType::kAdaptive;
+    c.lag = lag;
+    char label[64];
+    std::snprintf(label, sizeof label, "KS-adaptive lag=%.0fms", 1e3 * lag);
+    out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}});
+  }
 }
 
 struct SavingsVariant {

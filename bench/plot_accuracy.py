@@ -31,6 +31,7 @@ FAMILY_NAMES = {
     "kalman_cj": "Kalman const. jerk",
     "kalman_cj_smooth": "Kalman smoother const. jerk (lag)",
     "adaptive": "adaptive (Kalman bank)",
+    "adaptive_smooth": "adaptive smoother (Kalman bank, lag)",
     "zero_phase": "zero-phase Butterworth (offline)",
 }
 OFFLINE = "zero_phase"
@@ -43,6 +44,7 @@ COLOURS = {
     "kalman_cj": "tab:purple",
     "kalman_cj_smooth": "tab:pink",
     "adaptive": "tab:olive",
+    "adaptive_smooth": "tab:cyan",
 }
 NUMERIC = [
     "window", "order", "delay_samples", "process_noise", "measurement_noise", "samples", "rms_effort", "max_effort",
@@ -283,7 +285,7 @@ def losses_section(rows, scenes):
     """Per scene and family: the family's best RMS effort error over the scene's best
     (online or offline), and its overshoot; > 2 is where the family loses."""
     families = ["default", "fd", "sg causal", "sg centred", "kalman_ca", "kalman_cj",
-                "kalman_cj_smooth", "adaptive", OFFLINE]
+                "kalman_cj_smooth", "adaptive", "adaptive_smooth", OFFLINE]
     body = []
     for s in scored_scenes(scenes):
         every = overall(rows, s, precision="double") + overall(rows, s, precision="double", offline=True)

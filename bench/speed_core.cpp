@@ -257,6 +257,13 @@ void smootherBank(benchmark::State& state) {
   c.lag = 0.1;
   runBank<jle::DifferentiatorBank>(state, c);
 }
+// The adaptive smoother (type adaptive, lag 0.1 s), its other keys' defaults.
+void adaptiveSmootherBank(benchmark::State& state) {
+  jle::DifferentiatorConfig c;
+  c.type = jle::DifferentiatorType::kAdaptive;
+  c.lag = 0.1;
+  runBank<jle::DifferentiatorBank>(state, c);
+}
 void legacyFilterBank(benchmark::State& state, const std::string& name) {
   runBank<jle_legacy_filter::DifferentiatorBank>(
       state, filterConfig<jle_legacy_filter::DifferentiatorConfig>(name));
@@ -481,5 +488,6 @@ JLE_FILTER(savitzky_golay_9);
 JLE_FILTER(finite_difference);
 JLE_FILTER(adaptive);
 BENCHMARK(smootherBank)->Arg(6)->Arg(7)->Arg(19)->Arg(50);
+BENCHMARK(adaptiveSmootherBank)->Arg(6)->Arg(7)->Arg(19)->Arg(50);
 
 BENCHMARK_MAIN();

@@ -96,7 +96,8 @@ inline void validate(const DifferentiatorConfig& c) {
     if (!(c.noise >= 0.0) || !std::isfinite(c.noise))
       fail("noise", "must be finite and >= 0 (0: estimated online)");
     if (!(c.memory > 0.0) || !std::isfinite(c.memory)) fail("memory", "must be finite and > 0 [s]");
-    if (c.lag != 0.0) fail("lag", "applies to type kalman only (it must be 0)");
+    if (!(c.lag >= 0.0) || !(c.lag <= kMaxLag))
+      fail("lag", "must be 0..10 [s] (0: the causal filter)");
   } else if (c.type == DifferentiatorType::kKalman) {
     if (!(c.process_noise > 0.0) || !std::isfinite(c.process_noise))
       fail("process_noise", "must be finite and > 0");
@@ -105,7 +106,7 @@ inline void validate(const DifferentiatorConfig& c) {
     if (!(c.lag >= 0.0) || !(c.lag <= kMaxLag))
       fail("lag", "must be 0..10 [s] (0: the causal filter)");
   } else {
-    if (c.lag != 0.0) fail("lag", "applies to type kalman only (it must be 0)");
+    if (c.lag != 0.0) fail("lag", "applies to types kalman and adaptive only (it must be 0)");
     if (c.order < 2 || c.order > 5)
       fail("order", "must be 2..5 (a second derivative needs a quadratic), it is " +
                         std::to_string(c.order));
@@ -148,6 +149,7 @@ class DifferentiatorBank {
       P_.setZero(n_, n_);
       innovation_.setZero(channels_);
       if (config_.type == DifferentiatorType::kAdaptive) buildModels();
+      if (config_.type == DifferentiatorType::kAdaptive && config_.lag > 0.0) buildSmoother();
       if (smoothing()) allocateRing(1);
     } else {
       n_ = config_.order + 1;
@@ -164,12 +166,16 @@ class DifferentiatorBank {
   /// Samples needed after a reset before the first estimate (a smoother: known once its
   /// delay is, after the second sample; before, that of the causal filter).
   int warmup() const {
+    if (delegating()) return smoother_.front().warmup();
     if (smoothing()) return std::max(n_, delay_ + 1);
     return isKalman() ? n_ : config_.window;
   }
   /// Samples the estimate describes behind the newest: Savitzky-Golay's `delay`, a
   /// smoother's D (0 before its second sample), 0 for the causal filters.
-  int delaySamples() const { return smoothing() ? delay_ : config_.delay; }
+  int delaySamples() const {
+    if (delegating()) return smoother_.front().delaySamples();
+    return smoothing() ? delay_ : config_.delay;
+  }
   /// Smoother: samples taken and not yet estimated. finish() smooths them with the data
   /// there is, after which each call of next() (true while one is left) makes the
   /// oldest of them the estimate (stamp(), value(), ...): the end of a stream. update()
@@ -177,15 +183,18 @@ class DifferentiatorBank {
   /// alike, and they are the estimates of the first samples after it, in their order
   /// (the restarted smoother has none yet): every sample is estimated once.
   int pending() const {
+    if (delegating()) return smoother_.front().pending();
     const int own = smoothing() && count_ > 0 ? index_ + 1 - emitted_ : 0;
     return own + carry_count_ - carry_next_;
   }
   void finish() {
+    if (delegating()) smoother_.front().finish();
     if (finishing_ || !smoothing()) return;
     if (count_ > 0 && emitted_ <= index_) smoothBack(index_, emitted_, index_);
     finishing_ = true;
   }
   bool next() {
+    if (delegating()) return takeSmoothed(smoother_.front().next());
     if (!finishing_) return false;
     if (emitCarry()) return true;
     if (count_ == 0 || emitted_ > index_) return false;
@@ -195,6 +204,7 @@ class DifferentiatorBank {
 
   void reset() {
     carry_count_ = carry_next_ = 0;
+    for (DifferentiatorBank& s : smoother_) s.reset();
     resetFilter();
   }
 
@@ -270,7 +280,7 @@ class DifferentiatorBank {
   /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.
   /// Throws std::invalid_argument if t does not increase (the caller's duty).
   bool update(double t, const double* x) {
-    if (finishing_) reset();
+    if (finishing_ || (delegating() && smoother_.front().finishing_)) reset();
     if (count_ > 0) {
       const double dt = t - last_time_;
       if (!(dt > 0.0)) throw std::invalid_argument("differentiator: sample time does not increase");
@@ -312,6 +322,7 @@ class DifferentiatorBank {
   /// every m), and until the filter has settled the forward filter's (larger). An
   /// estimate carried over a gap keeps the one it was made with.
   Eigen::Matrix3d noiseGain() const {
+    if (delegating()) return smoother_.front().noiseGain();
     if (config_.type == DifferentiatorType::kAdaptive)
       return models_[selection_.selected()].noiseGain();
     if (config_.type == DifferentiatorType::kKalman && smoothing() && emitted_carried_)
@@ -327,7 +338,38 @@ class DifferentiatorBank {
   }
 
  private:
-  bool smoothing() const { return config_.lag > 0.0; }
+  // A Kalman smoother of its own (its ring), or an adaptive one's (smoother_).
+  bool smoothing() const {
+    return config_.type == DifferentiatorType::kKalman && config_.lag > 0.0;
+  }
+  bool delegating() const { return !smoother_.empty(); }
+
+  // Adaptive with a lag: a Kalman smoother in unit measurement noise whose process noise
+  // follows the selected filter's at every sample (the backward gains of a time-varying
+  // model are exact as well: each sample's is remembered).
+  void buildSmoother() {
+    DifferentiatorConfig k = config_;
+    k.type = DifferentiatorType::kKalman;
+    k.measurement_noise = 1.0;
+    k.process_noise = 1.0;
+    smoother_.emplace_back(k, channels_);
+  }
+
+  // The smoother's estimate, if `ready`, as this bank's.
+  bool takeSmoothed(bool ready) {
+    if (!ready) return false;
+    const DifferentiatorBank& s = smoother_.front();
+    out_ = s.out_;
+    stamp_ = s.stamp_;
+    return true;
+  }
+
+  // A new process noise from the next sample on (F and Q recomputed, the gain unsettled).
+  void setProcessNoise(double q) {
+    if (q == config_.process_noise) return;
+    config_.process_noise = q;
+    dt_prev_ = -1.0;
+  }
 
   // noiseGain() of the smoothed estimate emitted last (emitted_steps_ backward steps).
   Eigen::Matrix3d smoothedNoiseGain() const {
@@ -370,6 +412,7 @@ class DifferentiatorBank {
     k.type = DifferentiatorType::kKalman;
     k.measurement_noise = 1.0;
     k.process_noise = 1.0;
+    k.lag = 0.0;  // causal: with a lag, smoother_ smooths
     for (int m = 0; m < count; ++m) {
       bandwidths_.push_back(
           std::min(config_.max_bandwidth, config_.min_bandwidth * std::pow(kBandwidthRatio, m)));
@@ -396,6 +439,11 @@ class DifferentiatorBank {
     // The innovations describe the noise once the filters predict from data alone.
     if (count_ > n_) selectModel(dt, x);
     if (count_ <= n_) ++count_;
+    if (delegating()) {
+      DifferentiatorBank& s = smoother_.front();
+      s.setProcessNoise(models_[selection_.selected()].config_.process_noise);
+      return takeSmoothed(s.update(t, x));
+    }
     out_ = models_[selection_.selected()].out_;
     return count_ >= n_;
   }
@@ -845,6 +893,8 @@ class DifferentiatorBank {
   std::vector<DifferentiatorBank> models_;
   std::vector<double> bandwidths_;
   BandwidthSelection selection_;
+  // Adaptive with a lag: the smoother that makes the estimates (one, or none).
+  std::vector<DifferentiatorBank> smoother_;
 };
 
 }  // namespace jle
