@@ -612,9 +612,12 @@ TEST(Pipeline, StaleStopNamesTheStoppingInputOnly) {
 // (100 at 1 kHz: beyond the ring the pipeline starts with), across a gap beyond max_gap
 // (the samples before it published as the first ones after it), and at the end
 // (flush()).
-TEST(Pipeline, SmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
+namespace {
+
+void expectEveryJointStateOnce(jle::DifferentiatorType type) {
   const jle::Model<double> model = ur5();
   jle::Settings settings;
+  settings.estimator.differentiator.type = type;
   settings.estimator.differentiator.lag = 0.1;
   jle::Pipeline pipeline(model, settings, nullptr);
   std::vector<Stamp> sent, published;
@@ -641,6 +644,17 @@ TEST(Pipeline, SmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
   EXPECT_EQ(pipeline.estimator().pendingSamples(), 0);
   EXPECT_EQ(published, sent);
   for (std::size_t k = 0; k < measured.size(); ++k) EXPECT_EQ(measured[k], static_cast<double>(k));
+}
+
+}  // namespace
+
+TEST(Pipeline, SmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
+  expectEveryJointStateOnce(jle::DifferentiatorType::kKalman);
+}
+
+// The adaptive smoother (type adaptive with a lag) through the same path.
+TEST(Pipeline, AdaptiveSmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
+  expectEveryJointStateOnce(jle::DifferentiatorType::kAdaptive);
 }
 
 namespace {
