@@ -57,6 +57,7 @@ struct DifferentiatorConfig {
   /// estimates with the data that followed them: the estimate describes the sample
   /// D = round(lag / h) before the newest (h: the first interval after a start), from
   /// D - B + 1 .. D samples after it (B = D / 2; about two backward steps per sample).
+  /// Adaptive: the same smoother, its process noise the selected filter's at each sample.
   double lag = 0.0;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
   /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
