@@ -9,6 +9,7 @@ target_include_directories(test_urdf_reader PRIVATE ${urdf_INCLUDE_DIRS})
 jle_add_unit_test(test_differentiation unit/test_differentiation.cpp)
 # The Kalman smoother (differentiator/lag) against a batch solve written in the test.
 jle_add_unit_test(test_smoother unit/test_smoother.cpp)
+jle_add_unit_test(test_spectral_cutoff unit/test_spectral_cutoff.cpp)
 # The offline zero-phase smoother (zero_phase.hpp) against closed forms.
 jle_add_unit_test(test_zero_phase unit/test_zero_phase.cpp)
 # joint_loads on positions only against scipy (python3-scipy) and closed-form dynamics.

@@ -7,6 +7,7 @@
 
 #include <joint_load_estimator/bandwidth_selection.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
+#include <joint_load_estimator/spectral_cutoff.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -132,6 +133,12 @@ class DifferentiatorBank {
   static constexpr int kMaxOrder = 5;
   /// Adaptive: ratio of neighbouring bandwidths of its filters.
   static constexpr double kBandwidthRatio = 2.0;
+  /// Adaptive with a lag: its smoother's bandwidth is at least kLagFloor / lag [Hz]: a
+  /// narrower smoother's response is longer than the lag (measured: docs/differentiators.md).
+  static constexpr double kLagFloor = 1.4;
+  /// The record's GCV choice is used where kLagFloor / lag is at most this [Hz] (lag >=
+  /// 0.14 s); with a shorter lag the likelihood's choice, measured better there.
+  static constexpr double kHighestFloor = 10.0;
   using SmallMatrix =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, kMaxOrder + 1>;
 
@@ -224,6 +231,7 @@ class DifferentiatorBank {
     dt_prev_ = -1.0;  // a restarted filter is a fresh one, to the bit: no cached F, Q
     for (DifferentiatorBank& m : models_) m.reset();
     selection_.reset();
+    spectral_.endBlock();
   }
 
   // A gap: the smoother's pending estimates (and those still carried) into the carry,
@@ -272,7 +280,16 @@ class DifferentiatorBank {
   /// standard deviation [unit] of channel c it assumes (estimated or given; 0 before the
   /// first estimate).
   double bandwidth() const {
+    if (delegating() && spectral_.bandwidth() > 0.0) return spectral_.bandwidth();
     return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
+  }
+  /// Adaptive with a lag: only the first `channels` channels (e.g. the joint positions,
+  /// not the wrenches filtered alike) choose the smoother's bandwidth. All by default.
+  void chooseBandwidthFrom(int channels) {
+    if (!delegating()) return;
+    const double floor = kLagFloor / config_.lag;
+    spectral_ = SpectralCutoff(floor <= kHighestFloor ? std::min(channels, channels_) : 0,
+                               std::max(config_.min_bandwidth, floor), config_.max_bandwidth);
   }
   double noise(int c) const {
     return models_.empty() ? 0.0 : std::sqrt(selection_.noiseVariance(c));
@@ -354,6 +371,7 @@ class DifferentiatorBank {
     k.measurement_noise = 1.0;
     k.process_noise = 1.0;
     smoother_.emplace_back(k, channels_);
+    chooseBandwidthFrom(channels_);
   }
 
   // The smoother's estimate, if `ready`, as this bank's.
@@ -425,6 +443,7 @@ class DifferentiatorBank {
   // The process noise of every filter for samples h [s] apart: the density q at which
   // the signal's spectrum q / w^(2n) meets the noise's, h (unit noise), at 2 pi f.
   void tuneModels(double h) {
+    tuned_h_ = h;
     for (std::size_t m = 0; m < models_.size(); ++m) {
       models_[m].config_.process_noise = h * std::pow(2.0 * M_PI * bandwidths_[m], 2 * n_);
       models_[m].dt_prev_ = -1.0;
@@ -434,6 +453,10 @@ class DifferentiatorBank {
   bool updateAdaptive(double t, const double* x) {
     const double dt = t - prev_t_;
     if (count_ == 1) tuneModels(dt);
+    if (delegating()) {
+      const Eigen::MatrixXd& widest = models_.back().out_;  // 3 x channels
+      spectral_.add(t, x, widest.data() + 1, static_cast<int>(widest.rows()));
+    }
     for (DifferentiatorBank& m : models_) m.update(t, x);
     prev_t_ = t;
     stamp_ = t;
@@ -442,7 +465,9 @@ class DifferentiatorBank {
     if (count_ <= n_) ++count_;
     if (delegating()) {
       DifferentiatorBank& s = smoother_.front();
-      s.setProcessNoise(models_[selection_.selected()].config_.process_noise);
+      s.setProcessNoise(spectral_.bandwidth() > 0.0
+                            ? tuned_h_ * std::pow(2.0 * M_PI * spectral_.bandwidth(), 2 * n_)
+                            : models_[selection_.selected()].config_.process_noise);
       return takeSmoothed(s.update(t, x));
     }
     out_ = models_[selection_.selected()].out_;
@@ -894,8 +919,11 @@ class DifferentiatorBank {
   std::vector<DifferentiatorBank> models_;
   std::vector<double> bandwidths_;
   BandwidthSelection selection_;
-  // Adaptive with a lag: the smoother that makes the estimates (one, or none).
+  // Adaptive with a lag: the smoother that makes the estimates (one, or none), its
+  // bandwidth's choice, and the first interval the filters were tuned for [s].
   std::vector<DifferentiatorBank> smoother_;
+  SpectralCutoff spectral_;
+  double tuned_h_ = 0.0;
 };
 
 }  // namespace jle

@@ -66,6 +66,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   plates_ =
       PlateInputs(model_, config_.plates, wrench_channel_ + 6 * static_cast<int>(inputs_.size()));
   channels_.assign(static_cast<std::size_t>(bank_.channels()), 0.0);
+  bank_.chooseBandwidthFrom(model_.nq);  // the joints, not the base pose or the wrenches
   last_inputs_.assign(channels_.size() * 3, 0.0);
   const std::vector<char> dynamics = selectSegments();
   markNeeded(dynamics);
@@ -183,6 +184,7 @@ bool Estimator::retune(const DifferentiatorConfig& differentiator, int decimatio
   config_.decimation = decimation;
   if (sameDifferentiator(differentiator, config_.differentiator)) return true;
   bank_ = DifferentiatorBank(differentiator, bank_.channels());
+  bank_.chooseBandwidthFrom(model_.nq);
   config_.differentiator = differentiator;
   covariance_.history = 0;
   have_last_ = false;

@@ -1,0 +1,278 @@
+// The bandwidth of the adaptive smoother (DifferentiatorType::kAdaptive with a lag): the
+// cutoff that generalised cross-validation of the zero-phase 4th-order Butterworth
+// (zero_phase.hpp, CutoffRule::kGcv) would choose on the record so far, computed from a
+// running spectrum of the samples instead of filtering the record at every candidate.
+// ROS-free, allocation-free after construction.
+#pragma once
+
+#include <joint_load_estimator/eigen_abi.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <vector>
+
+namespace jle {
+
+/// In place radix-2 discrete Fourier transform of n = 2^k <= capacity points (forward,
+/// no scaling: X_k = sum_j x_j exp(-2 pi i j k / n)); the twiddles of the capacity are
+/// computed once, and every smaller size uses every (capacity / n)-th of them.
+class Fft {
+ public:
+  Fft() = default;
+  explicit Fft(int capacity) : capacity_(capacity), twiddle_(static_cast<std::size_t>(capacity / 2)) {
+    for (int k = 0; k < capacity / 2; ++k)
+      twiddle_[static_cast<std::size_t>(k)] = std::polar(1.0, -2.0 * M_PI * k / capacity);
+  }
+  int capacity() const { return capacity_; }
+
+  void transform(std::complex<double>* x, int n) const {
+    for (int i = 1, j = 0; i < n; ++i) {  // bit reversal
+      int bit = n >> 1;
+      for (; j & bit; bit >>= 1) j ^= bit;
+      j ^= bit;
+      if (i < j) std::swap(x[i], x[j]);
+    }
+    for (int len = 2; len <= n; len <<= 1) {
+      const int step = capacity_ / len;
+      for (int start = 0; start < n; start += len)
+        for (int k = 0; k < len / 2; ++k) {
+          const std::complex<double> a = x[start + k];
+          const std::complex<double> b =
+              x[start + k + len / 2] * twiddle_[static_cast<std::size_t>(k * step)];
+          x[start + k] = a + b;
+          x[start + k + len / 2] = a - b;
+        }
+    }
+  }
+
+ private:
+  int capacity_ = 0;
+  std::vector<std::complex<double>> twiddle_;
+};
+
+/// The GCV cutoff of the record so far, from its spectrum. The samples are resampled on a
+/// regular grid at the first interval h by linear interpolation at their stamps (what
+/// the smoother sees: jitter in the stamps is noise to it; a gap longer than kMaxFill
+/// intervals ends the current block), averaged in groups down to at most kMaxRate, cut into blocks of kBlockSeconds or more (a power of two of samples), and
+/// each block's first differences (which flatten the spectrum, so that the window leaks
+/// little of the motion into the noise band) windowed (Hann) and transformed; the
+/// spectrum of the positions is theirs divided by |1 - exp(-i w)|^2, summed over the
+/// channels that choose, and averaged over the blocks (equally for the first
+/// kMemorySeconds, then with that memory). The cutoff minimises
+///   GCV(w) = mean_k (1 - G_k(w))^2 P_k / (1 - mean_k G_k(w))^2,
+/// G_k the zero-phase filter's gain 1 / (1 + (tan(pi k / n) / tan(pi w))^8): the score
+/// zero_phase.cpp's gcvScore evaluates in the time domain (the circulant approximation
+/// of the same smoother), searched on a grid of ratio kGridRatio.
+class SpectralCutoff {
+ public:
+  static constexpr double kBlockSeconds = 2.0;
+  static constexpr double kMemorySeconds = 30.0;
+  static constexpr double kMaxRate = 1000.0;  ///< [Hz] above it, samples are averaged
+  static constexpr int kMaxFill = 10;
+  static constexpr int kMaxBlock = 4096;  ///< samples of a block at most (2 s at 2 kHz)         ///< missing samples filled in a block
+  static constexpr double kGridRatio = 1.05;
+  static constexpr int kGridSize = 128;  ///< candidates at most (1.05^128: 500x)
+  static constexpr double kTolerance = 0.02;
+  /// Fraction of the stamp's offset from the grid that the grid follows per sample.
+  static constexpr double kTrack = 0.01;
+
+  SpectralCutoff() = default;
+  /// channels: how many of the first channels of each sample choose (e.g. the joint
+  /// positions, not the wrenches); lowest, highest: the cutoffs searched [Hz].
+  SpectralCutoff(int channels, double lowest, double highest)
+      : channels_(channels), lowest_(lowest), highest_(highest) {
+    if (channels_ <= 0) return;
+    // Every buffer at the largest block (the grid is at most kMaxRate): none grows later.
+    fft_ = Fft(kMaxBlock);
+    buffer_.resize(static_cast<std::size_t>(kMaxBlock));
+    samples_.setZero(kMaxBlock + 1, channels_);
+    sum_.setZero(channels_);
+    last_.setZero(channels_);
+    fill_.setZero(channels_);
+    gap_.setZero(channels_);
+    spectrum_.setZero(kMaxBlock / 2 + 1);
+    part_.setZero(kMaxBlock / 2 + 1);
+    window_.setZero(kMaxBlock);
+    whitening_.setZero(kMaxBlock / 2 + 1);
+    tan_k_.setZero(kMaxBlock / 2 + 1);
+  }
+
+  /// Intervals whose median fixes the grid (receive-time stamps make single ones wrong).
+  static constexpr int kFirstIntervals = 15;
+
+  /// The next sample x[0..channels) at time t [s], and an estimate of its rates
+  /// rate[c * stride] [unit/s]. Returns true when a block completed and the cutoff was chosen
+  /// anew.
+  bool add(double t, const double* x, const double* rate, int stride) {
+    if (channels_ <= 0) return false;
+    if (!started_) {
+      if (have_first_ && t > first_time_) intervals_[first_count_++] = t - first_time_;
+      have_first_ = true;
+      first_time_ = t;
+      if (first_count_ < kFirstIntervals) return false;
+      std::nth_element(intervals_, intervals_ + kFirstIntervals / 2, intervals_ + kFirstIntervals);
+      start(intervals_[kFirstIntervals / 2]);
+    }
+    int steps = 1;
+    if (have_last_) {
+      steps = static_cast<int>(std::lround((t - grid_time_) / h_));
+      if (steps > kMaxFill + 1) endBlock();
+    }
+    if (!have_last_) {
+      grid_time_ = t;
+      steps = 1;
+    } else {
+      steps = std::max(steps, 1);
+      grid_time_ += steps * h_;
+      grid_time_ += kTrack * (t - grid_time_);
+    }
+    // The sample moved to the grid's instant along its rate: what the smoother is given
+    // (x at t) seen at regular instants, so that jitter in the stamps is noise here too.
+    for (int c = 0; c < channels_; ++c) fill_[c] = x[c] + rate[c * stride] * (grid_time_ - t);
+    bool chosen = false;
+    for (int s = 1; s < steps; ++s) {  // missing samples: linear interpolation
+      const double f = static_cast<double>(s) / steps;
+      for (int c = 0; c < channels_; ++c) gap_[c] = last_[c] + f * (fill_[c] - last_[c]);
+      chosen = accumulate(gap_.data()) || chosen;
+    }
+    chosen = accumulate(fill_.data()) || chosen;
+    last_ = fill_;
+    have_last_ = true;
+    return chosen;
+  }
+
+  /// A restart of the filters: the block in progress ends; the spectrum stays.
+  void endBlock() {
+    filled_ = 0;
+    in_sum_ = 0;
+    sum_.setZero();
+    have_last_ = false;
+  }
+
+  /// The chosen cutoff [Hz] (0 before the first choice).
+  double cutoff() const { return cutoff_; }
+  /// The bandwidth to use [Hz]: the chosen cutoff, before it the lowest searched; 0 when
+  /// there is nothing to search (lowest above highest).
+  double bandwidth() const {
+    if (!(lowest_ <= highest_) || channels_ <= 0) return 0.0;
+    return cutoff_ > 0.0 ? cutoff_ : lowest_;
+  }
+  int blockSamples() const { return block_; }
+  int decimation() const { return decimation_; }
+
+ private:
+  // The grid's interval h [s] and the block layout, once.
+  void start(double h) {
+    started_ = true;
+    decimation_ = std::max(1, static_cast<int>(std::floor(1.0 / (h * kMaxRate) + 1e-9)));
+    h_ = h;
+    const double hd = h * decimation_;
+    block_ = 16;
+    while (block_ * hd < 0.9 * kBlockSeconds && block_ < kMaxBlock) block_ *= 2;
+    window_norm_ = 0.0;
+    for (int j = 0; j < block_; ++j) {
+      window_[j] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (j + 0.5) / block_);
+      window_norm_ += window_[j] * window_[j];
+    }
+    for (int k = 0; k <= block_ / 2; ++k) {
+      const double s = std::sin(M_PI * k / block_);
+      whitening_[k] = k == 0 ? 0.0 : 1.0 / (4.0 * s * s);
+      tan_k_[k] = k == block_ / 2 ? 1e300 : std::tan(M_PI * k / block_);
+    }
+  }
+
+  bool accumulate(const double* x) {
+    for (int c = 0; c < channels_; ++c) sum_[c] += x[c];
+    if (++in_sum_ < decimation_) return false;
+    samples_.row(filled_) = sum_.transpose() / decimation_;
+    sum_.setZero();
+    in_sum_ = 0;
+    if (++filled_ <= block_) return false;
+    const bool first = ++seen_ == 1;  // the first block holds the filters' start (rates)
+    if (!first) addBlock();
+    samples_.row(0) = samples_.row(block_);  // the next block's differences start here
+    filled_ = 1;
+    if (first) return false;
+    choose();
+    return true;
+  }
+
+  void addBlock() {
+    part_.setZero();
+    for (int c = 0; c < channels_; ++c) {
+      for (int j = 0; j < block_; ++j)
+        buffer_[static_cast<std::size_t>(j)] = window_[j] * (samples_(j + 1, c) - samples_(j, c));
+      fft_.transform(buffer_.data(), block_);
+      for (int k = 1; k <= block_ / 2; ++k)
+        part_[k] += std::norm(buffer_[static_cast<std::size_t>(k)]) * whitening_[k] / window_norm_;
+    }
+    ++blocks_;
+    const double seconds = blocks_ * block_ * h_ * decimation_;
+    const double weight =
+        seconds <= kMemorySeconds ? 1.0 / blocks_ : block_ * h_ * decimation_ / kMemorySeconds;
+    spectrum_ += weight * (part_ - spectrum_);
+  }
+
+  // GCV over the grid; the two-sided means from the one-sided spectrum (k and n - k
+  // alike, k = n / 2 once; k = 0 has gain 1). The narrowest cutoff within kTolerance of
+  // the minimum: where the score is flat (broadband motion, a short record) its minimum
+  // wanders, and the narrower cutoff has the less noisy derivatives.
+  void choose() {
+    const double hd = h_ * decimation_;
+    const double top = std::min(highest_, 0.45 / hd);
+    int count = 0;
+    double lowest_score = 0.0;
+    for (double f = lowest_; f <= top * (1.0 + 1e-12) && count < kGridSize; f *= kGridRatio) {
+      grid_[count] = f;
+      scores_[count] = score(f * hd);
+      if (count == 0 || scores_[count] < lowest_score) lowest_score = scores_[count];
+      ++count;
+    }
+    if (count == 0) return;
+    for (int j = 0; j < count; ++j)
+      if (scores_[j] <= (1.0 + kTolerance) * lowest_score) {
+        cutoff_ = grid_[j];
+        break;
+      }
+  }
+
+  // GCV(w), w [cycles per grid sample].
+  double score(double w) const {
+    const double inv_tc = 1.0 / std::tan(M_PI * w);
+    double residual = 0.0, trace = 1.0;
+    for (int k = 1; k <= block_ / 2; ++k) {
+      const double r = tan_k_[k] * inv_tc;
+      const double r2 = r * r, r4 = r2 * r2;
+      const double g = 1.0 / (1.0 + r4 * r4);
+      const double both = k == block_ / 2 ? 1.0 : 2.0;
+      residual += both * (1.0 - g) * (1.0 - g) * spectrum_[k];
+      trace += both * g;
+    }
+    const double dof = 1.0 - trace / block_;
+    return residual / block_ / (dof * dof);
+  }
+
+  int channels_ = 0;
+  double lowest_ = 0.5, highest_ = 50.0;
+  bool started_ = false, have_first_ = false;
+  int first_count_ = 0;
+  double first_time_ = 0.0;
+  double intervals_[kFirstIntervals] = {};
+  double grid_[kGridSize] = {}, scores_[kGridSize] = {};
+  double h_ = 0.0;
+  int decimation_ = 1, block_ = 0, filled_ = 0, in_sum_ = 0, blocks_ = 0, seen_ = 0;
+  bool have_last_ = false;
+  double grid_time_ = 0.0;
+  double cutoff_ = 0.0;
+  double window_norm_ = 1.0;
+  Fft fft_;
+  std::vector<std::complex<double>> buffer_;
+  Eigen::MatrixXd samples_;  // (block + 1) x channels, decimated
+  Eigen::VectorXd sum_, last_, fill_, gap_;
+  Eigen::VectorXd spectrum_, part_, window_, whitening_, tan_k_;
+};
+
+}  // namespace jle
