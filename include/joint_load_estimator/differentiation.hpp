@@ -276,12 +276,16 @@ class DifferentiatorBank {
   }
 
  public:
-  /// Adaptive: the bandwidth [Hz] of the filter in use, and the position noise's
+  /// Adaptive: the bandwidth [Hz] of the filter in use (with a lag of 0.14 s or more,
+  /// the smoother's: SpectralCutoff's choice), and the position noise's
   /// standard deviation [unit] of channel c it assumes (estimated or given; 0 before the
   /// first estimate).
   double bandwidth() const {
     if (delegating() && spectral_.bandwidth() > 0.0) return spectral_.bandwidth();
     return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
+  }
+  double noise(int c) const {
+    return models_.empty() ? 0.0 : std::sqrt(selection_.noiseVariance(c));
   }
   /// Adaptive with a lag: only the first `channels` channels (e.g. the joint positions,
   /// not the wrenches filtered alike) choose the smoother's bandwidth. All by default.
@@ -290,9 +294,6 @@ class DifferentiatorBank {
     const double floor = kLagFloor / config_.lag;
     spectral_ = SpectralCutoff(floor <= kHighestFloor ? std::min(channels, channels_) : 0,
                                std::max(config_.min_bandwidth, floor), config_.max_bandwidth);
-  }
-  double noise(int c) const {
-    return models_.empty() ? 0.0 : std::sqrt(selection_.noiseVariance(c));
   }
 
   /// Adds the sample (t [s], x[0..channels)). Returns true when an estimate is ready.

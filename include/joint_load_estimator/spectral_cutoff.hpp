@@ -22,7 +22,8 @@ namespace jle {
 class Fft {
  public:
   Fft() = default;
-  explicit Fft(int capacity) : capacity_(capacity), twiddle_(static_cast<std::size_t>(capacity / 2)) {
+  explicit Fft(int capacity)
+      : capacity_(capacity), twiddle_(static_cast<std::size_t>(capacity / 2)) {
     for (int k = 0; k < capacity / 2; ++k)
       twiddle_[static_cast<std::size_t>(k)] = std::polar(1.0, -2.0 * M_PI * k / capacity);
   }
@@ -56,11 +57,11 @@ class Fft {
 /// The GCV cutoff of the record so far, from its spectrum. The samples are resampled on a
 /// regular grid at the first interval h by linear interpolation at their stamps (what
 /// the smoother sees: jitter in the stamps is noise to it; a gap longer than kMaxFill
-/// intervals ends the current block), averaged in groups down to at most kMaxRate, cut into blocks of kBlockSeconds or more (a power of two of samples), and
-/// each block's first differences (which flatten the spectrum, so that the window leaks
-/// little of the motion into the noise band) windowed (Hann) and transformed; the
-/// spectrum of the positions is theirs divided by |1 - exp(-i w)|^2, summed over the
-/// channels that choose, and averaged over the blocks (equally for the first
+/// intervals ends the current block), averaged in groups down to at most kMaxRate, cut into blocks
+/// of kBlockSeconds or more (a power of two of samples), and each block's first differences (which
+/// flatten the spectrum, so that the window leaks little of the motion into the noise band)
+/// windowed (Hann) and transformed; the spectrum of the positions is theirs divided by |1 - exp(-i
+/// w)|^2, summed over the channels that choose, and averaged over the blocks (equally for the first
 /// kMemorySeconds, then with that memory). The cutoff minimises
 ///   GCV(w) = mean_k (1 - G_k(w))^2 P_k / (1 - mean_k G_k(w))^2,
 /// G_k the zero-phase filter's gain 1 / (1 + (tan(pi k / n) / tan(pi w))^8): the score
@@ -72,7 +73,8 @@ class SpectralCutoff {
   static constexpr double kMemorySeconds = 30.0;
   static constexpr double kMaxRate = 1000.0;  ///< [Hz] above it, samples are averaged
   static constexpr int kMaxFill = 10;
-  static constexpr int kMaxBlock = 4096;  ///< samples of a block at most (2 s at 2 kHz)         ///< missing samples filled in a block
+  static constexpr int kMaxBlock = 4096;  ///< samples of a block at most (2 s at 2 kHz) ///<
+                                          ///< missing samples filled in a block
   static constexpr double kGridRatio = 1.05;
   static constexpr int kGridSize = 128;  ///< candidates at most (1.05^128: 500x)
   static constexpr double kTolerance = 0.02;

@@ -63,8 +63,8 @@ TEST(SpectralCutoff, ChoosesWithinFifteenPercentOfTheTimeDomainGcv) {
     const Record r = smoothMotion(c.rate, c.noise, 0.0, 20.0);
     const double offline = jle::chooseCutoff(r.t, r.x, jle::ZeroPhaseConfig{});
     const double online = spectralChoice(r);
-    EXPECT_NEAR(online / offline, 1.0, 0.15) << c.rate << " Hz, noise " << c.noise << ": "
-                                             << online << " against " << offline;
+    EXPECT_NEAR(online / offline, 1.0, 0.15)
+        << c.rate << " Hz, noise " << c.noise << ": " << online << " against " << offline;
   }
 }
 
@@ -102,8 +102,8 @@ TEST(SpectralCutoff, TheAdaptiveSmootherUsesItFromALagOf014SecondsOn) {
     }
     if (lag < 0.14) {  // the likelihood's choice: one of the bank's bandwidths
       const double b = bank.bandwidth();
-      EXPECT_NEAR(std::log2(b / config.min_bandwidth), std::round(std::log2(b / config.min_bandwidth)),
-                  1e-9);
+      EXPECT_NEAR(std::log2(b / config.min_bandwidth),
+                  std::round(std::log2(b / config.min_bandwidth)), 1e-9);
     } else {
       const double offline = jle::chooseCutoff(r.t, r.x, jle::ZeroPhaseConfig{});
       EXPECT_NEAR(bank.bandwidth() / std::max(offline, 1.4 / lag), 1.0, 0.15) << lag;
