@@ -54,27 +54,31 @@ class Fft {
   std::vector<std::complex<double>> twiddle_;
 };
 
-/// The GCV cutoff of the record so far, from its spectrum. The samples are resampled on a
-/// regular grid at the first interval h by linear interpolation at their stamps (what
-/// the smoother sees: jitter in the stamps is noise to it; a gap longer than kMaxFill
-/// intervals ends the current block), averaged in groups down to at most kMaxRate, cut into blocks
-/// of kBlockSeconds or more (a power of two of samples), and each block's first differences (which
-/// flatten the spectrum, so that the window leaks little of the motion into the noise band)
-/// windowed (Hann) and transformed; the spectrum of the positions is theirs divided by |1 - exp(-i
-/// w)|^2, summed over the channels that choose, and averaged over the blocks (equally for the first
-/// kMemorySeconds, then with that memory). The cutoff minimises
+/// The GCV cutoff of the record so far, from its spectrum. Each sample is moved along
+/// its rate (an estimate the caller gives) to the instant of a regular grid whose interval
+/// h is the median of the first kFirstIntervals intervals and which follows the stamps
+/// slowly (kTrack): what the smoother is given, x at its stamp, seen at regular instants,
+/// so that jitter in the stamps is noise here as it is to the smoother. Missing samples
+/// (up to kMaxFill intervals) are interpolated linearly; a longer gap ends the current
+/// block. The grid is averaged in groups down to at most kMaxRate and cut into blocks of
+/// about kBlockSeconds (a power of two of samples); the first block is left out (it holds
+/// the start of the filters that give the rates). Each block's first differences (which
+/// flatten the spectrum, so that the window leaks little of the motion into the noise
+/// band) are windowed (Hann) and transformed; the positions' spectrum is theirs divided by
+/// |1 - exp(-i w)|^2, summed over the channels that choose and averaged over the blocks
+/// (equally for the first kMemorySeconds, then with that memory). The score
 ///   GCV(w) = mean_k (1 - G_k(w))^2 P_k / (1 - mean_k G_k(w))^2,
-/// G_k the zero-phase filter's gain 1 / (1 + (tan(pi k / n) / tan(pi w))^8): the score
+/// G_k the zero-phase filter's gain 1 / (1 + (tan(pi k / n) / tan(pi w))^8), is the one
 /// zero_phase.cpp's gcvScore evaluates in the time domain (the circulant approximation
-/// of the same smoother), searched on a grid of ratio kGridRatio.
+/// of the same smoother); it is searched on a grid of ratio kGridRatio, and the narrowest
+/// cutoff within kTolerance of the minimum is chosen.
 class SpectralCutoff {
  public:
   static constexpr double kBlockSeconds = 2.0;
   static constexpr double kMemorySeconds = 30.0;
   static constexpr double kMaxRate = 1000.0;  ///< [Hz] above it, samples are averaged
-  static constexpr int kMaxFill = 10;
-  static constexpr int kMaxBlock = 4096;  ///< samples of a block at most (2 s at 2 kHz) ///<
-                                          ///< missing samples filled in a block
+  static constexpr int kMaxFill = 10;         ///< missing samples filled in a block at most
+  static constexpr int kMaxBlock = 4096;      ///< samples of a block at most (2 s at 2 kHz)
   static constexpr double kGridRatio = 1.05;
   static constexpr int kGridSize = 128;  ///< candidates at most (1.05^128: 500x)
   static constexpr double kTolerance = 0.02;
