@@ -261,6 +261,7 @@ class Pipeline {
   void anchor(Stamp stamp);
   bool clockWentBack(Stamp stamp, Stamp clock);
   void resetTimeline(Stamp stamp);
+  void resetTimeline(Stamp from, Stamp stamp);  // reported as a jump from `from`
   Outcome checkJointStamp(Stamp stamp, Stamp clock);
   Outcome checkInputStamp(InputKind kind, const std::string& input, double timeout, Stamp stamp,
                           Stamp clock);

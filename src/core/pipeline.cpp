@@ -264,11 +264,13 @@ bool Pipeline::clockWentBack(Stamp stamp, Stamp clock) {
   return back && !(stamp > last_stamp_);
 }
 
-void Pipeline::resetTimeline(Stamp stamp) {
+void Pipeline::resetTimeline(Stamp stamp) { resetTimeline(last_stamp_, stamp); }
+
+void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   // A looping bag (rosbag play -l), a restarted simulation, a driver's clock set: the
   // filters' memory belongs to another timeline, and so does the time axis.
   jumped_ = true;
-  jump_from_ = last_stamp_;
+  jump_from_ = from;
   jump_to_ = stamp;
   drainSmoother();
   estimator_.reset();
@@ -285,7 +287,16 @@ void Pipeline::resetTimeline(Stamp stamp) {
 Outcome Pipeline::checkJointStamp(Stamp stamp, Stamp clock) {
   constexpr InputKind kind = InputKind::kJointState;
   if (clockWentBack(stamp, clock)) resetTimeline(stamp);
-  if (last_stamp_ == 0) return Outcome::kUsed;
+  if (last_stamp_ == 0) {
+    // The first joint state of the timeline, on an axis whose origin the wrenches or
+    // plates set (and used) more than its reach away: their clock is another one (a
+    // simulation's from 0 beside a wall clock). Kept, the axis would resolve these stamps
+    // to no better than its rounding there (240 ns at 54 years) and take samples a few ns
+    // apart for duplicates; the timeline restarts from the joint states, their readings
+    // before it left behind (one warning, a jump in the diagnostics).
+    if (axis_used_ && std::abs(stamp - time_ref_) > kReach) resetTimeline(time_ref_, stamp);
+    return Outcome::kUsed;
+  }
   const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
   const double threshold = settings_.time_jump_threshold;
   // Forward, a gap of 10 periods is no jump either (a slow stream).

@@ -65,7 +65,17 @@ for t in "${targets[@]}"; do
     echo "ok    $t: $(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$work/$t.log" |
       grep -oE '[0-9]+$') runs in $(($(date +%s) - start)) s"
   else
-    grep -E "ERROR: |runtime error:|SUMMARY|Test unit written" "$work/$t.log" | head -20 || true
+    grep -E "ERROR: |runtime error:|check failed:|terminate called|what\(\):|SUMMARY|Test unit written" \
+      "$work/$t.log" | head -20 || true
+    grep -E "^ *#[0-9]+ 0x" "$work/$t.log" | head -16 | sed 's/^ */  /' || true
+    # The input itself, so that a CI machine gone afterwards still hands it over:
+    # base64 -d > regressions/<target>/NAME restores it.
+    for crash in $(find "$work" -maxdepth 1 -newermt "@$start" \
+                     \( -name 'crash-*' -o -name 'timeout-*' -o -name 'oom-*' -o -name 'leak-*' \)); do
+      echo "input $(basename "$crash") ($(stat -c %s "$crash") bytes), base64:"
+      base64 -w 100 "$crash" | head -c 24000
+      echo
+    done
     echo "FAIL  $t (log: $work/$t.log; copy the crash-* input into $reg/)"
     status=1
   fi

@@ -173,8 +173,12 @@ struct Shadow {
   jle::Stamp last_clock = 0, pending_stamp = 0, taken_clock = 0;
   int pending = 0, clock_back = 0;
   bool joints_stamped = false, wrench_stamped = false;
-  double period = 0.0;  // [ns] the joint stream's (its sample clock's) before the message
-  void before(const jle::Pipeline& p) { period = p.sampleClock().period(); }
+  double period = 0.0;     // [ns] the joint stream's (its sample clock's) before the message
+  jle::Stamp origin = -1;  // the time axis's origin before the message (-1: none)
+  void before(const jle::Pipeline& p) {
+    period = p.sampleClock().period();
+    origin = p.hasTimeOrigin() ? p.timeOrigin() : -1;
+  }
   // False: stamp 0 on an input that has had stamps (dropped); else `stamp` is effective.
   static bool zero(bool& stamped, jle::Stamp& stamp, jle::Stamp clock) {
     if (stamp != 0) return stamped = true;
@@ -266,12 +270,20 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
   // A message with no needed joint is neither a sample nor a time: checked first.
   JLE_FUZZ_CHECK((outcome == Outcome::kNoJoint) == !moves(p, js));
   if (outcome == Outcome::kNoJoint) return;
+  const bool first = shadow.last == 0;  // no joint state taken on this timeline yet
   const bool rogue = !Shadow::zero(shadow.joints_stamped, stamp, clock) ||
                      (shadow.clockSeen(stamp, clock), shadow.jointRogue(stamp, clock));
   JLE_FUZZ_CHECK(rogue == (outcome == Outcome::kRogueStamp));
   if (rogue) {
     JLE_FUZZ_CHECK(!p.problem().empty());
     return;
+  }
+  // The first joint state of a timeline whose axis the wrenches set more than its reach
+  // (2^52 ns) away restarts it (README, "Time stamps"); the clock going back resets
+  // only when the stamps do not go forward, so not here.
+  if (first && p.jumped()) {
+    JLE_FUZZ_CHECK(shadow.origin >= 0 && std::abs(stamp - shadow.origin) > jle::Stamp{1} << 52);
+    shadow.reset();
   }
   JLE_FUZZ_CHECK(outcome != Outcome::kInvalid && outcome != Outcome::kFrame);
   if (outcome == Outcome::kWaiting) return;

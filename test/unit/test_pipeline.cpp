@@ -315,6 +315,47 @@ TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
   EXPECT_EQ(pipeline.record().stamp, far + (4 - pipeline.estimator().delaySamples()) * kMs + 1);
 }
 
+// A wrench stamped by a clock from 0 (a simulation's) before any joint state, the joint
+// states by the wall clock: the time axis the wrench set cannot hold the joint states'
+// stamps to the nanosecond (at 54 years a double's step is 238 ns), so their first restarts
+// the timeline; samples 32 ns apart are then both taken (the fuzzer found them taken for
+// duplicates).
+TEST(Pipeline, JointStatesFarFromTheWrenchesOriginRestartTheTimeline) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings = finiteDifferences();
+  addWrenchInput(settings, "tool0");
+  jle::Pipeline pipeline(model, settings, nullptr);
+  const Eigen::Vector3d f(1.0, 2.0, 3.0), m = Eigen::Vector3d::Zero();
+  EXPECT_EQ(pipeline.onWrench(0, 4 * kMs, 4 * kMs, "tool0", f, m), Outcome::kUsed);
+  EXPECT_EQ(pipeline.timeOrigin(), 4 * kMs);
+  auto feed = [&](Stamp stamp) {
+    std::vector<double> p(6);
+    const double t = static_cast<double>(stamp - kStart) * 1e-9;
+    for (int i = 0; i < 6; ++i) p[static_cast<std::size_t>(i)] = q(i, t);
+    return pipeline.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone);
+  };
+  EXPECT_EQ(feed(kStart), Outcome::kUsed);
+  EXPECT_TRUE(pipeline.jumped());
+  EXPECT_TRUE(pipeline.jumpedForward());
+  EXPECT_EQ(pipeline.jumpFrom(), 4 * kMs);
+  EXPECT_EQ(pipeline.jumpTo(), kStart);
+  EXPECT_EQ(pipeline.timeOrigin(), kStart);
+  EXPECT_EQ(pipeline.counters().forward_jumps, 1);
+  EXPECT_EQ(feed(kStart + 32), Outcome::kUsed);
+  EXPECT_FALSE(pipeline.jumped());
+  EXPECT_EQ(feed(kStart + 64), Outcome::kPublished);
+  EXPECT_EQ(pipeline.record().stamp, kStart + 64 - 32 * pipeline.estimator().delaySamples());
+  EXPECT_EQ(pipeline.counters().count(InputKind::kJointState, Outcome::kOrder), 0);
+  EXPECT_EQ(pipeline.counters().resets, 1);
+  // The wrench's stamps afterwards (received by the wall clock): 54 years behind the
+  // joint states, a rogue stamp.
+  EXPECT_EQ(pipeline.onWrench(0, 5 * kMs, kStart + 80, "tool0", f, m), Outcome::kRogueStamp);
+  // A timeline whose origin the joint states set keeps it for a wrench stamped far away
+  // that was not taken (rogue): nothing restarts.
+  EXPECT_EQ(feed(kStart + 96), Outcome::kPublished);
+  EXPECT_EQ(pipeline.counters().resets, 1);
+}
+
 TEST(Pipeline, StampZeroIsTheClockOnlyOnAStreamThatNeverHadStamps) {
   const jle::Model<double> model = ur5();
   jle::Settings settings = finiteDifferences();
