@@ -72,6 +72,11 @@ class Fft {
 /// zero_phase.cpp's gcvScore evaluates in the time domain (the circulant approximation
 /// of the same smoother); it is searched on a grid of ratio kGridRatio, and the narrowest
 /// cutoff within kTolerance of the minimum is chosen.
+/// The work of a completed block (a transform per channel, the spectrum, the scores) is
+/// spread over the grid samples that follow it, one step per sample (a channel's
+/// transform, or kScoresPerStep scores), so that no sample's call carries the whole of it:
+/// the choice takes effect pendingSteps() samples after the block, the same choice at the
+/// same sample on every run (the node and process_bag agree).
 class SpectralCutoff {
  public:
   static constexpr double kBlockSeconds = 2.0;
@@ -84,6 +89,8 @@ class SpectralCutoff {
   static constexpr double kTolerance = 0.02;
   /// Fraction of the stamp's offset from the grid that the grid follows per sample.
   static constexpr double kTrack = 0.01;
+  /// Candidates scored per step of the spread work.
+  static constexpr int kScoresPerStep = 16;
 
   SpectralCutoff() = default;
   /// channels: how many of the first channels of each sample choose (e.g. the joint
@@ -95,6 +102,7 @@ class SpectralCutoff {
     fft_ = Fft(kMaxBlock);
     buffer_.resize(static_cast<std::size_t>(kMaxBlock));
     samples_.setZero(kMaxBlock + 1, channels_);
+    block_samples_.setZero(kMaxBlock + 1, channels_);
     sum_.setZero(channels_);
     last_.setZero(channels_);
     fill_.setZero(channels_);
@@ -158,6 +166,14 @@ class SpectralCutoff {
     have_last_ = false;
   }
 
+  /// Steps of a completed block's work still to do (0: none); one is done per grid sample.
+  int pendingSteps() const {
+    if (step_ < 0) return 0;
+    const int scored = step_ <= channels_ ? 0 : scored_;
+    const int scoring = std::max(1, (count_ - scored + kScoresPerStep - 1) / kScoresPerStep);
+    return std::max(0, channels_ + 1 - step_) + scoring;
+  }
+
   /// The chosen cutoff [Hz] (0 before the first choice).
   double cutoff() const { return cutoff_; }
   /// The bandwidth to use [Hz]: the chosen cutoff, before it the lowest searched; 0 when
@@ -188,33 +204,64 @@ class SpectralCutoff {
       whitening_[k] = k == 0 ? 0.0 : 1.0 / (4.0 * s * s);
       tan_k_[k] = k == block_ / 2 ? 1e300 : std::tan(M_PI * k / block_);
     }
+    const double top = std::min(highest_, 0.45 / hd);  // the candidates
+    count_ = 0;
+    for (double f = lowest_; f <= top * (1.0 + 1e-12) && count_ < kGridSize; f *= kGridRatio)
+      grid_[count_++] = f;
   }
 
+  // One grid sample: a step of the last block's work, then the sample; a completed
+  // block is handed to the work (what is left of the one before done first: rare, the
+  // steps are far fewer than a block's samples).
   bool accumulate(const double* x) {
+    bool chosen = step_ >= 0 && step();
     for (int c = 0; c < channels_; ++c) sum_[c] += x[c];
-    if (++in_sum_ < decimation_) return false;
+    if (++in_sum_ < decimation_) return chosen;
     samples_.row(filled_) = sum_.transpose() / decimation_;
     sum_.setZero();
     in_sum_ = 0;
-    if (++filled_ <= block_) return false;
+    if (++filled_ <= block_) return chosen;
     const bool first = ++seen_ == 1;  // the first block holds the filters' start (rates)
-    if (!first) addBlock();
-    samples_.row(0) = samples_.row(block_);  // the next block's differences start here
+    if (!first) {
+      while (step_ >= 0) chosen = step() || chosen;
+      block_samples_.swap(samples_);
+      step_ = 0;
+    }
+    samples_.row(0) = (first ? samples_ : block_samples_).row(block_);  // next differences
     filled_ = 1;
-    if (first) return false;
-    choose();
-    return true;
+    return chosen;
   }
 
-  void addBlock() {
-    part_.setZero();
-    for (int c = 0; c < channels_; ++c) {
-      for (int j = 0; j < block_; ++j)
-        buffer_[static_cast<std::size_t>(j)] = window_[j] * (samples_(j + 1, c) - samples_(j, c));
-      fft_.transform(buffer_.data(), block_);
-      for (int k = 1; k <= block_ / 2; ++k)
-        part_[k] += std::norm(buffer_[static_cast<std::size_t>(k)]) * whitening_[k] / window_norm_;
+  // The next step of the work on block_samples_: channel step_'s transform (steps 0 ..
+  // channels - 1), the spectrum (channels), kScoresPerStep scores (then); true when the
+  // choice is made.
+  bool step() {
+    if (step_ < channels_) {
+      transformChannel(step_++);
+      return false;
     }
+    if (step_ == channels_) {
+      addSpectrum();
+      scored_ = 0;
+      ++step_;
+      return false;
+    }
+    const bool done = scoreSome();
+    if (done) step_ = -1;
+    return done;
+  }
+
+  void transformChannel(int c) {
+    if (c == 0) part_.setZero();
+    for (int j = 0; j < block_; ++j)
+      buffer_[static_cast<std::size_t>(j)] =
+          window_[j] * (block_samples_(j + 1, c) - block_samples_(j, c));
+    fft_.transform(buffer_.data(), block_);
+    for (int k = 1; k <= block_ / 2; ++k)
+      part_[k] += std::norm(buffer_[static_cast<std::size_t>(k)]) * whitening_[k] / window_norm_;
+  }
+
+  void addSpectrum() {
     ++blocks_;
     const double seconds = blocks_ * block_ * h_ * decimation_;
     const double weight =
@@ -222,30 +269,29 @@ class SpectralCutoff {
     spectrum_ += weight * (part_ - spectrum_);
   }
 
-  // GCV over the grid; the two-sided means from the one-sided spectrum (k and n - k
-  // alike, k = n / 2 once; k = 0 has gain 1). The narrowest cutoff within kTolerance of
-  // the minimum: where the score is flat (broadband motion, a short record) its minimum
-  // wanders, and the narrower cutoff has the less noisy derivatives.
-  void choose() {
+  // GCV over the grid, kScoresPerStep candidates a step; with the last, the choice (true
+  // once made): the narrowest cutoff within kTolerance of the minimum. Where the score is
+  // flat (broadband motion, a short record) its minimum wanders, and the narrower cutoff
+  // has the less noisy derivatives.
+  bool scoreSome() {
     const double hd = h_ * decimation_;
-    const double top = std::min(highest_, 0.45 / hd);
-    int count = 0;
-    double lowest_score = 0.0;
-    for (double f = lowest_; f <= top * (1.0 + 1e-12) && count < kGridSize; f *= kGridRatio) {
-      grid_[count] = f;
-      scores_[count] = score(f * hd);
-      if (count == 0 || scores_[count] < lowest_score) lowest_score = scores_[count];
-      ++count;
+    const int end = std::min(count_, scored_ + kScoresPerStep);
+    for (; scored_ < end; ++scored_) {
+      scores_[scored_] = score(grid_[scored_] * hd);
+      if (scored_ == 0 || scores_[scored_] < lowest_score_) lowest_score_ = scores_[scored_];
     }
-    if (count == 0) return;
-    for (int j = 0; j < count; ++j)
-      if (scores_[j] <= (1.0 + kTolerance) * lowest_score) {
+    if (scored_ < count_) return false;
+    if (count_ == 0) return true;
+    for (int j = 0; j < count_; ++j)
+      if (scores_[j] <= (1.0 + kTolerance) * lowest_score_) {
         cutoff_ = grid_[j];
         break;
       }
+    return true;
   }
 
-  // GCV(w), w [cycles per grid sample].
+  // GCV(w), w [cycles per grid sample]; the two-sided means from the one-sided spectrum
+  // (k and n - k alike, k = n / 2 once; k = 0 has gain 1).
   double score(double w) const {
     const double inv_tc = 1.0 / std::tan(M_PI * w);
     double residual = 0.0, trace = 1.0;
@@ -274,9 +320,13 @@ class SpectralCutoff {
   double grid_time_ = 0.0;
   double cutoff_ = 0.0;
   double window_norm_ = 1.0;
+  int step_ = -1;               // the next step of a completed block's work (-1: none)
+  int count_ = 0, scored_ = 0;  // candidates on the grid, and scored so far
+  double lowest_score_ = 0.0;
   Fft fft_;
   std::vector<std::complex<double>> buffer_;
-  Eigen::MatrixXd samples_;  // (block + 1) x channels, decimated
+  Eigen::MatrixXd samples_;        // (block + 1) x channels, decimated
+  Eigen::MatrixXd block_samples_;  // the completed block the work is on, alike
   Eigen::VectorXd sum_, last_, fill_, gap_;
   Eigen::VectorXd spectrum_, part_, window_, whitening_, tan_k_;
 };

@@ -79,6 +79,33 @@ TEST(SpectralCutoff, NoChoiceBeforeTwoBlocksAndAGapEndsOnlyTheBlock) {
   EXPECT_NEAR(spectralChoice(r) / gapless, 1.0, 0.1);
 }
 
+// A completed block's work (a transform per channel, the spectrum, the scores) is done a
+// step per sample over the samples after it, not in the call that completes it: the
+// choice comes exactly pendingSteps() samples later, one step each.
+TEST(SpectralCutoff, ABlocksWorkIsSpreadOneStepPerSample) {
+  const Record r = smoothMotion(1000, 1e-3, 0.0, 10.0);
+  jle::SpectralCutoff choice(3, 0.5, 50.0);
+  const Eigen::Vector3d rate = Eigen::Vector3d::Zero();
+  int pending = 0, choices = 0, due = -1;
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    const Eigen::Vector3d row = r.x.row(static_cast<Eigen::Index>(i)).transpose();
+    const bool chosen = choice.add(r.t[i], row.data(), rate.data(), 1);
+    const int now = choice.pendingSteps();
+    if (pending == 0 && now > 0) {  // a block completed at this sample
+      // 3 transforms, the spectrum, the scores of 0.5..50 Hz at ratio 1.05 (95) by 16.
+      EXPECT_EQ(now, 3 + 1 + 6);
+      due = static_cast<int>(i) + now;
+    } else if (pending > 0) {
+      EXPECT_EQ(now, pending - 1) << i;
+    }
+    EXPECT_EQ(chosen, static_cast<int>(i) == due) << i;
+    choices += chosen;
+    pending = now;
+  }
+  EXPECT_EQ(choices, 3);  // 10 s of 2.048 s blocks, the first left out
+  EXPECT_GT(choice.cutoff(), 0.0);
+}
+
 TEST(SpectralCutoff, OnlyTheChoosingChannelsChoose) {
   Record r = smoothMotion(1000, 1e-3, 0.1, 20.0);
   const double joints = spectralChoice(r, 2);
