@@ -126,6 +126,9 @@ target_compile_definitions(test_process_bag PRIVATE
   JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>"
   JLE_MAKE_EXAMPLE_BAG="$<TARGET_FILE:make_example_bag>")
 add_dependencies(test_process_bag process_bag make_example_bag)
+# The node's wait for a late transform (Tf2FrameSource, tf_wait).
+catkin_add_gtest(test_tf_wait unit/test_tf_wait.cpp)
+target_link_libraries(test_tf_wait joint_load_estimator_ros ${catkin_LIBRARIES} gtest_main)
 # csv_to_bag and bag_to_csv: the bag's contents, and CSV -> bag -> process_bag -> CSV
 # against joint_loads on the same CSV.
 catkin_add_gtest(test_csv_to_bag unit/test_csv_to_bag.cpp)

@@ -283,6 +283,11 @@ struct Settings {
   bool floating_base = false;
   std::string world_frame = "world";  ///< tf2 frame of the world (floating base)
   std::string base_frame;             ///< tf2 frame of the base; empty: the URDF root link
+  /// [s] >= 0, the node only: a transform the loads need (the floating base's pose, a
+  /// wrench's frame) that is late, its stamp newer than tf2's newest by at most this, is
+  /// waited for up to this long (wall time) before the message is dropped (counted). 0:
+  /// no wait. Offline tools fill tf2 in the bag's order and never wait.
+  double tf_wait = 0.05;
   /// [s] > 0; a joint-state stamp this far from the last one taken (back, or forward
   /// beyond 10 periods too, unless the clock moved as far) is a rogue stamp, or,
   /// confirmed (stamps.jump_confirm), a jump of time: reset.

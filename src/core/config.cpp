@@ -164,6 +164,7 @@ void validate(const Settings& settings) {
   positive("base_residual_threshold", settings.base_residual_threshold);
   positive("still_velocity", settings.still_velocity);
   positive("diagnostic_period", settings.diagnostic_period);
+  nonNegative("tf_wait", settings.tf_wait);
   positive("friction/velocity_scale", settings.friction.velocity_scale);
   validate(settings.external_effort);
   const double m = settings.body_mass;

@@ -3,6 +3,10 @@
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
 namespace jle {
 namespace {
 
@@ -36,11 +40,48 @@ std::string Tf2FrameSource::lookupError(const tf2::TransformException& e, const 
   return "tf2 cannot give '" + frame + "' in '" + target + "'";
 }
 
+bool Tf2FrameSource::late(const std::string& target, const std::string& frame,
+                          const ros::Time& time) {
+  try {
+    newest_ = buffer_.lookupTransform(target, frame, ros::Time(0)).header.stamp;
+  } catch (const tf2::TransformException&) {
+    // No chain yet (a latched /tf_static the listener has not delivered, the first
+    // poses): one wait per pair of frames, the first time.
+    chain_ = target + '\n' + frame;
+    return std::find(missing_chains_.begin(), missing_chains_.end(), chain_) ==
+           missing_chains_.end();
+  }
+  chain_.clear();
+  const double behind = (time - newest_).toSec();
+  return behind > 0.0 && behind <= wait_ && newest_ != gave_up_;
+}
+
+void Tf2FrameSource::waitFor(const std::string& target, const std::string& frame,
+                             const ros::Time& time) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  const Clock::time_point deadline =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait_));
+  ++waits_;
+  bool arrived = false;
+  while (!(arrived = buffer_.canTransform(target, frame, time)) && Clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  if (!arrived) {
+    ++waits_run_out_;
+    gave_up_ = newest_;
+  }
+  if (!chain_.empty()) missing_chains_.push_back(chain_);  // waited for once
+  longest_wait_ =
+      std::max(longest_wait_, std::chrono::duration<double>(Clock::now() - start).count());
+}
+
 bool Tf2FrameSource::lookup(const std::string& target, const std::string& frame, Stamp stamp,
                             Eigen::Isometry3d& X_target_frame, std::string& error) {
+  const ros::Time time = toRosTime(stamp);
+  if (wait_ > 0.0 && !buffer_.canTransform(target, frame, time) && late(target, frame, time))
+    waitFor(target, frame, time);
   try {
-    X_target_frame =
-        tf2::transformToEigen(buffer_.lookupTransform(target, frame, toRosTime(stamp)));
+    X_target_frame = tf2::transformToEigen(buffer_.lookupTransform(target, frame, time));
     return true;
   } catch (const tf2::TransformException& e) {
     error = lookupError(e, target, frame, stamp);

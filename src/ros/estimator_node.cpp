@@ -28,6 +28,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   private_nh_.deleteParam("reconfigure");
   if (!private_nh_.getParam(private_nh_.getNamespace(), params_)) params_ = XmlRpc::XmlRpcValue();
   settings_ = parseSettings(params_);
+  frames_.setWait(settings_.tf_wait);
   const Model<double> model = loadModel();
   pipeline_ = std::make_unique<Pipeline>(model, settings_, &frames_);
   settings_ = pipeline_->settings();  // with the sensors' links and the base frame filled in
@@ -341,6 +342,10 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("max latency [s]", latency_max_);
   status.add("mean queue wait [s]", queue_wait_count_ ? queue_wait_sum_ / queue_wait_count_ : 0.0);
   status.add("max queue wait [s]", queue_wait_max_);
+  status.add("tf waits (for a late transform)", frames_.waits());
+  status.add("tf waits run out", frames_.waitsRunOut());
+  status.add("max tf wait [s]", frames_.longestWait());
+  frames_.clearLongestWait();
   status.add("joint states received", received);
   status.add("wrenches received", c.received(InputKind::kWrench));
   status.add("loads published", published);

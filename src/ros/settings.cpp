@@ -313,6 +313,7 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("floating_base", n.floating_base);
   s.read("world_frame", n.world_frame);
   s.read("base_frame", n.base_frame);
+  s.read("tf_wait", n.tf_wait);
   s.read("time_jump_threshold", n.time_jump_threshold);
   s.read("keep_fixed_joints", n.keep_fixed_joints);
   s.read("diagnostic_period", n.diagnostic_period);

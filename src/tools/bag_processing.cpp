@@ -205,6 +205,7 @@ class BagProcessor {
   void smoothInputs(rosbag::View& view);
   void dispatch(const rosbag::MessageInstance& m);
   void onTf(const rosbag::MessageInstance& m, bool is_static);
+  void preloadStatic(const rosbag::Bag& in);
   void note(jle::Outcome outcome);
   void write();
   std::string noLoads() const;
@@ -243,6 +244,7 @@ void BagProcessor::run() {
   topics.insert(topics.end(), plate_topics_.begin(), plate_topics_.end());
   rosbag::View view(in, rosbag::TopicQuery(topics));
   checkTopics(in, view);
+  preloadStatic(in);
   if (options_.smooth) smoothInputs(view);
   sink_.open(pipeline_);
 
@@ -324,6 +326,24 @@ void BagProcessor::onTf(const rosbag::MessageInstance& m, bool is_static) {
       tf_.setTransform(t, "process_bag", is_static);
     } catch (const std::exception& e) {  // tf2 refuses a NaN or a frame named ""
       std::fprintf(stderr, "process_bag: warning: %s: %s\n", m.getTopic().c_str(), e.what());
+    }
+  }
+}
+
+// A static transform holds for all time, but a recorder may write the latched /tf_static
+// after the first messages that need it (the node's listener waits for it, tf_wait):
+// each static frame's first value is set before the bag is read; the messages in order
+// then set theirs as they come (with their warnings), as before.
+void BagProcessor::preloadStatic(const rosbag::Bag& in) {
+  std::unordered_set<std::string> seen;
+  for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery("/tf_static"))) {
+    deserialize(m, buffer_, tf_msg_);
+    for (const geometry_msgs::TransformStamped& t : tf_msg_.transforms) {
+      if (!seen.insert(t.child_frame_id).second) continue;
+      try {
+        tf_.setTransform(t, "process_bag", true);
+      } catch (const std::exception&) {  // said when the message comes in order
+      }
     }
   }
 }

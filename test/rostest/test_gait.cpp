@@ -53,6 +53,7 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
   ros::Subscriber residual_sub = nh.subscribe<geometry_msgs::WrenchStamped>(
       "/joint_load_estimator/base_residual", 10000,
       [&residuals](const geometry_msgs::WrenchStamped::ConstPtr& m) { residuals.push_back(*m); });
+  jle_test::DiagnosticsRecorder& diagnostics = jle_test::diagnostics();
   // The node is up and connected to us (base_residual is published only while heard).
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(30.0);
   while (ros::ok() && (loads_sub.getNumPublishers() == 0 || residual_sub.getNumPublishers() == 0) &&
@@ -71,6 +72,21 @@ TEST(Gait, ResidualIsFilterErrorAndEveryJointIsLoaded) {
             0);
   // The last messages in flight: until nothing new arrives for 1 s.
   jle_test::spinUntilQuiet([&] { return loads.size() + residuals.size(); });
+
+  // What the node did with them, from its diagnostics once they count every joint state
+  // sent (bag order: the poses 2 ms before their joint state; over ROS, tf2's listener
+  // thread may deliver one later: the node waits for it, tf_wait).
+  const std::string status = "joint_load_estimator: joint loads";
+  EXPECT_TRUE(jle_test::waitFor(
+      [&] { return diagnostics.latest(status, "joint states received") == 630; }, 10.0));
+  const long no_pose = diagnostics.latest(status, "dropped: no base pose");
+  std::printf(
+      "gait: %ld joint states received, %ld dropped for no base pose, %ld tf waits, %ld "
+      "run out\n",
+      diagnostics.latest(status, "joint states received"), no_pose,
+      diagnostics.latest(status, "tf waits (for a late transform)"),
+      diagnostics.latest(status, "tf waits run out"));
+  RecordProperty("dropped_no_base_pose", std::to_string(no_pose));
 
   // 3 strides of 1.05 s at 200 Hz = 630 joint states; decimation 2 gives 315 estimates
   // less the filter's start (10 samples). Messages are not dropped (queues of 10000).

@@ -88,6 +88,7 @@ TEST(Config, DefaultsAreTheNodes) {
   EXPECT_EQ(s.estimator.gravity_world, Eigen::Vector3d(0.0, 0.0, -9.80665));
   EXPECT_EQ(s.diagnostic_period, 1.0);
   EXPECT_EQ(s.time_jump_threshold, 1.0);
+  EXPECT_EQ(s.tf_wait, 0.05);
   EXPECT_EQ(s.stamps.regularize, jle::StampRegularize::kOff);
   EXPECT_EQ(s.stamps.jump_confirm, 3);
   EXPECT_EQ(s.body_mass, 0.0);
@@ -153,7 +154,8 @@ TEST(Config, TopLevel) {
              {"body_mass", [](Settings& s) { s.body_mass = 70.0; }},
              {"time_jump_threshold", [](Settings& s) { s.time_jump_threshold = 1e-3; }},
              {"stamps/jump_confirm", [](Settings& s) { s.stamps.jump_confirm = 1; }},
-             {"diagnostic_period", [](Settings& s) { s.diagnostic_period = 0.01; }}},
+             {"diagnostic_period", [](Settings& s) { s.diagnostic_period = 0.01; }},
+             {"tf_wait", [](Settings& s) { s.tf_wait = 0.0; }}},
             true);
   expectAll({{"decimation", [](Settings& s) { s.estimator.decimation = 0; }},
              {"gravity", [](Settings& s) { s.estimator.gravity_world.y() = kNaN; }},
@@ -165,6 +167,8 @@ TEST(Config, TopLevel) {
              {"still_velocity", [](Settings& s) { s.still_velocity = kNaN; }},
              {"diagnostic_period", [](Settings& s) { s.diagnostic_period = 0.0; }},
              {"diagnostic_period", [](Settings& s) { s.diagnostic_period = kInf; }},
+             {"tf_wait", [](Settings& s) { s.tf_wait = -0.01; }},
+             {"tf_wait", [](Settings& s) { s.tf_wait = kNaN; }},
              {"joint_states_topic", [](Settings& s) { s.joint_states_topic.clear(); }},
              {"robot_description", [](Settings& s) { s.robot_description.clear(); }},
              {"joints[1]",

@@ -12,6 +12,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "tool_test.hpp"
 
@@ -488,6 +489,49 @@ TEST_F(ProcessBagTest, ExampleBagIsDeterministic) {
 }
 
 // ---------------------------------------------------------------------------- bad input
+
+// rosbag record may write the latched /tf_static after the first messages that need it:
+// its frames hold from the bag's start (the node's listener waits for them, tf_wait).
+// Wrenches in a frame that only a /tf_static at the bag's end gives (panda_link8 ->
+// ft_sensor, the pose of panda_hand_tcp) give the loads of the same wrenches in
+// panda_hand_tcp; before, each was dropped for an unresolved frame.
+TEST_F(ProcessBagTest, StaticTransformsWrittenLateHoldFromTheStart) {
+  Messages m = makeMessages();
+  writeBag(path("urdf_frame.bag"), m);
+  for (auto& w : m.wrenches) w.second.header.frame_id = "ft_sensor";
+  {
+    rosbag::Bag bag(path("late_static.bag"), rosbag::bagmode::Write);
+    for (const auto& j : m.joints) bag.write("/arm/joint_states", j.first, j.second);
+    for (const auto& w : m.wrenches) bag.write("/ft", w.first, w.second);
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = m.joints.back().first;
+    t.header.frame_id = "panda_link8";
+    t.child_frame_id = "ft_sensor";
+    t.transform.translation.z = 0.1034;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(-M_PI / 4.0, Eigen::Vector3d::UnitZ()));
+    t.transform.rotation.w = q.w();
+    t.transform.rotation.z = q.z();
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(t);
+    bag.write("/tf_static", m.joints.back().first + ros::Duration(0.01), tf);
+  }
+  writeFile(path("config.yaml"), kConfig);
+  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) +
+                           " --config " + quote(path("config.yaml"));
+  Result r =
+      run(tool + " --bag " + quote(path("urdf_frame.bag")) + " --csv " + quote(path("a.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = run(tool + " --bag " + quote(path("late_static.bag")) + " --csv " + quote(path("b.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("unresolved frame"), std::string::npos) << r.output;
+  const Table a = readCsv(path("a.csv")), b = readCsv(path("b.csv"));
+  ASSERT_EQ(a.header, b.header);
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  ASSERT_EQ(a.rows.size(), 145u);
+  for (std::size_t i = 0; i < a.rows.size(); ++i)
+    for (std::size_t c = 0; c < a.header.size(); ++c)
+      EXPECT_NEAR(b.rows[i][c], a.rows[i][c], 1e-9) << a.header[c] << ", row " << i;
+}
 
 TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
   const Messages m = makeMessages();

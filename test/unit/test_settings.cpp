@@ -187,6 +187,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(floating_base);
   EXPECT_SAME(world_frame);
   EXPECT_SAME(base_frame);
+  EXPECT_SAME(tf_wait);
   EXPECT_SAME(time_jump_threshold);
   EXPECT_SAME(stamps.regularize);
   EXPECT_SAME(stamps.jump_confirm);
@@ -248,6 +249,7 @@ TEST(SettingsReader, TopLevelKeys) {
   e.floating_base = true;
   e.world_frame = "odom";
   e.base_frame = "base_link";
+  e.tf_wait = 0.2;
   e.base_residual_threshold = 0.2;
   e.still_velocity = 0.05;
   e.bias_file = "/tmp/ft_bias.yaml";
