@@ -41,7 +41,7 @@ struct Data {
   // Forward pass (kinematics.hpp), per segment.
   std::vector<Scalar> q, qd, qdd;  ///< joint coordinate of the segment (mimics expanded)
   /// sin and cos of q where the joint is revolute (elsewhere not meaningful), computed
-  /// for all joints before the forward pass's loop (trig.hpp, sinCosMany).
+  /// for all joints before the forward pass's loop (trig.hpp, sinCosArray).
   std::vector<Scalar> sin_q, cos_q;
   std::vector<Matrix3> R_parent_child;  ///< segment orientation in its parent segment
   std::vector<Vector3> p_parent_child;  ///< segment origin in its parent segment [m]

@@ -86,13 +86,9 @@ void checkCoordinates(const Model<Scalar>& model, const VectorX<Scalar>& q,
 
 namespace detail {
 
-// Force inlining of the per-segment steps: the loops over segments are the whole of the
-// algorithms, and a call per segment costs more than its bookkeeping saves.
-#if defined(__GNUC__)
-#define JLE_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define JLE_ALWAYS_INLINE inline
-#endif
+// The per-segment steps are forced inline (JLE_ALWAYS_INLINE, trig.hpp): the loops over
+// segments are the whole of the algorithms, and a call per segment costs more than its
+// bookkeeping saves.
 
 // The algorithms read the flags Model::analyze() derives; a model built by hand must call it.
 template <typename Scalar>
@@ -254,8 +250,7 @@ void forwardSegments(const Model<Scalar>& model, Data<Scalar>& data, const Vecto
                      const VectorX<Scalar>& qd, const VectorX<Scalar>& qdd) {
   const int n = model.nsegments();
   for (int i = 1; i < n; ++i) segmentCoordinates<Scalar, false>(model, data, i, q, qd, qdd);
-  sinCosMany(
-      n - 1, [](int j) { return j + 1; }, data.q.data(), data.sin_q.data(), data.cos_q.data());
+  sinCosArray(n - 1, data.q.data() + 1, data.sin_q.data() + 1, data.cos_q.data() + 1);
   for (int i = 1; i < n; ++i) forwardSegment<Scalar, false>(model, data, i);
 }
 

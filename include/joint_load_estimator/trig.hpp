@@ -2,14 +2,22 @@
 // a branch-free Cody-Waite reduction and the minimax kernels of fdlibm (Sun's freely
 // distributable libm, as musl carries them), about 4 times cheaper than the C library's
 // sin and cos, within 1 ulp of the exact value for |q| <= kFastTrigLimit; any other
-// scalar type, and larger angles, go to std::sin and std::cos. sinCosMany does many
-// angles, in double two at a time in one vector register (the same operations in each
-// lane: the same bits as sinCos).
+// scalar type, and larger angles, go to std::sin and std::cos. sinCosArray and
+// sinCosMany do many angles, in double 8 at a time in vector registers (the same
+// operations in each lane: the same bits as sinCos; src/core/trig.cpp).
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+
+// Forced inlining (GCC and Clang): the forward pass's per-segment steps
+// (kinematics.hpp) and the kernels below.
+#if defined(__GNUC__)
+#define JLE_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define JLE_ALWAYS_INLINE inline
+#endif
 
 namespace jle {
 
@@ -21,8 +29,10 @@ namespace detail {
 
 // sin(x + y) and cos(x + y) for |x| <= pi/4, y the tail of the reduced argument
 // (fdlibm's __kernel_sin and __kernel_cos, musl's arrangement).
+// Always inlined: src/core/trig.cpp instantiates it on vectors in functions compiled
+// for different instruction sets, each of which must have its own copy.
 template <typename T>
-inline void kernelSinCos(T x, T y, T& s, T& c) {
+JLE_ALWAYS_INLINE void kernelSinCos(T x, T y, T& s, T& c) {
   constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
                    S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
                    S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
@@ -88,39 +98,31 @@ inline void sinCos<double>(double q, double& s, double& c) {
   std::memcpy(&c, &out_c, sizeof c);
 }
 
-namespace detail {
+/// Which vector instructions sinCosArray<double> uses: chosen once, at its first call,
+/// as the widest this CPU has (x86-64: AVX-512F, AVX2, else SSE2; elsewhere the
+/// compiler's generic vectors). Each takes the angles 8 at a time, the same operations
+/// in each lane, so each gives the bits of sinCos.
+enum class TrigPath : std::uint8_t { kGeneric, kAvx2, kAvx512 };
 
-#if defined(__GNUC__)
-// sinCos<double> of two angles in the lanes of one vector (GCC's vector extensions: SSE2
-// on amd64, NEON on arm64), for |q| <= kFastTrigLimit in both lanes. The quadrant n mod
-// 4 is read from the low bits of n + kToInt, whose unit is the last place.
-inline void sinCosPair(const double* q, double* s, double* c) {
-  typedef double V __attribute__((vector_size(16)));
-  typedef std::int64_t I __attribute__((vector_size(16)));
-  const V x = {q[0], q[1]};
-  const V shifted = x * kInvPio2 + kToInt;
-  const V n = shifted - kToInt;
-  const V r = x - n * kPio2_1;
-  const V w = n * kPio2_1t;
-  const V y0 = r - w;
-  const V y1 = (r - y0) - w;
-  V ks, kc;
-  kernelSinCos(y0, y1, ks, kc);
-  I quadrant, bs, bc;
-  std::memcpy(&quadrant, &shifted, sizeof quadrant);
-  std::memcpy(&bs, &ks, sizeof bs);
-  std::memcpy(&bc, &kc, sizeof bc);
-  const I swap = -(quadrant & 1);
-  I out_s = (bs & ~swap) | (bc & swap);
-  I out_c = (bc & ~swap) | (bs & swap);
-  out_s ^= (quadrant & 2) << 62;
-  out_c ^= ((quadrant + 1) & 2) << 62;
-  std::memcpy(s, &out_s, sizeof out_s);
-  std::memcpy(c, &out_c, sizeof out_c);
+/// The path sinCosArray<double> takes on this CPU.
+TrigPath trigPath();
+/// Whether this CPU can take `path` (kGeneric: always).
+bool trigPathSupported(TrigPath path);
+/// sinCosArray<double> through `path` (which trigPathSupported must allow), for tests
+/// and benchmarks of each path.
+void sinCosArray(TrigPath path, int count, const double* q, double* s, double* c);
+
+/// s[j] = sin(q[j]), c[j] = cos(q[j]), j = 0..count-1.
+template <typename Scalar>
+inline void sinCosArray(int count, const Scalar* q, Scalar* s, Scalar* c) {
+  for (int j = 0; j < count; ++j) sinCos(q[j], s[j], c[j]);
 }
-#endif
 
-}  // namespace detail
+/// In double: sinCos's bits, 8 angles at a time in vector registers (trigPath(); in
+/// the core library, so the instructions depend on the CPU, not on a client's flags).
+/// A group of 8 with a large or non-finite angle is redone with sinCos one by one.
+template <>
+void sinCosArray<double>(int count, const double* q, double* s, double* c);
 
 /// sinCos of count angles: s[index(j)] = sin(q[index(j)]), likewise c, j = 0..count-1.
 template <typename Scalar, typename Index>
@@ -128,27 +130,21 @@ inline void sinCosMany(int count, Index index, const Scalar* q, Scalar* s, Scala
   for (int j = 0; j < count; ++j) sinCos(q[index(j)], s[index(j)], c[index(j)]);
 }
 
+/// In double: gathered into blocks for sinCosArray<double>.
 template <typename Index>
 inline void sinCosMany(int count, Index index, const double* q, double* s, double* c) {
-  int j = 0;
-#if defined(__GNUC__)
-  for (; j + 1 < count; j += 2) {
-    const int a = index(j), b = index(j + 1);
-    const double pair[2] = {q[a], q[b]};
-    if (std::abs(pair[0]) <= kFastTrigLimit && std::abs(pair[1]) <= kFastTrigLimit) {
-      double ps[2], pc[2];
-      detail::sinCosPair(pair, ps, pc);
-      s[a] = ps[0];
-      s[b] = ps[1];
-      c[a] = pc[0];
-      c[b] = pc[1];
-    } else {
-      sinCos(pair[0], s[a], c[a]);
-      sinCos(pair[1], s[b], c[b]);
+  constexpr int kBlock = 64;
+  double qb[kBlock], sb[kBlock], cb[kBlock];
+  for (int j0 = 0; j0 < count; j0 += kBlock) {
+    const int m = count - j0 < kBlock ? count - j0 : kBlock;
+    for (int j = 0; j < m; ++j) qb[j] = q[index(j0 + j)];
+    sinCosArray<double>(m, qb, sb, cb);
+    for (int j = 0; j < m; ++j) {
+      const int i = index(j0 + j);
+      s[i] = sb[j];
+      c[i] = cb[j];
     }
   }
-#endif
-  for (; j < count; ++j) sinCos(q[index(j)], s[index(j)], c[index(j)]);
 }
 
 }  // namespace jle

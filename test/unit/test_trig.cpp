@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -69,10 +70,10 @@ TEST(SinCos, BeyondTheLimitAndOtherTypesAreTheCLibrarys) {
   EXPECT_EQ(cf, std::cos(0.7f));
 }
 
-// sinCosMany takes the angles two at a time in one vector register: each lane must give
-// the bits of sinCos (the same operations), in every quadrant, over an odd count (the
-// last angle alone), through an index map, with a pair that has a large or non-finite
-// angle falling back to sinCos for both.
+// sinCosMany gathers the angles for sinCosArray, which takes them 8, 4 and 2 at a time
+// in vector registers: each lane must give the bits of sinCos (the same operations), in
+// every quadrant, over an odd count (the last angle alone), through an index map, with a
+// group that has a large or non-finite angle falling back to sinCos for all of it.
 TEST(SinCos, ManyAtOnceAreSinCosBitForBit) {
   jle::PortableRandom random(11);
   std::vector<double> q;
@@ -99,6 +100,15 @@ TEST(SinCos, ManyAtOnceAreSinCosBitForBit) {
     EXPECT_EQ(c[k], c1) << "q = " << q[k];
     EXPECT_EQ(std::signbit(s[k]), std::signbit(s1)) << "q = " << q[k];
   }
+  // More than one gathered block of sinCosMany (64 angles each), in order.
+  std::vector<double> s2(q.size()), c2(q.size());
+  jle::sinCosMany(
+      count, [](int j) { return j; }, q.data(), s2.data(), c2.data());
+  for (int k = 1; k < count; ++k) {
+    if (std::isnan(q[k]) || std::isinf(q[k])) continue;
+    EXPECT_EQ(s2[k], s[k]) << "q = " << q[k];
+    EXPECT_EQ(c2[k], c[k]) << "q = " << q[k];
+  }
   // Other scalar types: sinCos one by one.
   std::vector<float> qf = {0.1f, -2.0f, 3.0f}, sf(3), cf(3);
   jle::sinCosMany(
@@ -107,6 +117,53 @@ TEST(SinCos, ManyAtOnceAreSinCosBitForBit) {
     EXPECT_EQ(sf[k], std::sin(qf[k]));
     EXPECT_EQ(cf[k], std::cos(qf[k]));
   }
+}
+
+// Every path this CPU can take (the generic vectors always; AVX2, AVX-512F where the CPU
+// has them), over every count from 0 to 40 (groups of 8, 4, 2 and one alone), with a
+// large, an infinite or a NaN angle at each position of a group: the bits of sinCos, and
+// nothing written past count.
+TEST(SinCos, EveryVectorPathGivesSinCosBitForBit) {
+  const jle::TrigPath paths[] = {jle::TrigPath::kGeneric, jle::TrigPath::kAvx2,
+                                 jle::TrigPath::kAvx512};
+  const char* names[] = {"generic", "avx2", "avx512"};
+  const double odd[] = {3e9, std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::quiet_NaN(), -jle::kFastTrigLimit};
+  jle::PortableRandom random(5);
+  int paths_run = 0;
+  for (int p = 0; p < 3; ++p) {
+    if (!jle::trigPathSupported(paths[p])) {
+      std::printf("[ INFO     ] this CPU cannot take the %s path\n", names[p]);
+      continue;
+    }
+    ++paths_run;
+    for (int count = 0; count <= 40; ++count) {
+      for (int bad = -1; bad < count; ++bad) {
+        std::vector<double> q(count + 1, 0.0);
+        for (int k = 0; k < count; ++k) q[k] = random.uniform(-40.0, 40.0);
+        if (bad >= 0) q[bad] = odd[bad % 4];
+        std::vector<double> s(count + 1, 7.0), c(count + 1, 7.0);
+        jle::sinCosArray(paths[p], count, q.data(), s.data(), c.data());
+        ASSERT_EQ(s[count], 7.0) << names[p] << ", count " << count;
+        ASSERT_EQ(c[count], 7.0) << names[p] << ", count " << count;
+        for (int k = 0; k < count; ++k) {
+          double s1, c1;
+          jle::sinCos(q[k], s1, c1);
+          if (std::isnan(s1)) {
+            ASSERT_TRUE(std::isnan(s[k]) && std::isnan(c[k])) << names[p] << ", q = " << q[k];
+            continue;
+          }
+          ASSERT_EQ(s[k], s1) << names[p] << ", count " << count << ", q = " << q[k];
+          ASSERT_EQ(c[k], c1) << names[p] << ", count " << count << ", q = " << q[k];
+          ASSERT_EQ(std::signbit(s[k]), std::signbit(s1)) << names[p] << ", q = " << q[k];
+        }
+      }
+    }
+  }
+  EXPECT_GE(paths_run, 1);
+  EXPECT_TRUE(jle::trigPathSupported(jle::trigPath()));
+  std::printf("[ INFO     ] sinCosArray takes the %s path here; %d path(s) checked\n",
+              names[static_cast<int>(jle::trigPath())], paths_run);
 }
 
 }  // namespace
