@@ -61,8 +61,7 @@ JLE_ALWAYS_INLINE void group(const double* q, double* s, double* c) {
 }
 
 // The whole array: groups of 8, then at most one of 4, one of 2 and one angle alone.
-JLE_ALWAYS_INLINE void groups(int count, const double* q, double* s,
-                                                  double* c) {
+JLE_ALWAYS_INLINE void groups(int count, const double* q, double* s, double* c) {
   int j = 0;
   for (; j + 8 <= count; j += 8) group<V8, I8>(q + j, s + j, c + j);
   if (j + 4 <= count) {
