@@ -78,14 +78,18 @@ void Tf2FrameSource::waitFor(const std::string& target, const std::string& frame
 bool Tf2FrameSource::lookup(const std::string& target, const std::string& frame, Stamp stamp,
                             Eigen::Isometry3d& X_target_frame, std::string& error) {
   const ros::Time time = toRosTime(stamp);
-  if (wait_ > 0.0 && !buffer_.canTransform(target, frame, time) && late(target, frame, time))
+  // The lookup first: the wait (and tf2's second walk of the chain) only where it fails.
+  for (bool waited = false;; waited = true) {
+    try {
+      X_target_frame = tf2::transformToEigen(buffer_.lookupTransform(target, frame, time));
+      return true;
+    } catch (const tf2::TransformException& e) {
+      if (waited || !(wait_ > 0.0 && late(target, frame, time))) {
+        error = lookupError(e, target, frame, stamp);
+        return false;
+      }
+    }
     waitFor(target, frame, time);
-  try {
-    X_target_frame = tf2::transformToEigen(buffer_.lookupTransform(target, frame, time));
-    return true;
-  } catch (const tf2::TransformException& e) {
-    error = lookupError(e, target, frame, stamp);
-    return false;
   }
 }
 
