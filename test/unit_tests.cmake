@@ -19,6 +19,8 @@ target_compile_definitions(test_zero_phase_reference PRIVATE
 add_dependencies(test_zero_phase_reference joint_loads)
 jle_add_unit_test(test_adaptive_differentiator unit/test_adaptive_differentiator.cpp)
 jle_add_unit_test(test_estimator unit/test_estimator.cpp)
+# Measured joint velocities (measured_velocity) against the exact loads of an analytic motion.
+jle_add_unit_test(test_measured_velocity unit/test_measured_velocity.cpp)
 jle_add_unit_test(test_savings unit/test_savings.cpp)
 jle_add_unit_test(test_ground_truth unit/test_ground_truth.cpp)
 # The bounds of the stability sweeps (bench/stability.cpp, docs/stability.md).

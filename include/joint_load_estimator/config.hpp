@@ -110,6 +110,21 @@ struct PlateInputConfig {
   StalePolicy stale_policy = StalePolicy::kZero;
 };
 
+/// Where a coordinate's q-dot and q-ddot come from when the joint states carry velocities
+/// (measured_velocity). From the velocities: q-dot is the filtered velocity and q-ddot its
+/// rate, the velocity filtered as the positions are (same filter, same delay); q stays the
+/// filtered position. A sample whose velocity is missing or not finite feeds that filter
+/// its own prediction instead (DifferentiatorBank::predict; counted by the Pipeline).
+enum class MeasuredVelocity : std::uint8_t {
+  /// Per coordinate: from the velocities when the first joint sample after a start, a reset
+  /// or a retune carries a finite one for it; from the positions otherwise. From the
+  /// positions for every coordinate while uncertainty/enabled (its propagation models the
+  /// positions' noise only).
+  kAuto,
+  kAlways,  ///< every coordinate from the velocities (refused with uncertainty/enabled)
+  kNever,   ///< from the positions only (the velocities are ignored)
+};
+
 /// Arithmetic of the dynamics (the filters always run in double).
 enum class Precision : std::uint8_t { kDouble, kFloat };
 
@@ -155,6 +170,7 @@ struct EstimatorConfig {
   /// The filter of the joint positions and of the inputs (the node's default: the
   /// accuracy study's constant-jerk Kalman filter, docs/accuracy.md).
   DifferentiatorConfig differentiator;
+  MeasuredVelocity measured_velocity = MeasuredVelocity::kAuto;
   Precision precision = Precision::kDouble;
   Savings savings;
   /// Joints whose loads are wanted and published (URDF names of moving joints, or of

@@ -318,6 +318,26 @@ class DifferentiatorBank {
     return true;
   }
 
+  /// What the causal filter predicts for channel c at time t [s], later than its newest
+  /// sample: Kalman, and adaptive's selected filter, the state propagated by the model (its
+  /// value held across a gap longer than max_gap); Savitzky-Golay and finite differences
+  /// the newest sample; 0 before any. Fed as a missing sample's measurement, it moves the
+  /// estimate no more than the model does.
+  double predict(int c, double t) const {
+    if (count_ == 0) return 0.0;
+    if (config_.type == DifferentiatorType::kAdaptive)
+      return models_[selection_.selected()].predict(c, t);
+    if (config_.type != DifferentiatorType::kKalman) return values_(ring(0), c);
+    const double dt = t - last_time_;
+    if (!(dt <= config_.max_gap)) return state_(0, c);
+    double x = 0.0, power = 1.0;  // sum of state_(k) dt^k / k!
+    for (int k = 0; k < n_; ++k) {
+      x += power * state_(k, c);
+      power *= dt / (k + 1);
+    }
+    return x;
+  }
+
   double stamp() const { return stamp_; }
   double value(int c) const { return out_(0, c); }
   double rate(int c) const { return out_(1, c); }

@@ -65,9 +65,17 @@ class Estimator {
   bool addWrench(int k, double t, const Eigen::Vector3d& force, const Eigen::Vector3d& moment);
 
   /// A joint sample at time t [s]: q has model().nq entries (model().coordinate_names
-  /// order); base is required for a floating-base model. When the result is
-  /// kPublished, stamp() and data() hold the loads.
-  SampleStatus addJointSample(double t, const double* q, const BasePose* base = nullptr);
+  /// order); base is required for a floating-base model; qd, if given, the measured
+  /// velocities (nq entries; NaN: not measured at this sample), used as
+  /// config().measured_velocity says (velocitiesUsed()). When the result is kPublished,
+  /// stamp() and data() hold the loads.
+  SampleStatus addJointSample(double t, const double* q, const BasePose* base = nullptr,
+                              const double* qd = nullptr);
+  /// Whether coordinate i's q-dot and q-ddot come from the measured velocities (decided at
+  /// the first sample after a start, a reset or a retune: MeasuredVelocity).
+  bool velocityUsed(int i) const { return velocity_used_[static_cast<std::size_t>(i)] != 0; }
+  /// How many coordinates take their q-dot from the measured velocities.
+  int velocitiesUsed() const;
 
   /// Forgets all history (a backward jump of time).
   void reset();
@@ -117,7 +125,8 @@ class Estimator {
   /// p_world) beyond the root's are computed only with force plates, which need them:
   /// jle::worldPoses() on a copy fills them otherwise.
   const Data<double>& data() const { return data_; }
-  /// The estimated coordinates of the last published sample.
+  /// The estimated coordinates of the last published sample (q-dot and q-ddot from the
+  /// measured velocities where velocityUsed()).
   const VectorX<double>& q() const { return q_; }
   const VectorX<double>& qd() const { return qd_; }
   const VectorX<double>& qdd() const { return qdd_; }
@@ -195,6 +204,8 @@ class Estimator {
   // A joint sample: its checks (false: refused, and why), the bank's channels, the estimate.
   bool accept(double t, const double* q, const BasePose* base, SampleStatus& refused);
   void fillChannels(double t, const double* q, const BasePose* base);
+  void chooseVelocities(const double* qd);
+  void fillVelocityChannels(double t, const double* qd);
   SampleStatus publish();
   BaseState<double> readEstimate();
   // savings.reuse_unchanged: whether the filtered inputs are those of the last computation
@@ -228,6 +239,15 @@ class Estimator {
   DifferentiatorBank bank_;
   std::vector<double> channels_;  // q (nq), base (7), wrenches (6 per input), plates (6 each)
   int base_channel_ = 0;
+  // The measured velocities (MeasuredVelocity): their filter, the same as the positions',
+  // fed while velocity_active_ (some coordinate uses them), and its channels (nq).
+  DifferentiatorBank velocity_bank_;
+  std::vector<double> velocity_channels_;
+  // Per coordinate: q-dot from velocity_bank_; decided at the first sample (after a
+  // start, reset or retune) while velocities_open_.
+  std::vector<char> velocity_used_;
+  bool velocity_active_ = false;
+  bool velocities_open_ = true;
   int wrench_channel_ = 0;
   std::vector<WrenchInput> inputs_;
   SensorJoints sensors_;

@@ -18,12 +18,13 @@ class JointStateMap {
   /// `published_segments` as publishedSegments() returns them.
   JointStateMap(const Model<double>& model, const std::vector<int>& published_segments);
 
-  /// Takes a message's names and positions (same size, checked by the caller) and its
-  /// efforts (empty, or the same size; a non-finite one is taken as none: NaN). Mimic
-  /// joints are ignored (a mimic follows its leader). Returns the index in `names` of the first
-  /// joint the model does not have, or -1 if there is none (the others are still taken).
+  /// Takes a message's names and positions (same size, checked by the caller), its
+  /// velocities and its efforts (each empty, or the same size; a non-finite one is taken
+  /// as none: NaN). Mimic joints are ignored (a mimic follows its leader). Returns the
+  /// index in `names` of the first joint the model does not have, or -1 if there is none
+  /// (the others are still taken).
   int update(const std::vector<std::string>& names, const std::vector<double>& position,
-             const std::vector<double>& effort);
+             const std::vector<double>& velocity, const std::vector<double>& effort);
 
   /// The index in `names` of the first name that an earlier entry of `names` has too,
   /// or -1 if every name is there once. Binds the layout (no cost for the same layout
@@ -35,6 +36,10 @@ class JointStateMap {
 
   /// The positions, model.coordinate_names order (size nq).
   const std::vector<double>& q() const { return q_; }
+  /// The velocities, model.coordinate_names order (size nq): a coordinate in the last
+  /// message has its velocity there (NaN: none, or not finite); another keeps the value of
+  /// the last message that had it (as its position), NaN before one.
+  const std::vector<double>& qd() const { return qd_; }
   /// Whether coordinate k has had a position.
   bool received(int k) const { return received_[static_cast<std::size_t>(k)] != 0; }
   /// Index of the first coordinate with no position received yet, or -1 if none.
@@ -48,7 +53,7 @@ class JointStateMap {
   std::vector<std::string> coordinate_names_;
   std::vector<std::string> moving_joint_names_;  // every moving joint, mimics included
   std::vector<std::string> published_joint_names_;
-  std::vector<double> q_;
+  std::vector<double> q_, qd_;
   std::vector<char> received_;
   std::vector<double> effort_;
   // Cached binding of the last layout of names: per message index, the coordinate

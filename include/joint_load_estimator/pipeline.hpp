@@ -33,7 +33,7 @@ using Stamp = std::int64_t;
 enum class Outcome : std::uint8_t {
   kUsed,        ///< taken (a joint state entered the filters; no loads for it yet)
   kPublished,   ///< a joint state: loads computed, record() holds them
-  kInvalid,     ///< sizes disagree, a name twice, or a non-finite position or velocity
+  kInvalid,     ///< sizes disagree, a name twice, or a non-finite position
   kOrder,       ///< same or older stamp than the input's previous one
   kFrame,       ///< frame neither rigid to the link in the URDF nor known to the FrameSource
   kNoBasePose,  ///< floating base: no pose of the base at the stamp
@@ -72,6 +72,10 @@ struct PipelineCounters {
   /// joint states with a non-finite effort (that joint's measured effort is none; the
   /// loads are computed)
   long nonfinite_efforts = 0;
+  /// joint states with a non-finite velocity (that joint's velocity is none at the sample:
+  /// Estimator::addJointSample takes its velocity filter's prediction; the loads are
+  /// computed)
+  long nonfinite_velocities = 0;
 
   long received(InputKind kind) const;
   long count(InputKind kind, Outcome outcome) const {
@@ -144,12 +148,12 @@ class Pipeline {
   Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames);
 
   /// A joint state: names, positions (same size), velocities and efforts (empty or the
-  /// same size; a non-finite effort only drops that joint's measured effort). `clock` is the front
-  /// end's clock when the message arrived (the node: ros::Time::now(); a bag: the message's bag
-  /// time): it going back confirms a backward jump of time (a looping bag), and it stands for stamp
-  /// 0 on a stream that never had a stamp (README, "Time stamps"). The estimator is fed the
-  /// sample's instant (the stamp, or with stamps/regularize the SampleClock's estimate); the loads
-  /// keep the message's own stamp.
+  /// same size; a non-finite velocity or effort only drops that joint's measured value). `clock` is
+  /// the front end's clock when the message arrived (the node: ros::Time::now(); a bag: the
+  /// message's bag time): it going back confirms a backward jump of time (a looping bag), and it
+  /// stands for stamp 0 on a stream that never had a stamp (README, "Time stamps"). The estimator
+  /// is fed the sample's instant (the stamp, or with stamps/regularize the SampleClock's estimate);
+  /// the loads keep the message's own stamp.
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
                        const std::vector<double>& position, const std::vector<double>& velocity,
                        const std::vector<double>& effort);
@@ -195,6 +199,8 @@ class Pipeline {
   const std::string& unknownJoint() const { return unknown_joint_; }
   /// The first joint of the last joint state whose effort was not finite, or empty.
   const std::string& nonFiniteEffort() const { return nonfinite_effort_; }
+  /// The first joint of the last joint state whose velocity was not finite, or empty.
+  const std::string& nonFiniteVelocity() const { return nonfinite_velocity_; }
   /// The first coordinate the computed loads need that has had no position yet, or empty.
   const std::string& missingJoint() const;
   /// The topics of the inputs with stale_policy stop that were stale at the last joint
@@ -268,7 +274,7 @@ class Pipeline {
   bool checkJointState(const std::vector<std::string>& names, const std::vector<double>& position,
                        const std::vector<double>& velocity, const std::vector<double>& effort);
   void mapJointState(const std::vector<std::string>& names, const std::vector<double>& position,
-                     const std::vector<double>& effort);
+                     const std::vector<double>& velocity, const std::vector<double>& effort);
   bool basePose(Stamp stamp, BasePose& base);
   Outcome sample(Stamp stamp, bool has_effort, const BasePose* base);
   Outcome staleProblem();
@@ -314,7 +320,7 @@ class Pipeline {
   // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
   std::vector<Sample> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;
-  std::string problem_, unknown_joint_, nonfinite_effort_;
+  std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
   bool any_needed_ = false;  // the loads need at least one coordinate
   bool jumped_ = false;
   Stamp jump_from_ = 0, jump_to_ = 0;

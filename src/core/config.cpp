@@ -148,6 +148,10 @@ void validate(const EstimatorConfig& config) {
   unique("joints", config.joints);
   validateSavings(config.savings);
   validateUncertainty(config.uncertainty);
+  if (config.measured_velocity == MeasuredVelocity::kAlways && config.uncertainty.enabled)
+    fail("measured_velocity",
+         "is always, but uncertainty/enabled propagates the positions' noise only: use auto or "
+         "never");
   for (std::size_t k = 0; k < config.wrenches.size(); ++k) validateWrench(config.wrenches[k], k);
   for (std::size_t k = 0; k < config.plates.size(); ++k) validatePlate(config.plates[k], k);
 }

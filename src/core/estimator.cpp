@@ -55,6 +55,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
       data_(model_),
       single_(model_),
       bank_(config.differentiator, channelCount(model, config)),
+      velocity_bank_(config.differentiator, model.nq),
       q_(VectorX<double>::Zero(model.nq)),
       qd_(VectorX<double>::Zero(model.nq)),
       qdd_(VectorX<double>::Zero(model.nq)),
@@ -66,8 +67,10 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   plates_ =
       PlateInputs(model_, config_.plates, wrench_channel_ + 6 * static_cast<int>(inputs_.size()));
   channels_.assign(static_cast<std::size_t>(bank_.channels()), 0.0);
+  velocity_channels_.assign(static_cast<std::size_t>(model_.nq), 0.0);
+  velocity_used_.assign(static_cast<std::size_t>(model_.nq), 0);
   bank_.chooseBandwidthFrom(model_.nq);  // the joints, not the base pose or the wrenches
-  last_inputs_.assign(channels_.size() * 3, 0.0);
+  last_inputs_.assign(channels_.size() * 3 + 2 * static_cast<std::size_t>(model_.nq), 0.0);
   const std::vector<char> dynamics = selectSegments();
   markNeeded(dynamics);
   setUpPlanar();
@@ -168,12 +171,14 @@ void Estimator::setUpPlanar() {
 
 void Estimator::reset() {
   bank_.reset();
+  velocity_bank_.reset();
   covariance_.history = 0;
   for (WrenchInput& input : inputs_) input.samples.reset();
   plates_.reset();
   have_last_ = false;
   have_result_ = false;
   sample_count_ = 0;
+  velocities_open_ = true;
 }
 
 bool Estimator::retune(const DifferentiatorConfig& differentiator, int decimation) {
@@ -185,11 +190,13 @@ bool Estimator::retune(const DifferentiatorConfig& differentiator, int decimatio
   if (sameDifferentiator(differentiator, config_.differentiator)) return true;
   bank_ = DifferentiatorBank(differentiator, bank_.channels());
   bank_.chooseBandwidthFrom(model_.nq);
+  velocity_bank_ = DifferentiatorBank(differentiator, model_.nq);
   config_.differentiator = differentiator;
   covariance_.history = 0;
   have_last_ = false;
   have_result_ = false;
   sample_count_ = 0;
+  velocities_open_ = true;
   return false;
 }
 
@@ -214,10 +221,18 @@ bool Estimator::addWrench(int k, double t, const Eigen::Vector3d& force,
   return input.samples.add(t, value);
 }
 
-SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose* base) {
+SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose* base,
+                                       const double* qd) {
   SampleStatus refused = SampleStatus::kPublished;
   if (!accept(t, q, base, refused)) return refused;
+  if (velocities_open_) chooseVelocities(qd);
   fillChannels(t, q, base);
+  if (velocity_active_) {
+    // The same filter at the same times as the positions': ready, restarted and delayed
+    // alike (its result is read only when bank_'s is).
+    fillVelocityChannels(t, qd);
+    velocity_bank_.update(t, velocity_channels_.data());
+  }
   // A gap restarts the bank inside update(); the decimation phase restarts with it.
   if (!bank_.update(t, channels_.data())) {
     sample_count_ = 0;
@@ -229,7 +244,9 @@ SampleStatus Estimator::addJointSample(double t, const double* q, const BasePose
 
 bool Estimator::flush(SampleStatus& status) {
   bank_.finish();
+  if (velocity_active_) velocity_bank_.finish();
   if (!bank_.next()) return false;
+  if (velocity_active_) velocity_bank_.next();
   status = publish();
   return true;
 }
@@ -283,11 +300,47 @@ inline void Estimator::fillChannels(double t, const double* q, const BasePose* b
   plates_.resample(t, channels_.data());
 }
 
+// MeasuredVelocity: per coordinate, whether this first sample (after a start, a reset or a
+// retune) brings a finite velocity; then held until the next such sample.
+void Estimator::chooseVelocities(const double* qd) {
+  velocities_open_ = false;
+  const MeasuredVelocity mode = config_.measured_velocity;
+  const bool auto_on = mode == MeasuredVelocity::kAuto && !config_.uncertainty.enabled;
+  velocity_active_ = false;
+  for (int i = 0; i < model_.nq; ++i) {
+    const bool measured = qd != nullptr && std::isfinite(qd[i]);
+    const bool used = mode == MeasuredVelocity::kAlways || (auto_on && measured);
+    velocity_used_[static_cast<std::size_t>(i)] = used;
+    velocity_active_ = velocity_active_ || used;
+  }
+}
+
+// The velocity channels at time t [s]: the measured velocity, or where it is missing what
+// the velocity filter predicts (no news: the estimate follows its model).
+inline void Estimator::fillVelocityChannels(double t, const double* qd) {
+  for (int i = 0; i < model_.nq; ++i) {
+    const double v = qd != nullptr ? qd[i] : std::nan("");
+    velocity_channels_[static_cast<std::size_t>(i)] =
+        std::isfinite(v) ? v : velocity_bank_.predict(i, t);
+  }
+}
+
+int Estimator::velocitiesUsed() const {
+  int n = 0;
+  for (char used : velocity_used_) n += used != 0;
+  return n;
+}
+
 inline BaseState<double> Estimator::readEstimate() {
   for (int i = 0; i < model_.nq; ++i) {
     q_[i] = bank_.value(i);
-    qd_[i] = bank_.rate(i);
-    qdd_[i] = bank_.accel(i);
+    if (velocity_used_[static_cast<std::size_t>(i)]) {
+      qd_[i] = velocity_bank_.value(i);
+      qdd_[i] = velocity_bank_.rate(i);
+    } else {
+      qd_[i] = bank_.rate(i);
+      qdd_[i] = bank_.accel(i);
+    }
   }
   if (!model_.floating_base) return BaseState<double>();
   return baseStateFromBank(bank_, base_channel_);
@@ -300,11 +353,20 @@ inline bool Estimator::sameFilteredInputs(bool contacts_changed) {
     same = bank_.value(static_cast<int>(i)) == last_inputs_[i] &&
            bank_.rate(static_cast<int>(i)) == last_inputs_[c + i] &&
            bank_.accel(static_cast<int>(i)) == last_inputs_[2 * c + i];
+  // The measured velocities' q-dot and q-ddot (qd_, qdd_ hold them; 0 where unused).
+  const std::size_t v = 3 * c, nq = static_cast<std::size_t>(model_.nq);
+  for (std::size_t i = 0; i < nq && same && velocity_active_; ++i)
+    same = qd_[static_cast<int>(i)] == last_inputs_[v + i] &&
+           qdd_[static_cast<int>(i)] == last_inputs_[v + nq + i];
   if (same) return true;
   for (std::size_t i = 0; i < c; ++i) {
     last_inputs_[i] = bank_.value(static_cast<int>(i));
     last_inputs_[c + i] = bank_.rate(static_cast<int>(i));
     last_inputs_[2 * c + i] = bank_.accel(static_cast<int>(i));
+  }
+  for (std::size_t i = 0; i < nq && velocity_active_; ++i) {
+    last_inputs_[v + i] = qd_[static_cast<int>(i)];
+    last_inputs_[v + nq + i] = qdd_[static_cast<int>(i)];
   }
   return false;
 }

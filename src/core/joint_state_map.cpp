@@ -8,6 +8,7 @@ namespace jle {
 JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>& published_segments)
     : coordinate_names_(model.coordinate_names),
       q_(static_cast<std::size_t>(model.nq), 0.0),
+      qd_(static_cast<std::size_t>(model.nq), std::numeric_limits<double>::quiet_NaN()),
       received_(static_cast<std::size_t>(model.nq), 0),
       effort_(published_segments.size(), std::numeric_limits<double>::quiet_NaN()) {
   for (int s : model.moving_segments)
@@ -37,7 +38,9 @@ void JointStateMap::bind(const std::vector<std::string>& names) {
 }
 
 int JointStateMap::update(const std::vector<std::string>& names,
-                          const std::vector<double>& position, const std::vector<double>& effort) {
+                          const std::vector<double>& position, const std::vector<double>& velocity,
+                          const std::vector<double>& effort) {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
   if (names != layout_) bind(names);
   int unknown = -1;
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -48,12 +51,13 @@ int JointStateMap::update(const std::vector<std::string>& names,
     const int k = coordinate_of_[i];
     if (k >= 0) {
       q_[static_cast<std::size_t>(k)] = position[i];
+      qd_[static_cast<std::size_t>(k)] =
+          !velocity.empty() && std::isfinite(velocity[i]) ? velocity[i] : kNone;
       received_[static_cast<std::size_t>(k)] = 1;
     }
     const int j = published_of_[i];
     if (j >= 0 && !effort.empty())
-      effort_[static_cast<std::size_t>(j)] =
-          std::isfinite(effort[i]) ? effort[i] : std::numeric_limits<double>::quiet_NaN();
+      effort_[static_cast<std::size_t>(j)] = std::isfinite(effort[i]) ? effort[i] : kNone;
   }
   return unknown;
 }

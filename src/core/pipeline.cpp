@@ -361,13 +361,13 @@ bool Pipeline::checkJointState(const std::vector<std::string>& names,
       return false;
     }
   }
+  // A non-finite velocity or effort costs only that value (mapJointState counts it).
   std::size_t bad = 0;
-  for (const Field& field : fields)  // a non-finite effort only drops its comparison
-    if (&field.values != &effort && !allFinite(field.values, bad)) {
-      problem_ = topic + ": " + field.name + " of joint '" + names[bad] + "' is " +
-                 std::to_string(field.values[bad]) + ": message dropped";
-      return false;
-    }
+  if (!allFinite(position, bad)) {
+    problem_ = topic + ": position of joint '" + names[bad] + "' is " +
+               std::to_string(position[bad]) + ": message dropped";
+    return false;
+  }
   const int twice = joints_.duplicate(names);
   if (twice >= 0) {
     problem_ = topic + ": joint '" + names[static_cast<std::size_t>(twice)] +
@@ -386,12 +386,17 @@ bool Pipeline::movesNeeded() const {
 
 void Pipeline::mapJointState(const std::vector<std::string>& names,
                              const std::vector<double>& position,
+                             const std::vector<double>& velocity,
                              const std::vector<double>& effort) {
-  const int unknown = joints_.update(names, position, effort);
+  const int unknown = joints_.update(names, position, velocity, effort);
   std::size_t bad = 0;
   if (!allFinite(effort, bad)) {
     nonfinite_effort_ = names[bad];
     ++counters_.nonfinite_efforts;
+  }
+  if (!allFinite(velocity, bad)) {
+    nonfinite_velocity_ = names[bad];
+    ++counters_.nonfinite_velocities;
   }
   if (unknown < 0) {
     unknown_joint_.clear();
@@ -409,11 +414,12 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   problem_.clear();
   unknown_joint_.clear();
   nonfinite_effort_.clear();
+  nonfinite_velocity_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
   jumped_ = false;
   // Neither a sample nor a time: its stamp and clock are not the stream's.
   if (!movesNeeded()) {
-    mapJointState(names, position, effort);
+    mapJointState(names, position, velocity, effort);
     return fail(kind, Outcome::kNoJoint,
                 settings_.joint_states_topic +
                     ": a message with none of the joints the loads need: not a sample");
@@ -422,7 +428,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
     return fail(kind, Outcome::kRogueStamp, settings_.joint_states_topic + kZeroStamp);
   const Outcome timeline = checkJointStamp(stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
-  mapJointState(names, position, effort);
+  mapJointState(names, position, velocity, effort);
   anchor(stamp);
   const std::string& missing = missingJoint();
   if (!missing.empty())
@@ -458,7 +464,8 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   if (last_stamp_ != 0 && stamp <= last_stamp_)
     return order(stamp == last_stamp_ ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder);
   const double t = relative(clock_.add(stamp));
-  const SampleStatus status = estimator_.addJointSample(t, joints_.q().data(), base);
+  const SampleStatus status =
+      estimator_.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
   switch (status) {
     case SampleStatus::kDuplicate:
     case SampleStatus::kOutOfOrder: return order(status);

@@ -267,15 +267,23 @@ class PyEstimator {
   const std::vector<int>& segments() const { return segments_; }
   const jle::Settings& settings() const { return settings_; }
 
-  std::string addJointSample(double t, const Array& q, const py::object& pose) {
+  std::string addJointSample(double t, const Array& q, const py::object& pose,
+                             const py::object& qd_object) {
     if (q.ndim() != 1 || q.shape(0) != model_.nq)
       throw std::invalid_argument("q must have " + std::to_string(model_.nq) + " entries");
     jle::BasePose base;
     if (!pose.is_none()) base = basePoseOf(pose.cast<Array>());
     if (model_.floating_base && pose.is_none())
       throw std::invalid_argument("a floating-base model needs base_pose (x y z qx qy qz qw)");
-    return jle::toString(
-        estimator_->addJointSample(t, q.data(), model_.floating_base ? &base : nullptr));
+    Array qd;
+    if (!qd_object.is_none()) {
+      qd = qd_object.cast<Array>();
+      if (qd.ndim() != 1 || qd.shape(0) != model_.nq)
+        throw std::invalid_argument("qd must have " + std::to_string(model_.nq) + " entries");
+    }
+    return jle::toString(estimator_->addJointSample(t, q.data(),
+                                                    model_.floating_base ? &base : nullptr,
+                                                    qd_object.is_none() ? nullptr : qd.data()));
   }
 
   static jle::BasePose basePoseOf(const Array& p) {
@@ -593,7 +601,9 @@ void defineEstimator(py::module_& m) {
            "config: the node's parameters as a YAML file (config/default.yaml); empty: the "
            "node's defaults.")
       .def("add_joint_sample", &PyEstimator::addJointSample, py::arg("t"), py::arg("q"),
-           py::arg("base_pose") = py::none())
+           py::arg("base_pose") = py::none(), py::arg("qd") = py::none(),
+           "qd: the measured joint velocities (NaN: none at this sample), used as the "
+           "configuration's measured_velocity says.")
       .def(
           "add_wrench",
           [](PyEstimator& e, int k, double t, const std::vector<double>& f,

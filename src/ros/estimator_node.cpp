@@ -150,6 +150,11 @@ void EstimatorNode::report(Outcome outcome) {
   if (!pipeline_->nonFiniteEffort().empty())
     ROS_WARN_THROTTLE(kThrottle, "%s: effort of joint '%s' is not finite: not compared",
                       settings_.joint_states_topic.c_str(), pipeline_->nonFiniteEffort().c_str());
+  if (!pipeline_->nonFiniteVelocity().empty())
+    ROS_WARN_THROTTLE(kThrottle,
+                      "%s: velocity of joint '%s' is not finite: that velocity is not used "
+                      "(the velocity filter's prediction instead)",
+                      settings_.joint_states_topic.c_str(), pipeline_->nonFiniteVelocity().c_str());
   // A gripper's own joint states are normal: said once, counted in the diagnostics.
   if (outcome == Outcome::kNoJoint) {
     ROS_INFO_ONCE("%s (counted under 'not used: no needed joint')", pipeline_->problem().c_str());
@@ -412,6 +417,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("not published: unchanged", c.count(Outcome::kUnchanged));
   status.add("messages with unknown joints", c.unknown_joints);
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
+  status.add("velocities not used: non-finite", c.nonfinite_velocities);
+  status.add("joints with measured velocities", pipeline_->estimator().velocitiesUsed());
   status.add("not published: stale input", c.count(Outcome::kStale));
   status.add("time jumps back", c.backJumps());
   status.add("time jumps forward", c.forward_jumps);

@@ -322,6 +322,10 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("gravity", n.estimator.gravity_world.data(), 3);
   s.read("precision", n.estimator.precision,
          {{"double", Precision::kDouble}, {"float", Precision::kFloat}});
+  s.read("measured_velocity", n.estimator.measured_velocity,
+         {{"auto", MeasuredVelocity::kAuto},
+          {"always", MeasuredVelocity::kAlways},
+          {"never", MeasuredVelocity::kNever}});
   s.read("body_mass", n.body_mass);
   s.read("base_residual_threshold", n.base_residual_threshold);
   s.read("still_velocity", n.still_velocity);

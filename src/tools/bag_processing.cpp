@@ -463,6 +463,8 @@ void processBag(const BagOptions& options, LoadsSink& sink) {
     d.order = 2;
     d.window = 3;
     d.delay = 1;
+    // Their velocities are the smoothed positions' rates: the positions say it all.
+    settings.estimator.measured_velocity = jle::MeasuredVelocity::kNever;
   }
   const jle::Model<double> model =
       jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));

@@ -170,6 +170,7 @@ void expectSame(const jle::EstimatorConfig& a, const jle::EstimatorConfig& b) {
   const std::string where;
   expectSame(a.differentiator, b.differentiator, "differentiator/");
   EXPECT_SAME(precision);
+  EXPECT_SAME(measured_velocity);
   expectSame(a.savings, b.savings, "savings/");
   EXPECT_SAME(joints);
   EXPECT_SAME(gravity_world);
@@ -246,6 +247,7 @@ TEST(SettingsReader, TopLevelKeys) {
   e.time_jump_threshold = 0.5;
   e.keep_fixed_joints = {"wrist_3_link-tool0_fixed_joint"};
   e.estimator.precision = jle::Precision::kFloat;
+  e.estimator.measured_velocity = jle::MeasuredVelocity::kNever;
   e.floating_base = true;
   e.world_frame = "odom";
   e.base_frame = "base_link";
@@ -404,6 +406,11 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
   expectRefused("decimation: 1.5", "parameter 'decimation' must be an integer");
   expectRefused("gravity: [0, 0]", "parameter 'gravity' must be a list of 3 numbers");
   expectRefused("gravity: [0, 0, g]", "parameter 'gravity[2]' must be a number");
+  expectRefused(
+      "measured_velocity: sometimes",
+      "parameter 'measured_velocity' is 'sometimes'; expected one of auto, always, never");
+  expectRefused("measured_velocity: always\nuncertainty: {enabled: true}",
+                "parameter 'measured_velocity' is always, but uncertainty/enabled");
   expectRefused("precision: half",
                 "parameter 'precision' is 'half'; expected one of double, float");
   expectRefused("differentiator: {delay: middle}", "'differentiator/delay' must be an integer or");
