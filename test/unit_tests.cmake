@@ -21,6 +21,8 @@ jle_add_unit_test(test_adaptive_differentiator unit/test_adaptive_differentiator
 jle_add_unit_test(test_estimator unit/test_estimator.cpp)
 # Measured joint velocities (measured_velocity) against the exact loads of an analytic motion.
 jle_add_unit_test(test_measured_velocity unit/test_measured_velocity.cpp)
+# The immediate and the smoothed stream of one pipeline against the exact loads.
+jle_add_unit_test(test_two_streams unit/test_two_streams.cpp)
 jle_add_unit_test(test_savings unit/test_savings.cpp)
 jle_add_unit_test(test_ground_truth unit/test_ground_truth.cpp)
 # The bounds of the stability sweeps (bench/stability.cpp, docs/stability.md).

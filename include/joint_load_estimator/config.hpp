@@ -290,6 +290,27 @@ struct StampSettings {
   int jump_confirm = 3;
 };
 
+/// The smoothed stream's filter by default: the constant-jerk Kalman smoother, process
+/// noise 1e2, lag 0.2 s (docs/accuracy.md; README, "Two streams").
+inline DifferentiatorConfig defaultSmoother() {
+  DifferentiatorConfig c;
+  c.type = DifferentiatorType::kKalman;
+  c.kalman_model = KalmanModel::kConstantJerk;
+  c.process_noise = 1e2;
+  c.lag = 0.2;
+  return c;
+}
+
+/// The smoothed stream (smoothed/...): the loads of the same samples, through the same
+/// pipeline, estimated by a smoother `differentiator.lag` seconds behind the newest sample,
+/// beside the immediate (causal) stream of `estimator.differentiator`. For monitoring,
+/// rviz and bag replay; control loops take the immediate stream.
+struct SmoothedStreamSettings {
+  bool enabled = true;
+  /// A smoother: type kalman or adaptive, lag > 0 [s].
+  DifferentiatorConfig differentiator = defaultSmoother();
+};
+
 /// Every setting of the node and of the offline front ends (process_bag), with the
 /// parameter names of config/default.yaml (README, "Parameters").
 struct Settings {
@@ -335,8 +356,10 @@ struct Settings {
   double body_mass = 0.0;
   FrictionConfig friction;
   ExternalEffortConfig external_effort;
-  /// The estimator's settings; estimator.joints are the joints whose loads are published.
+  /// The estimator's settings (the immediate stream's); estimator.joints are the joints
+  /// whose loads are published.
   EstimatorConfig estimator;
+  SmoothedStreamSettings smoothed;
   std::vector<WrenchTopicSettings> wrenches;     ///< pairs with estimator.wrenches
   std::vector<PlateTopicSettings> force_plates;  ///< pairs with estimator.plates
 };
@@ -346,6 +369,9 @@ struct Settings {
 /// naming the key. What needs the model (links and joints that exist) is checked by the
 /// Estimator.
 void validate(const EstimatorConfig& config);
+
+/// The smoothed stream's estimator settings: `estimator` with the smoothed stream's filter.
+EstimatorConfig smoothedEstimatorConfig(const Settings& settings);
 
 /// Checks `settings`: validate(settings.estimator), the front end's own settings, and
 /// that wrenches and force_plates pair with estimator.wrenches and estimator.plates.

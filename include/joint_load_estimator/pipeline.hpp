@@ -214,7 +214,25 @@ class Pipeline {
   /// Whether that jump went forward (stamps far ahead, confirmed), not back.
   bool jumpedForward() const { return jumped_ && jump_from_ != 0 && jump_to_ > jump_from_; }
 
+  /// The immediate stream's record: the loads of the last joint state that returned
+  /// kPublished (or of flush(), takeDrained()).
   const LoadsRecord& record() const { return record_; }
+
+  /// The smoothed stream (settings.smoothed; README, "Two streams"): the loads of the same
+  /// samples, taken through the same checks, by a second estimator whose filter is the
+  /// smoother of settings.smoothed, its loads `lag` seconds of stamps behind the newest
+  /// joint state. Its records carry no external efforts or contacts (the immediate
+  /// stream's). False when smoothed/enabled is false, and then nothing below applies.
+  bool hasSmoothed() const { return smoothed_ != nullptr; }
+  /// Whether the last input call put a sample's smoothed loads in smoothedRecord().
+  bool smoothedPublished() const { return smoothed_published_; }
+  const LoadsRecord& smoothedRecord() const { return smoothed_->record; }
+  /// As flush() and takeDrained(), for the smoothed stream (call both after the
+  /// immediate stream's: each puts the next of its records in smoothedRecord()).
+  bool flushSmoothed();
+  bool takeDrainedSmoothed();
+  /// The smoothed stream's estimator (null without one).
+  const Estimator* smoothedEstimator() const { return smoothed_ ? &smoothed_->estimator : nullptr; }
   const PipelineCounters& counters() const { return counters_; }
   const Settings& settings() const { return settings_; }
   const Estimator& estimator() const { return estimator_; }
@@ -251,6 +269,14 @@ class Pipeline {
     bool pose_known = false;
     bool stamped = false;
   };
+  // The smoothed stream: its estimator, its record, and its loads drained by a reset.
+  struct Stream {
+    Stream(const Model<double>& model, const EstimatorConfig& config) : estimator(model, config) {}
+    Estimator estimator;
+    LoadsRecord record;
+    std::vector<LoadsRecord> drained;
+    std::size_t drained_next = 0;
+  };
   // One joint sample entering the filters: its time, stamp and measured efforts.
   struct Sample {
     double t = 0.0;
@@ -282,12 +308,16 @@ class Pipeline {
   void growRing(std::size_t size);
   bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
   bool resolvePlatePose(int k, const std::string& frame);
-  void fillRecord();
+  void fillRecord(const Estimator& estimator, LoadsRecord& rec);
   void setUpExternal();
   void fillExternal();
-  void fillCoordinates(std::size_t i, std::size_t segment);
+  void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
+                       std::size_t segment);
   const Sample* sampleAt(double t) const;
   void drainSmoother();
+  bool flushStream(Estimator& estimator, LoadsRecord& record);
+  static bool takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, std::size_t& next);
+  void sampleSmoothed(double t, const BasePose* base);
 
   Settings settings_;
   FrameSource* frames_;
@@ -299,6 +329,8 @@ class Pipeline {
   // A smoother's loads made before a reset or a retune (takeDrained), and the next one.
   std::vector<LoadsRecord> drained_;
   std::size_t drained_next_ = 0;
+  std::unique_ptr<Stream> smoothed_;  // settings.smoothed.enabled
+  bool smoothed_published_ = false;
   PipelineCounters counters_;
   std::vector<WrenchInput> wrenches_;
   std::vector<PlateInput> plates_;

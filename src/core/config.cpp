@@ -156,8 +156,39 @@ void validate(const EstimatorConfig& config) {
   for (std::size_t k = 0; k < config.plates.size(); ++k) validatePlate(config.plates[k], k);
 }
 
+EstimatorConfig smoothedEstimatorConfig(const Settings& settings) {
+  EstimatorConfig config = settings.estimator;
+  config.differentiator = settings.smoothed.differentiator;
+  return config;
+}
+
+namespace {
+
+void validateSmoothed(const SmoothedStreamSettings& s) {
+  if (!s.enabled) return;
+  const DifferentiatorConfig& d = s.differentiator;
+  try {
+    validate(d);
+  } catch (const std::invalid_argument& e) {
+    // "parameter 'differentiator/..." names the key within smoothed/.
+    std::string what = e.what();
+    const std::string key = "'differentiator/";
+    const std::size_t at = what.find(key);
+    if (at != std::string::npos) what.insert(at + 1, "smoothed/");
+    throw SettingsError(what);
+  }
+  if (d.type != DifferentiatorType::kKalman && d.type != DifferentiatorType::kAdaptive)
+    fail("smoothed/differentiator/type", "must be kalman or adaptive (a smoother)");
+  if (!(d.lag > 0.0))
+    fail("smoothed/differentiator/lag",
+         "must be > 0 [s]: the smoothed stream's delay (smoothed/enabled: false turns it off)");
+}
+
+}  // namespace
+
 void validate(const Settings& settings) {
   validate(settings.estimator);
+  validateSmoothed(settings.smoothed);
   required("robot_description", settings.robot_description);
   required("joint_states_topic", settings.joint_states_topic);
   unique("keep_fixed_joints", settings.keep_fixed_joints);

@@ -183,6 +183,10 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
   }
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
+  if (settings_.smoothed.enabled) {
+    smoothed_ = std::make_unique<Stream>(model, smoothedEstimatorConfig(settings_));
+    smoothed_->record = record_;  // sized; no external outputs
+  }
   if (settings_.external_effort.enabled) setUpExternal();
 }
 
@@ -274,6 +278,7 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   jump_to_ = stamp;
   drainSmoother();
   estimator_.reset();
+  if (smoothed_) smoothed_->estimator.reset();
   if (external_) external_->reset();
   clock_.reset();
   ring_count_ = 0;
@@ -412,6 +417,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
                                const std::vector<double>& effort) {
   constexpr InputKind kind = InputKind::kJointState;
   problem_.clear();
+  smoothed_published_ = false;
   unknown_joint_.clear();
   nonfinite_effort_.clear();
   nonfinite_velocity_.clear();
@@ -478,39 +484,64 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   last_taken_clock_ = last_clock_;
   if (clock_back_ > 0) --clock_back_;
   remember(t, stamp, has_effort);
+  if (smoothed_) sampleSmoothed(t, base);
   if (status == SampleStatus::kStale) return staleProblem();
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
   if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged)
     return count(kind, Outcome::kUnchanged);
-  fillRecord();
+  fillRecord(estimator_, record_);
   return count(kind, Outcome::kPublished);
+}
+
+// The sample the immediate stream took, into the smoothed stream (the same checks passed:
+// the same time, positions, velocities and base pose).
+void Pipeline::sampleSmoothed(double t, const BasePose* base) {
+  Estimator& e = smoothed_->estimator;
+  const SampleStatus status = e.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
+  smoothed_published_ = status == SampleStatus::kPublished &&
+                        !(e.lastWasReused() && !settings_.estimator.savings.republish_unchanged);
+  if (smoothed_published_) fillRecord(e, smoothed_->record);
 }
 
 void Pipeline::drainSmoother() {
   // Rare (a reset with a smoother): copies of the record are fine here.
-  if (estimator_.pendingSamples() == 0) return;
-  while (flush()) drained_.push_back(record_);
+  if (estimator_.pendingSamples() > 0)
+    while (flush()) drained_.push_back(record_);
+  if (smoothed_ && smoothed_->estimator.pendingSamples() > 0)
+    while (flushSmoothed()) smoothed_->drained.push_back(smoothed_->record);
 }
 
-bool Pipeline::takeDrained() {
-  if (drained_next_ == drained_.size()) return false;
-  std::swap(record_, drained_[drained_next_++]);
-  if (drained_next_ == drained_.size()) {
-    drained_.clear();
-    drained_next_ = 0;
+bool Pipeline::takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, std::size_t& next) {
+  if (next == drained.size()) return false;
+  std::swap(record, drained[next++]);
+  if (next == drained.size()) {
+    drained.clear();
+    next = 0;
   }
   return true;
 }
 
-bool Pipeline::flush() {
+bool Pipeline::takeDrained() { return takeFrom(record_, drained_, drained_next_); }
+
+bool Pipeline::takeDrainedSmoothed() {
+  return smoothed_ && takeFrom(smoothed_->record, smoothed_->drained, smoothed_->drained_next);
+}
+
+bool Pipeline::flushStream(Estimator& estimator, LoadsRecord& record) {
   SampleStatus status = SampleStatus::kPublished;
-  while (estimator_.flush(status)) {
+  while (estimator.flush(status)) {
     if (status != SampleStatus::kPublished) continue;
-    if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
-    fillRecord();
+    if (estimator.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
+    fillRecord(estimator, record);
     return true;
   }
   return false;
+}
+
+bool Pipeline::flush() { return flushStream(estimator_, record_); }
+
+bool Pipeline::flushSmoothed() {
+  return smoothed_ && flushStream(smoothed_->estimator, smoothed_->record);
 }
 
 std::string Pipeline::stoppingInputs() const {
@@ -544,7 +575,9 @@ Outcome Pipeline::staleProblem() {
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
   // A smoother's delay is known from its second sample; over a gap its carried estimates
   // add to it: the ring holds twice the delay (grown here, rarely: a new rate).
-  const std::size_t needed = 2 * static_cast<std::size_t>(estimator_.delaySamples()) + 2;
+  const int delay =
+      std::max(estimator_.delaySamples(), smoothed_ ? smoothed_->estimator.delaySamples() : 0);
+  const std::size_t needed = 2 * static_cast<std::size_t>(delay) + 2;
   if (needed > ring_.size()) growRing(needed);
   Sample& s = ring_[ring_head_];
   s.t = t;
@@ -573,49 +606,50 @@ const Pipeline::Sample* Pipeline::sampleAt(double t) const {
   return nullptr;
 }
 
-void Pipeline::fillRecord() {
-  const Data<double>& data = estimator_.data();
-  const Sample* s = sampleAt(estimator_.stamp());
-  record_.stamp = s ? s->stamp : absolute(estimator_.stamp());
+void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
+  const Data<double>& data = estimator.data();
+  const Sample* s = sampleAt(estimator.stamp());
+  rec.stamp = s ? s->stamp : absolute(estimator.stamp());
   const bool measured = s && s->has_effort;
   const UncertaintyConfig& u = settings_.estimator.uncertainty;
   const std::size_t per_joint = u.diagonal_only ? 6 : 36;
-  for (std::size_t i = 0; i < record_.segment.size(); ++i) {
-    const int segment = record_.segment[i];
+  for (std::size_t i = 0; i < rec.segment.size(); ++i) {
+    const int segment = rec.segment[i];
     const std::size_t j = static_cast<std::size_t>(segment);
-    record_.force[i] = data.force[j];
-    record_.moment[i] = data.moment[j];
-    record_.effort[i] = data.effort[j];
-    record_.measured_effort[i] = measured ? s->effort[i] : kNaN;
-    if (!record_.effort_per_kg.empty()) record_.effort_per_kg[i] = data.effort[j] / body_mass_;
-    fillCoordinates(i, j);
+    rec.force[i] = data.force[j];
+    rec.moment[i] = data.moment[j];
+    rec.effort[i] = data.effort[j];
+    rec.measured_effort[i] = measured ? s->effort[i] : kNaN;
+    if (!rec.effort_per_kg.empty()) rec.effort_per_kg[i] = data.effort[j] / body_mass_;
+    fillCoordinates(estimator, rec, i, j);
     if (!u.enabled) continue;
-    const Eigen::Matrix<double, 6, 6>& C = estimator_.covariance(segment);
-    double* out = &record_.covariance[per_joint * i];
+    const Eigen::Matrix<double, 6, 6>& C = estimator.covariance(segment);
+    double* cov = &rec.covariance[per_joint * i];
     for (int r = 0; r < 6; ++r)
       for (int c = 0; c < 6; ++c)
         if (!u.diagonal_only)
-          out[6 * r + c] = C(r, c);
+          cov[6 * r + c] = C(r, c);
         else if (r == c)
-          out[r] = C(r, r);
-    record_.effort_stddev[i] = std::sqrt(estimator_.effortVariance(segment));
+          cov[r] = C(r, r);
+    rec.effort_stddev[i] = std::sqrt(estimator.effortVariance(segment));
   }
-  if (external_) fillExternal();
+  if (external_ && &rec == &record_) fillExternal();
 }
 
-void Pipeline::fillCoordinates(std::size_t i, std::size_t segment) {
+void Pipeline::fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
+                               std::size_t segment) {
   const Model<double>& m = model();
   const int c = m.coordinate[segment];
   if (c < 0) return;  // a fixed joint kept as a segment: 0 from the constructor
   // As forwardKinematics maps them (a mimic joint follows its leader).
   const double k = m.multiplier[segment];
-  record_.position[i] = k * estimator_.q()[c] + m.offset[segment];
-  record_.velocity[i] = k * estimator_.qd()[c];
-  record_.acceleration[i] = k * estimator_.qdd()[c];
-  if (!record_.motor_effort.empty())
-    record_.motor_effort[i] =
-        record_.effort[i] + frictionEffort(m.damping[segment], m.friction[segment],
-                                           record_.velocity[i], settings_.friction.velocity_scale);
+  rec.position[i] = k * estimator.q()[c] + m.offset[segment];
+  rec.velocity[i] = k * estimator.qd()[c];
+  rec.acceleration[i] = k * estimator.qdd()[c];
+  if (!rec.motor_effort.empty())
+    rec.motor_effort[i] =
+        rec.effort[i] + frictionEffort(m.damping[segment], m.friction[segment], rec.velocity[i],
+                                       settings_.friction.velocity_scale);
 }
 
 bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation) {
@@ -626,6 +660,8 @@ bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation
   validate(next);  // throws naming the key, changing nothing
   if (!sameDifferentiator(differentiator, estimator_.config().differentiator)) drainSmoother();
   const bool kept = estimator_.retune(differentiator, decimation);
+  if (smoothed_)  // its own filter kept; the decimation is the node's
+    smoothed_->estimator.retune(smoothed_->estimator.config().differentiator, decimation);
   settings_.estimator.differentiator = differentiator;
   settings_.estimator.decimation = decimation;
   return kept;
@@ -661,6 +697,7 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
                            const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
   constexpr InputKind kind = InputKind::kWrench;
   problem_.clear();
+  smoothed_published_ = false;
   const std::string& topic = settings_.wrenches.at(ix(k)).topic;
   if (!force.allFinite() || !torque.allFinite())
     return fail(kind, Outcome::kInvalid,
@@ -682,7 +719,9 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   const Eigen::Vector3d f = force - input.bias_force, m = torque - input.bias_torque;
   Eigen::Vector3d f_link, m_link;
   wrenchInLink(input.X_link_frame.linear(), input.X_link_frame.translation(), f, m, f_link, m_link);
-  if (!estimator_.addWrench(k, relative(stamp), f_link, m_link))
+  const double t = relative(stamp);
+  if (smoothed_) smoothed_->estimator.addWrench(k, t, f_link, m_link);  // the same order
+  if (!estimator_.addWrench(k, t, f_link, m_link))
     return fail(
         kind, Outcome::kOrder,
         "wrench '" + topic + "': stamp " + seconds(stamp) + " not newer than the last: dropped");
@@ -709,6 +748,7 @@ bool Pipeline::resolvePlatePose(int k, const std::string& frame) {
     return false;
   }
   estimator_.setPlatePose(k, X.rotation(), X.translation());
+  if (smoothed_) smoothed_->estimator.setPlatePose(k, X.rotation(), X.translation());
   plate.frame = frame;
   plate.pose_known = true;
   return true;
@@ -718,6 +758,7 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
                           const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
   constexpr InputKind kind = InputKind::kPlate;
   problem_.clear();
+  smoothed_published_ = false;
   const std::string& name = settings_.estimator.plates.at(ix(k)).plate.name;
   if (!force.allFinite() || !moment.allFinite())
     return fail(kind, Outcome::kInvalid,
@@ -735,7 +776,9 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
                                            settings_.estimator.plates[ix(k)].timeout, stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
-  if (!estimator_.addPlateSample(k, relative(stamp), force, moment))
+  const double t = relative(stamp);
+  if (smoothed_) smoothed_->estimator.addPlateSample(k, t, force, moment);  // the same order
+  if (!estimator_.addPlateSample(k, t, force, moment))
     return fail(kind, Outcome::kOrder,
                 "force plate '" + name + "': stamp " + seconds(stamp) +
                     " not newer than the last: dropped");

@@ -123,9 +123,15 @@ def process_bag(bag, urdf, config="", zero_phase=None, cutoff_rule="gcv", summar
     Returns Loads with ``t`` (stamp [s], as process_bag --csv writes it), ``stamp_ns``,
     ``wrench`` (child frame), ``effort``, ``position``, ``velocity``, ``acceleration``
     (the filter's estimate), ``measured_effort``, and, when the config enables them,
-    ``effort_stddev`` and ``motor_effort`` (else N x 0).
+    ``effort_stddev`` and ``motor_effort`` (else N x 0): the immediate stream. Its
+    ``smoothed`` is the smoothed stream's Loads (the config's smoothed/...; README "Two
+    streams"), None when it is off or with zero_phase.
     """
-    return Loads(_core._process_bag(bag, urdf, config, zero_phase, cutoff_rule, summary))
+    arrays = _core._process_bag(bag, urdf, config, zero_phase, cutoff_rule, summary)
+    smoothed = arrays.pop("smoothed")
+    loads = Loads(arrays)
+    loads.smoothed = Loads(smoothed) if smoothed is not None else None
+    return loads
 
 
 def estimate(estimator, t, q, wrenches=()):

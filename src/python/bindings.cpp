@@ -473,15 +473,10 @@ Array lowPassZeroPhase(const Array& t_in, const Array& x_in, double cutoff, int 
 
 // ---- a bag through the node's message path --------------------------------------------
 
-// Every published record, kept as columns.
-class RecordSink : public jle::LoadsSink {
+// The records of one stream, kept as columns.
+class RecordColumns {
  public:
-  void open(const jle::Pipeline& pipeline) override {
-    const jle::LoadsRecord& r = pipeline.record();
-    joints_ = r.joint;
-    links_ = r.link;
-  }
-  void write(const jle::LoadsRecord& r, long) override {
+  void add(const jle::LoadsRecord& r) {
     stamps_.push_back(r.stamp);
     for (std::size_t i = 0; i < r.joint.size(); ++i) {
       for (int c = 0; c < 3; ++c) wrench_.push_back(r.force[i][c]);
@@ -495,29 +490,30 @@ class RecordSink : public jle::LoadsSink {
     append(motor_, r.motor_effort);
     append(measured_, r.measured_effort);
   }
-  py::dict result() const;
+  py::dict result(const std::vector<std::string>& joints,
+                  const std::vector<std::string>& links) const;
 
  private:
   static void append(std::vector<double>& to, const std::vector<double>& from) {
     to.insert(to.end(), from.begin(), from.end());
   }
-  std::vector<std::string> joints_, links_;
   std::vector<jle::Stamp> stamps_;
   std::vector<double> wrench_, effort_, stddev_, position_, velocity_, acceleration_, motor_,
       measured_;
 };
 
-py::dict RecordSink::result() const {
+py::dict RecordColumns::result(const std::vector<std::string>& joints,
+                               const std::vector<std::string>& links) const {
   const auto n = static_cast<py::ssize_t>(stamps_.size());
-  const auto m = static_cast<py::ssize_t>(joints_.size());
+  const auto m = static_cast<py::ssize_t>(joints.size());
   const auto columns = [&](const std::vector<double>& v) {
     return Array({n, v.empty() ? py::ssize_t(0) : m}, v.data());
   };
   std::vector<double> t;
   for (jle::Stamp s : stamps_) t.push_back(jle::toRosTime(s).toSec());  // as process_bag writes
   py::dict out;
-  out["joints"] = joints_;
-  out["links"] = links_;
+  out["joints"] = joints;
+  out["links"] = links;
   out["frame"] = "child";
   out["t"] = Array(n, t.data());
   out["stamp_ns"] = py::array_t<std::int64_t>(n, stamps_.data());
@@ -531,6 +527,31 @@ py::dict RecordSink::result() const {
   out["measured_effort"] = columns(measured_);
   return out;
 }
+
+// Every published record of both streams.
+class RecordSink : public jle::LoadsSink {
+ public:
+  void open(const jle::Pipeline& pipeline) override {
+    const jle::LoadsRecord& r = pipeline.record();
+    joints_ = r.joint;
+    links_ = r.link;
+    has_smoothed_ = pipeline.hasSmoothed();
+  }
+  void write(const jle::LoadsRecord& r, long) override { immediate_.add(r); }
+  void writeSmoothed(const jle::LoadsRecord& r, long) override { smoothed_.add(r); }
+  // The immediate stream's columns, and its smoothed stream's under "smoothed" (None when
+  // smoothed/enabled is false).
+  py::dict result() const {
+    py::dict out = immediate_.result(joints_, links_);
+    out["smoothed"] = has_smoothed_ ? py::object(smoothed_.result(joints_, links_)) : py::none();
+    return out;
+  }
+
+ private:
+  std::vector<std::string> joints_, links_;
+  bool has_smoothed_ = false;
+  RecordColumns immediate_, smoothed_;
+};
 
 py::dict processBag(const std::string& bag, const std::string& urdf, const std::string& config,
                     const py::object& zero_phase, const std::string& cutoff_rule, bool summary) {

@@ -34,6 +34,10 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   settings_ = pipeline_->settings();  // with the sensors' links and the base frame filled in
   prepare(pipeline_->record(), loads_msg_);
   prepare(pipeline_->record(), efforts_msg_);
+  if (pipeline_->hasSmoothed()) {
+    prepare(pipeline_->smoothedRecord(), smoothed_.loads_msg);
+    prepare(pipeline_->smoothedRecord(), smoothed_.efforts_msg);
+  }
   advertise();
   setUpConsistency();
   applyBiasFile(*pipeline_);  // before the first wrench can arrive
@@ -87,6 +91,16 @@ void EstimatorNode::advertise() {
   if (pipeline_->model().floating_base)
     residual_pub_ = private_nh_.advertise<geometry_msgs::WrenchStamped>("base_residual", 10);
   external_outputs_.advertise(private_nh_, record);
+  if (pipeline_->hasSmoothed()) {
+    smoothed_.loads_pub =
+        private_nh_.advertise<joint_load_estimator::JointLoads>("smoothed/joint_loads", 100);
+    smoothed_.efforts_pub =
+        private_nh_.advertise<sensor_msgs::JointState>("smoothed/joint_efforts", 100);
+    if (settings_.publish_wrench_topics)
+      for (const std::string& joint : record.joint)
+        smoothed_.wrench_pubs.push_back(
+            private_nh_.advertise<geometry_msgs::WrenchStamped>("smoothed/wrench/" + joint, 10));
+  }
   wrench_topics_.resize(settings_.wrenches.size());
   plate_topics_.resize(settings_.force_plates.size());
   for (std::size_t k = 0; k < plate_topics_.size(); ++k)
@@ -286,6 +300,24 @@ void EstimatorNode::publish(const ros::Time& received) {
 void EstimatorNode::publishDrained(const ros::Time& received) {
   // A smoother's loads still to come when time jumped back or the filter was replaced.
   while (pipeline_->takeDrained()) publish(received);
+  if (!pipeline_->hasSmoothed()) return;
+  if (pipeline_->smoothedPublished()) publishSmoothed();
+  while (pipeline_->takeDrainedSmoothed()) publishSmoothed();
+}
+
+void EstimatorNode::publishSmoothed() {
+  const LoadsRecord& record = pipeline_->smoothedRecord();
+  toMessage(record, smoothed_.loads_msg);
+  smoothed_.loads_pub.publish(smoothed_.loads_msg);
+  if (smoothed_.efforts_pub.getNumSubscribers() > 0) {
+    toJointState(record, smoothed_.efforts_msg);
+    smoothed_.efforts_pub.publish(smoothed_.efforts_msg);
+  }
+  for (std::size_t i = 0; i < smoothed_.wrench_pubs.size(); ++i)
+    if (smoothed_.wrench_pubs[i].getNumSubscribers() > 0) {
+      toWrenchMessage(record, i, wrench_msg_);
+      smoothed_.wrench_pubs[i].publish(wrench_msg_);
+    }
 }
 
 void EstimatorNode::publishPlates(const ros::Time& stamp) {

@@ -373,6 +373,11 @@ Settings parseSettings(const XmlRpcValue& params) {
   s.readMap("external_effort", [&](Section& m) { readExternalEffort(m, n.external_effort); });
   s.readMap("differentiator",
             [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });
+  s.readMap("smoothed", [&](Section& m) {
+    m.read("enabled", n.smoothed.enabled);
+    m.readMap("differentiator",
+              [&](Section& d) { readDifferentiator(d, n.smoothed.differentiator); });
+  });
   s.readList("wrenches", [&](Section& m) {
     readWrench(m, n.wrenches.emplace_back(), n.estimator.wrenches.emplace_back());
   });

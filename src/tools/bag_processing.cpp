@@ -208,6 +208,7 @@ class BagProcessor {
   void preloadStatic(const rosbag::Bag& in);
   void note(jle::Outcome outcome);
   void write();
+  void writeSmoothed();
   std::string noLoads() const;
   void summarize(double total_s) const;
   void printDrops() const;
@@ -222,6 +223,7 @@ class BagProcessor {
   std::vector<std::string> wrench_topics_, plate_topics_;  // settings order
   bool have_tf_ = false;                                   // the bag has /tf or /tf_static
   long written_ = 0;                                       // loads given to the sink
+  long smoothed_written_ = 0;                              // the smoothed stream's
   ReuseBuffer buffer_;
   sensor_msgs::JointState joint_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
@@ -265,8 +267,10 @@ void BagProcessor::run() {
     }
   }
   if (progress_shown) std::fputc('\n', stderr);
-  // A smoother's last joint states (differentiator/lag): their loads too, numbered on.
+  // A smoother's last joint states (differentiator/lag, the smoothed stream): their loads
+  // too, numbered on.
   while (pipeline_.flush()) write();
+  while (pipeline_.flushSmoothed()) writeSmoothed();
   if (written_ == 0) throw std::runtime_error(noLoads());
   sink_.commit();
   if (options_.summary) summarize(std::chrono::duration<double>(Clock::now() - start).count());
@@ -301,9 +305,15 @@ void BagProcessor::dispatch(const rosbag::MessageInstance& m) {
   }
   // A smoother's loads still to come when the bag looped back in time (Pipeline::takeDrained).
   while (pipeline_.takeDrained()) write();
+  if (pipeline_.smoothedPublished()) writeSmoothed();
+  while (pipeline_.takeDrainedSmoothed()) writeSmoothed();
 }
 
 void BagProcessor::write() { sink_.write(pipeline_.record(), written_++); }
+
+void BagProcessor::writeSmoothed() {
+  sink_.writeSmoothed(pipeline_.smoothedRecord(), smoothed_written_++);
+}
 
 // --zero-phase: the whole bag's inputs read and smoothed before the message path runs.
 void BagProcessor::smoothInputs(rosbag::View& view) {
@@ -424,6 +434,9 @@ void BagProcessor::summarize(double total_s) const {
                c.received(jle::InputKind::kPlate), c.count(jle::Outcome::kPublished),
                sink_.destination().c_str(), compute_s, compute_s > 0 ? samples / compute_s : 0.0,
                total_s, total_s > 0 ? samples / total_s : 0.0);
+  if (pipeline_.hasSmoothed())
+    std::fprintf(stderr, "process_bag: smoothed stream (lag %.3g s): %ld loads\n",
+                 pipeline_.settings().smoothed.differentiator.lag, smoothed_written_);
   printDrops();
 }
 
@@ -463,8 +476,10 @@ void processBag(const BagOptions& options, LoadsSink& sink) {
     d.order = 2;
     d.window = 3;
     d.delay = 1;
-    // Their velocities are the smoothed positions' rates: the positions say it all.
+    // Their velocities are the smoothed positions' rates: the positions say it all. And
+    // the offline smoothing is the smoothed stream.
     settings.estimator.measured_velocity = jle::MeasuredVelocity::kNever;
+    settings.smoothed.enabled = false;
   }
   const jle::Model<double> model =
       jle::modelFromUrdfFile(options.urdf, jle::modelOptions(settings));

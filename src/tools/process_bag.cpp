@@ -33,6 +33,7 @@ using jle::cli::optionValues;
 const char* const kUsage =
     R"(usage: process_bag --bag IN.bag --urdf ROBOT.urdf [--config CONFIG.yaml]
                    [--output OUT.bag | --csv OUT.csv [--kinematics]] [--sto OUT.sto]
+                   [--smoothed-csv OUT.csv]
                    [--topic-prefix /joint_load_estimator]
                    [--zero-phase HZ|auto [--cutoff-rule gcv|residual]]
 
@@ -50,7 +51,9 @@ bag is played to it, without the timing of a live system.
                        applied). Topic names that are not absolute are taken in the
                        root namespace. Default: every default, no wrench input.
   --output PATH        write joint_load_estimator/JointLoads messages on
-                       PREFIX/joint_loads, bag time = the estimate's stamp
+                       PREFIX/joint_loads, bag time = the estimate's stamp, and
+                       the smoothed stream's on PREFIX/smoothed/joint_loads (as the
+                       node publishes them; README "Two streams")
   --csv PATH           write the loads as CSV instead: t, then for every published
                        joint JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort (the columns of
                        joint_loads; wrenches in the child link frame, moment about the
@@ -63,7 +66,10 @@ bag is played to it, without the timing of a live system.
                        every joint, contact (0/1) and external@LINK.fx ... .mz per
                        contact link (the bag gets PREFIX/external_wrench/LINK and
                        PREFIX/contact, as the node publishes them)
-  --kinematics         the JOINT.q, .qd, .qdd columns in the CSV (docs/outputs.md)
+  --kinematics         the JOINT.q, .qd, .qdd columns in the CSVs (docs/outputs.md)
+  --smoothed-csv PATH  also write the smoothed stream's loads (smoothed/... in the
+                       config; on by default: the loads `lag` behind, smoothed) as
+                       CSV, the columns of --csv without the external ones
   --sto PATH           also (or only) write them as an OpenSim storage file: the
                        same numbers, tab-separated, under OpenSim's column names
                        (time, JOINT_moment or JOINT_force, and
@@ -98,7 +104,7 @@ culprit); 2 a usage error.
 )";
 
 struct Options {
-  std::string bag, urdf, config, output, csv, sto;
+  std::string bag, urdf, config, output, csv, sto, smoothed_csv;
   std::string prefix = "/joint_load_estimator";
   bool smooth = false;  // --zero-phase
   jle::ZeroPhaseConfig smoothing;
@@ -123,7 +129,7 @@ Options parseOptions(int argc, char** argv) {
   std::map<std::string, std::string> v =
       optionValues(argc, argv,
                    {"--bag", "--urdf", "--config", "--output", "--csv", "--sto", "--topic-prefix",
-                    "--zero-phase", "--cutoff-rule"},
+                    "--zero-phase", "--cutoff-rule", "--smoothed-csv"},
                    {"--kinematics"});
   Options o;
   if (!v.count("--bag")) throw UsageError("--bag IN.bag is required");
@@ -136,8 +142,10 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--output")) o.output = v["--output"];
   if (v.count("--csv")) o.csv = v["--csv"];
   if (v.count("--sto")) o.sto = v["--sto"];
+  if (v.count("--smoothed-csv")) o.smoothed_csv = v["--smoothed-csv"];
   o.kinematics = v.count("--kinematics") > 0;
-  if (o.kinematics && o.csv.empty()) throw UsageError("--kinematics is only used with --csv");
+  if (o.kinematics && o.csv.empty() && o.smoothed_csv.empty())
+    throw UsageError("--kinematics is only used with --csv or --smoothed-csv");
   if (v.count("--topic-prefix")) o.prefix = v["--topic-prefix"];
   if (o.prefix[0] != '/') o.prefix = "/" + o.prefix;
   while (o.prefix.size() > 1 && o.prefix.back() == '/') o.prefix.pop_back();
@@ -157,6 +165,7 @@ class Outputs : public jle::LoadsSink {
 
   void open(const jle::Pipeline& pipeline) override;
   void write(const jle::LoadsRecord& record, long seq) override;
+  void writeSmoothed(const jle::LoadsRecord& record, long seq) override;
   void commit() override;
   std::string destination() const override;
 
@@ -166,14 +175,19 @@ class Outputs : public jle::LoadsSink {
   std::vector<double> row_;
   std::size_t sto_columns_ = 0;  // the first numbers of row_: the .sto row
   std::unique_ptr<rosbag::Bag> bag_;
-  std::string bag_temporary_, topic_;
-  std::unique_ptr<jle::CsvWriter> csv_;
+  std::string bag_temporary_, topic_, smoothed_topic_;
+  std::unique_ptr<jle::CsvWriter> csv_, smoothed_csv_;
+  std::vector<double> smoothed_row_;
   std::unique_ptr<jle::StoWriter> sto_;
   // external_effort/enabled: the wrench topics per contact link and the contact events.
   std::vector<std::string> external_topics_;
   std::string contact_topic_;
   geometry_msgs::WrenchStamped wrench_;
   double* writeExternal(const jle::LoadsRecord& record, double* row);
+  // t, the 7 numbers per joint, the effort sigmas: the .sto row; `csv`: then the kinematics
+  // (--kinematics) and the motor efforts. Returns the end of what it wrote.
+  double* writeLoads(const jle::LoadsRecord& record, bool csv, double* row) const;
+  void openSmoothed(const jle::Pipeline& pipeline);
   void writeExternalMessages(const jle::LoadsRecord& record);
 };
 
@@ -199,6 +213,7 @@ void Outputs::open(const jle::Pipeline& pipeline) {
       throw std::runtime_error(options.output + ": " + e.what());
     }
     topic_ = options.prefix + "/joint_loads";
+    smoothed_topic_ = options.prefix + "/smoothed/joint_loads";
     if (!record.external_effort.empty()) {
       for (const jle::ContactEstimate& c : record.contacts)
         external_topics_.push_back(options.prefix + "/external_wrench/" + c.link);
@@ -221,6 +236,25 @@ void Outputs::open(const jle::Pipeline& pipeline) {
     sto_ = std::make_unique<jle::StoWriter>(options.sto);
     sto_->writeHeader(jle::stoColumnNames(pipeline.model(), names, jle::WrenchFrame::kChild));
   }
+  openSmoothed(pipeline);
+}
+
+void Outputs::openSmoothed(const jle::Pipeline& pipeline) {
+  if (options_.smoothed_csv.empty()) return;
+  if (!pipeline.hasSmoothed())
+    throw std::runtime_error(
+        "--smoothed-csv: the smoothed stream is off (smoothed/enabled: "
+        "false in the config, or --zero-phase)");
+  const jle::LoadsRecord& record = pipeline.smoothedRecord();
+  jle::LoadColumnLayout layout;
+  layout.effort_stddev = !record.effort_stddev.empty();
+  layout.kinematics = options_.kinematics;
+  layout.motor_effort = !record.motor_effort.empty();
+  smoothed_csv_ = std::make_unique<jle::CsvWriter>(options_.smoothed_csv);
+  smoothed_csv_->writeHeader(jle::jointLoadColumns(record.joint, layout));
+  smoothed_row_.resize(1 + 7 * record.joint.size() + record.effort_stddev.size() +
+                       (options_.kinematics ? 3 * record.joint.size() : 0) +
+                       record.motor_effort.size());
 }
 
 Outputs::~Outputs() {
@@ -228,9 +262,7 @@ Outputs::~Outputs() {
   if (!bag_temporary_.empty()) std::remove(bag_temporary_.c_str());
 }
 
-void Outputs::write(const jle::LoadsRecord& record, long seq) {
-  if (!bag_ && !csv_ && !sto_) return;
-  double* row = row_.data();
+double* Outputs::writeLoads(const jle::LoadsRecord& record, bool csv, double* row) const {
   *row++ = jle::toRosTime(record.stamp).toSec();
   for (std::size_t i = 0; i < record.joint.size(); ++i) {
     for (int c = 0; c < 3; ++c) *row++ = record.force[i][c];
@@ -238,16 +270,35 @@ void Outputs::write(const jle::LoadsRecord& record, long seq) {
     *row++ = record.effort[i];
   }
   for (double s : record.effort_stddev) *row++ = s;
-  if (csv_ && options_.kinematics)
+  if (!csv) return row;
+  if (options_.kinematics)
     for (std::size_t i = 0; i < record.joint.size(); ++i) {
       *row++ = record.position[i];
       *row++ = record.velocity[i];
       *row++ = record.acceleration[i];
     }
-  if (csv_) {
-    for (double e : record.motor_effort) *row++ = e;
-    row = writeExternal(record, row);
+  for (double e : record.motor_effort) *row++ = e;
+  return row;
+}
+
+void Outputs::writeSmoothed(const jle::LoadsRecord& record, long seq) {
+  if (smoothed_csv_) {
+    double* end = writeLoads(record, true, smoothed_row_.data());
+    assert(static_cast<std::size_t>(end - smoothed_row_.data()) == smoothed_row_.size());
+    (void)end;
+    smoothed_csv_->writeRow(smoothed_row_.data(), smoothed_row_.size());
   }
+  if (bag_) {
+    jle::toMessage(record, loads_);
+    loads_.header.seq = static_cast<std::uint32_t>(seq);
+    bag_->write(smoothed_topic_, loads_.header.stamp, loads_);
+  }
+}
+
+void Outputs::write(const jle::LoadsRecord& record, long seq) {
+  if (!bag_ && !csv_ && !sto_) return;
+  double* row = writeLoads(record, csv_ != nullptr, row_.data());
+  if (csv_) row = writeExternal(record, row);
   assert(static_cast<std::size_t>(row - row_.data()) == (csv_ ? row_.size() : sto_columns_));
   if (csv_) csv_->writeRow(row_.data(), row_.size());
   if (sto_) sto_->writeRow(row_.data(), sto_columns_);
@@ -295,6 +346,7 @@ void Outputs::commit() {
   }
   if (csv_) csv_->commit();
   if (sto_) sto_->commit();
+  if (smoothed_csv_) smoothed_csv_->commit();
 }
 
 std::string Outputs::destination() const {

@@ -898,7 +898,7 @@ TEST_F(CliTest, RvizConfigForTheUr5) {
   for (std::size_t k = 0; k < moving.size(); ++k) {
     EXPECT_EQ(wrenches[k]["Class"].as<std::string>(), "rviz/WrenchStamped");
     EXPECT_EQ(wrenches[k]["Topic"].as<std::string>(),
-              "/arm/joint_load_estimator/wrench/" + moving[k]);
+              "/arm/joint_load_estimator/smoothed/wrench/" + moving[k]);
     // 6 significant digits printed.
     EXPECT_NEAR(wrenches[k]["Torque Arrow Scale"].as<double>() * 2.0 * weight, 1.0, 1e-5);
   }

@@ -71,7 +71,8 @@ Errors run(jle::Pipeline& pipeline, const Stream& s, std::vector<jle::LoadsRecor
     }
     if (s.nan_joint >= 0 && k % s.nan_every == s.nan_phase) v[s.nan_joint] = std::nan("");
     const Stamp stamp = kStart + k * kMs;
-    const Outcome o = pipeline.onJointState(stamp, stamp, names, p, s.velocities ? v : kNone, kNone);
+    const Outcome o =
+        pipeline.onJointState(stamp, stamp, names, p, s.velocities ? v : kNone, kNone);
     EXPECT_TRUE(o == Outcome::kUsed || o == Outcome::kPublished) << k << " " << pipeline.problem();
     if (o != Outcome::kPublished) continue;
     ++e.published;
@@ -116,9 +117,10 @@ TEST(MeasuredVelocity, UsedByDefaultAndCloserToTheTruthThanThePositions) {
   EXPECT_LT(m.velocity, 0.5 * p.velocity) << m.velocity << " " << p.velocity;
   EXPECT_LT(m.acceleration, 0.5 * p.acceleration) << m.acceleration << " " << p.acceleration;
   EXPECT_LT(m.effort, 0.5 * p.effort) << m.effort << " " << p.effort;
-  std::printf("RMS error, velocities | positions: qd %.3g | %.3g rad/s, qdd %.3g | %.3g rad/s^2, "
-              "effort %.3g | %.3g N m\n",
-              m.velocity, p.velocity, m.acceleration, p.acceleration, m.effort, p.effort);
+  std::printf(
+      "RMS error, velocities | positions: qd %.3g | %.3g rad/s, qdd %.3g | %.3g rad/s^2, "
+      "effort %.3g | %.3g N m\n",
+      m.velocity, p.velocity, m.acceleration, p.acceleration, m.effort, p.effort);
 }
 
 TEST(MeasuredVelocity, PositionsOnlyStreamsAreUnchangedBySetting) {

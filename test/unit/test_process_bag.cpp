@@ -184,13 +184,23 @@ wrenches:
     timeout: 0.5
 )";
 
-// The estimator of kConfig, configured here by hand (not by the settings parser).
-jle::Estimator referenceEstimator(const jle::Model<double>& model) {
+// The estimator of kConfig, configured here by hand (not by the settings parser); with
+// `smoothed`, its smoothed stream's (the default: constant-jerk Kalman smoother, process
+// noise 1e2, measurement noise 1e-4, lag 0.2 s; README "Two streams").
+jle::Estimator referenceEstimator(const jle::Model<double>& model, bool smoothed) {
   jle::EstimatorConfig config;
-  config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
-  config.differentiator.window = 11;
-  config.differentiator.order = 3;
-  config.differentiator.delay = 5;
+  if (smoothed) {
+    config.differentiator.type = jle::DifferentiatorType::kKalman;
+    config.differentiator.kalman_model = jle::KalmanModel::kConstantJerk;
+    config.differentiator.process_noise = 1e2;
+    config.differentiator.measurement_noise = 1e-4;
+    config.differentiator.lag = 0.2;
+  } else {
+    config.differentiator.type = jle::DifferentiatorType::kSavitzkyGolay;
+    config.differentiator.window = 11;
+    config.differentiator.order = 3;
+    config.differentiator.delay = 5;
+  }
   config.gravity_world = Eigen::Vector3d(0.0, 0.0, -9.81);
   config.decimation = 2;
   jle::WrenchInputConfig input;
@@ -214,10 +224,27 @@ struct Expected {
   std::vector<std::vector<double>> measured;
 };
 
-// Drives the estimator directly with the messages, in time order.
-Expected expectedLoads(const Messages& m) {
+// The estimator's published loads into a row of `e`.
+void take(const jle::Estimator& estimator, const std::vector<int>& published,
+          const ros::Time& origin, const std::map<double, std::vector<double>>& efforts,
+          Expected& e) {
+  e.t.push_back((origin + ros::Duration(estimator.stamp())).toSec());
+  std::vector<double> row;
+  for (int s : published) {
+    const jle::Data<double>& d = estimator.data();
+    for (int c = 0; c < 3; ++c) row.push_back(d.force[static_cast<std::size_t>(s)][c]);
+    for (int c = 0; c < 3; ++c) row.push_back(d.moment[static_cast<std::size_t>(s)][c]);
+    row.push_back(d.effort[static_cast<std::size_t>(s)]);
+  }
+  e.values.push_back(row);
+  e.measured.push_back(efforts.at(estimator.stamp()));
+}
+
+// Drives the estimator directly with the messages, in time order (and to the end of the
+// stream: a smoother's last samples).
+Expected expectedLoads(const Messages& m, bool smoothed = false) {
   const jle::Model<double> model = jle::modelFromUrdfFile(kPanda);
-  jle::Estimator estimator = referenceEstimator(model);
+  jle::Estimator estimator = referenceEstimator(model, smoothed);
   const std::vector<int> published = {model.segmentOfJoint("panda_joint2"),
                                       model.segmentOfJoint("panda_joint4"),
                                       model.segmentOfJoint("panda_joint7")};
@@ -246,17 +273,11 @@ Expected expectedLoads(const Messages& m) {
       for (std::size_t i = 0; i < j.second.name.size(); ++i)
         if (j.second.name[i] == name) effort.push_back(j.second.effort[i]);
     if (estimator.addJointSample(rel(j.first), q.data()) != jle::SampleStatus::kPublished) continue;
-    e.t.push_back((origin + ros::Duration(estimator.stamp())).toSec());
-    std::vector<double> row;
-    for (int s : published) {
-      const jle::Data<double>& d = estimator.data();
-      for (int c = 0; c < 3; ++c) row.push_back(d.force[static_cast<std::size_t>(s)][c]);
-      for (int c = 0; c < 3; ++c) row.push_back(d.moment[static_cast<std::size_t>(s)][c]);
-      row.push_back(d.effort[static_cast<std::size_t>(s)]);
-    }
-    e.values.push_back(row);
-    e.measured.push_back(efforts.at(estimator.stamp()));
+    take(estimator, published, origin, efforts, e);
   }
+  jle::SampleStatus status;
+  while (estimator.flush(status))
+    if (status == jle::SampleStatus::kPublished) take(estimator, published, origin, efforts, e);
   return e;
 }
 
@@ -315,6 +336,31 @@ TEST_F(ProcessBagTest, CsvEqualsTheEstimatorDrivenWithTheSameMessages) {
   }
 }
 
+// The smoothed stream (on by default) against its estimator driven by hand: the same
+// samples, the smoother's loads 0.2 s behind, every sample once (the last ones at the end).
+TEST_F(ProcessBagTest, SmoothedCsvEqualsTheSmootherDrivenWithTheSameMessages) {
+  const Messages m = makeMessages();
+  writeBag(path("in.bag"), m);
+  writeFile(path("config.yaml"), kConfig);
+  const Result r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("in.bag")) +
+                       " --urdf " + quote(kPanda) + " --config " + quote(path("config.yaml")) +
+                       " --smoothed-csv " + quote(path("smoothed.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("smoothed stream (lag 0.2 s)"), std::string::npos) << r.output;
+  const Expected e = expectedLoads(m, true);
+  const Table csv = readCsv(path("smoothed.csv"));
+  ASSERT_EQ(csv.header.size(), 22u);
+  // Every second of the 300 samples (decimation 2): all of them reach the smoothed
+  // stream, the end of the bag included.
+  ASSERT_EQ(e.t.size(), 150u);
+  ASSERT_EQ(csv.rows.size(), e.t.size());
+  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
+    expectClose(csv.rows[i][0], e.t[i], "t, row " + std::to_string(i));
+    for (std::size_t c = 1; c < csv.header.size(); ++c)
+      expectClose(csv.rows[i][c], e.values[i][c - 1], csv.header[c] + ", row " + std::to_string(i));
+  }
+}
+
 TEST_F(ProcessBagTest, BagOutputHoldsTheLoadsAndTheMeasuredEfforts) {
   const Messages m = makeMessages();
   writeBag(path("in.bag"), m);
@@ -326,7 +372,11 @@ TEST_F(ProcessBagTest, BagOutputHoldsTheLoadsAndTheMeasuredEfforts) {
   const Expected e = expectedLoads(m);
 
   rosbag::Bag bag(path("out.bag"), rosbag::bagmode::Read);
-  rosbag::View view(bag);
+  rosbag::View view(bag, rosbag::TopicQuery("/estimate/joint_loads"));
+  // And the smoothed stream's, every sample once (checked against its estimator below).
+  rosbag::View smoothed(bag, rosbag::TopicQuery("/estimate/smoothed/joint_loads"));
+  EXPECT_EQ(smoothed.size(), expectedLoads(m, true).t.size());
+  EXPECT_EQ(view.size() + smoothed.size(), rosbag::View(bag).size());
   std::size_t i = 0;
   for (const rosbag::MessageInstance& instance : view) {
     EXPECT_EQ(instance.getTopic(), "/estimate/joint_loads");

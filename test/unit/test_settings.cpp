@@ -200,6 +200,8 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(inline_callbacks);
   EXPECT_SAME(body_mass);
   expectSame(a.estimator, b.estimator);
+  EXPECT_SAME(smoothed.enabled);
+  expectSame(a.smoothed.differentiator, b.smoothed.differentiator, "smoothed/differentiator/");
   expectSame(a.external_effort, b.external_effort);
   expectSameList(a.wrenches, b.wrenches, "wrenches");
   expectSameList(a.force_plates, b.force_plates, "force_plates");
@@ -225,6 +227,7 @@ const Refused kRefused[] = {
     {"ko_savings.yaml", "'savings/static_velocity'", "must be finite and >= 0"},
     {"ko_stamps.yaml", "'stamps/jump_confirm'", "must be >= 1"},
     {"ko_external_effort.yaml", "'external_effort/release_fraction'", "must be in (0, 1]"},
+    {"ko_smoothed.yaml", "'smoothed/differentiator/lag'", "must be > 0 [s]"},
 };
 
 TEST(SettingsReader, EachKoFileIsRefusedWithItsReason) {
@@ -259,6 +262,16 @@ TEST(SettingsReader, TopLevelKeys) {
   e.inline_callbacks = true;
   e.body_mass = -1.0;
   expectSame(parseFile(kConfig + "/ok_top_level.yaml"), e);
+}
+
+TEST(SettingsReader, SmoothedKeys) {
+  Settings e;
+  e.smoothed.enabled = false;
+  e.smoothed.differentiator.type = jle::DifferentiatorType::kAdaptive;
+  e.smoothed.differentiator.lag = 0.15;
+  e.smoothed.differentiator.min_bandwidth = 1.0;
+  e.smoothed.differentiator.max_bandwidth = 20.0;
+  expectSame(parseFile(kConfig + "/ok_smoothed.yaml"), e);
 }
 
 TEST(SettingsReader, DifferentiatorKeys) {
@@ -453,8 +466,8 @@ TEST(SettingsDocs, DefaultYamlIsSettingsDefaults) {
 // config/default.yaml: top-level keys at the top, a map's keys in that map.
 TEST(SettingsDocs, DefaultYamlListsEveryKey) {
   XmlRpc::XmlRpcValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
-  for (const char* family :
-       {"top_level", "differentiator", "savings", "uncertainty", "stamps", "external_effort"}) {
+  for (const char* family : {"top_level", "differentiator", "savings", "uncertainty", "stamps",
+                             "external_effort", "smoothed"}) {
     XmlRpc::XmlRpcValue ok = jle::loadYaml(kConfig + "/ok_" + family + ".yaml");
     for (auto& kv : ok) {
       ASSERT_TRUE(defaults.hasMember(kv.first)) << kv.first << " is not in config/default.yaml";
@@ -472,15 +485,18 @@ TEST(SettingsDocs, DefaultYamlListsEveryKey) {
 TEST(SettingsDocs, ReadmeTableStatesTheDefaults) {
   std::ifstream readme(JLE_README);
   ASSERT_TRUE(readme.good());
-  const std::regex row(R"(^\| `([a-z_]+)(/([a-z_]+))?` \| `([^`]*)`)");
+  const std::regex row(R"(^\| `([a-z_]+)(/([a-z_]+))?(/([a-z_]+))?` \| `([^`]*)`)");
   std::string line, rows;
   int checked = 0;
   while (std::getline(readme, line)) {
     std::smatch m;
     if (!std::regex_search(line, m, row)) continue;
     rows += "`" + m[1].str() + (m[2].matched ? m[2].str() : "") + "`\n";
-    const std::string yaml = m[2].matched ? m[1].str() + ":\n  " + m[3].str() + ": " + m[4].str()
-                                          : m[1].str() + ": " + m[4].str();
+    const std::string value = m[6].str();
+    const std::string yaml =
+        m[4].matched   ? m[1].str() + ":\n  " + m[3].str() + ":\n    " + m[5].str() + ": " + value
+        : m[2].matched ? m[1].str() + ":\n  " + m[3].str() + ": " + value
+                       : m[1].str() + ": " + value;
     SCOPED_TRACE("README row " + line.substr(0, 60));
     expectSame(parseText(yaml + "\n"), Settings{});
     ++checked;

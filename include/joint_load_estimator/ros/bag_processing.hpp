@@ -35,6 +35,8 @@ class LoadsSink {
   virtual void open(const Pipeline& pipeline) = 0;
   /// Every published sample, `seq` counting from 0.
   virtual void write(const LoadsRecord& record, long seq) = 0;
+  /// Every sample of the smoothed stream (Pipeline::smoothedRecord), `seq` counting from 0.
+  virtual void writeSmoothed(const LoadsRecord& /*record*/, long /*seq*/) {}
   /// After the last message, when there were loads.
   virtual void commit() {}
   /// For the summary: " to PATH", or " (not written)".

@@ -89,7 +89,10 @@ class EstimatorNode {
   // Logs what the pipeline said of the last message, each problem throttled on its own.
   void report(Outcome outcome);
   void publish(const ros::Time& received);
+  // The immediate stream's loads a reset or a retune drained, then the smoothed stream's.
   void publishDrained(const ros::Time& received);
+  // The smoothed stream's record on ~smoothed/... (settings.smoothed).
+  void publishSmoothed();
   // A ~joint_loads message to fill: one of the pool that no subscriber holds any more,
   // else a new one (published as a shared pointer, so that a subscriber in the same
   // process gets the message itself, not a serialised copy).
@@ -141,6 +144,14 @@ class EstimatorNode {
   sensor_msgs::JointState efforts_msg_;  // the JointLoads' names, q, q-dot, efforts
   geometry_msgs::WrenchStamped wrench_msg_;
   geometry_msgs::PointStamped cop_msg_;
+  // The smoothed stream: ~smoothed/joint_loads, ~smoothed/joint_efforts,
+  // ~smoothed/wrench/<joint> (advertised only with smoothed/enabled).
+  struct SmoothedTopics {
+    ros::Publisher loads_pub, efforts_pub;
+    std::vector<ros::Publisher> wrench_pubs;
+    joint_load_estimator::JointLoads loads_msg;
+    sensor_msgs::JointState efforts_msg;
+  } smoothed_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
   InputHealth joint_health_;
