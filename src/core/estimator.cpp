@@ -234,6 +234,12 @@ bool Estimator::flush(SampleStatus& status) {
   return true;
 }
 
+bool Estimator::takeDue(SampleStatus& status) {
+  if (!bank_.next()) return false;
+  status = publish();
+  return true;
+}
+
 // The loads of the bank's estimate (a sample taken now, or earlier for a delayed one).
 inline SampleStatus Estimator::publish() {
   if (sample_count_++ % config_.decimation != 0) return SampleStatus::kDecimated;

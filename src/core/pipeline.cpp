@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace jle {
 namespace {
@@ -486,7 +487,7 @@ void Pipeline::drainSmoother() {
 }
 
 bool Pipeline::takeDrained() {
-  if (drained_next_ == drained_.size()) return false;
+  if (drained_next_ == drained_.size()) return nextRecord(false);
   std::swap(record_, drained_[drained_next_++]);
   if (drained_next_ == drained_.size()) {
     drained_.clear();
@@ -495,9 +496,11 @@ bool Pipeline::takeDrained() {
   return true;
 }
 
-bool Pipeline::flush() {
+bool Pipeline::flush() { return nextRecord(true); }
+
+bool Pipeline::nextRecord(bool end) {
   SampleStatus status = SampleStatus::kPublished;
-  while (estimator_.flush(status)) {
+  while (end ? estimator_.flush(status) : estimator_.takeDue(status)) {
     if (status != SampleStatus::kPublished) continue;
     if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
     fillRecord();
@@ -535,10 +538,11 @@ Outcome Pipeline::staleProblem() {
 }
 
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
-  // A smoother's delay is known from its second sample; over a gap its carried estimates
-  // add to it: the ring holds twice the delay (grown here, rarely: a new rate).
-  const std::size_t needed = 2 * static_cast<std::size_t>(estimator_.delaySamples()) + 2;
-  if (needed > ring_.size()) growRing(needed);
+  // The estimates still to come are of the newest sample and the delaySamples() before
+  // it (a smoother's pending samples, its carry over a gap included): grown to twice
+  // that when they do not fit (rarely after the warm-up: a faster rate, a gap).
+  const std::size_t needed = static_cast<std::size_t>(estimator_.delaySamples()) + 1;
+  if (needed > ring_.size()) growRing(2 * needed);
   Sample& s = ring_[ring_head_];
   s.t = t;
   s.stamp = stamp;
@@ -549,9 +553,11 @@ void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
 }
 
 void Pipeline::growRing(std::size_t size) {
+  // Every slot's effort at its size now: none allocated when first used.
   std::vector<Sample> grown(size);
+  for (Sample& slot : grown) slot.effort.assign(ring_.front().effort.size(), kNaN);
   for (std::size_t i = 0; i < ring_count_; ++i)  // oldest first
-    grown[i] = ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()];
+    grown[i] = std::move(ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()]);
   ring_head_ = ring_count_;
   ring_.swap(grown);
 }
