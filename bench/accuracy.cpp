@@ -825,6 +825,14 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
   Eigen::Index published = 0;
   // Recording the outputs is inside the timed loop: a copy of 7 numbers per joint, small
   // against the estimator's work, and the same for every configuration.
+  // The loads in record() and estimator(), the newest sample's stamp then.
+  const auto take = [&](double newest) {
+    out.index.push_back(readingOf(scene, pipeline.record().stamp));
+    out.newest.push_back(newest);
+    recordLoads(pipeline.estimator().data(), segments, out);
+    out.qdd.col(published++) = pipeline.estimator().qdd();
+    if (pipeline.estimator().lastWasPlanar()) ++out.planar_published;
+  };
   const double cpu_start = threadCpuSeconds();
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < n; ++k) {
@@ -837,22 +845,13 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
     }
     for (int c = 0; c < model.nq; ++c) position[static_cast<std::size_t>(c)] = j.q[c];
     if (pipeline.onJointState(scene.stamp_ns[k], scene.stamp_ns[k], model.coordinate_names,
-                              position, none, none) != jle::Outcome::kPublished)
-      continue;
-    out.index.push_back(readingOf(scene, pipeline.record().stamp));
-    out.newest.push_back(j.stamp);
-    recordLoads(pipeline.estimator().data(), segments, out);
-    out.qdd.col(published++) = pipeline.estimator().qdd();
-    if (pipeline.estimator().lastWasPlanar()) ++out.planar_published;
+                              position, none, none) == jle::Outcome::kPublished)
+      take(j.stamp);
+    // A smoother's other loads due at this sample (after a longer interval or a gap).
+    while (pipeline.takeDrained()) take(j.stamp);
   }
   // The end of the stream: a smoother's last samples (Pipeline::flush).
-  while (n > 0 && pipeline.flush()) {
-    out.index.push_back(readingOf(scene, pipeline.record().stamp));
-    out.newest.push_back(r.joints.back().stamp);
-    recordLoads(pipeline.estimator().data(), segments, out);
-    out.qdd.col(published++) = pipeline.estimator().qdd();
-    if (pipeline.estimator().lastWasPlanar()) ++out.planar_published;
-  }
+  while (n > 0 && pipeline.flush()) take(r.joints.back().stamp);
   const auto stop = std::chrono::steady_clock::now();
   const double cpu_stop = threadCpuSeconds();
   if (pipeline.counters().count(jle::InputKind::kWrench, jle::Outcome::kUsed) !=

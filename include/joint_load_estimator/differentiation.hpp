@@ -13,9 +13,11 @@
 #include <Eigen/Core>
 #include <Eigen/Householder>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace jle {
@@ -52,12 +54,17 @@ struct DifferentiatorConfig {
   KalmanModel kalman_model = KalmanModel::kConstantJerk;
   double process_noise = 1e4;
   double measurement_noise = 1e-4;
-  /// Kalman: delay [s] of the smoothed estimate behind the newest sample (0: the causal
-  /// filter). With lag > 0 the filter runs forward as with 0, and every B samples a
-  /// Rauch-Tung-Striebel backward pass over its remembered states smooths the next B
-  /// estimates with the data that followed them: the estimate describes the sample
-  /// D = round(lag / h) before the newest (h: the first interval after a start), from
-  /// D - B + 1 .. D samples after it (B = D / 2; about two backward steps per sample).
+  /// Kalman: delay [s] of the smoothed estimate behind the newest sample's stamp (0: the
+  /// causal filter). With lag > 0 the filter runs forward as with 0 and remembers its
+  /// states; the estimate of a sample is made once the newest stamp is `lag` after its
+  /// own, within h (the mean interval of the samples not yet estimated): the sample
+  /// nearest to newest - lag, kept from sample to sample while within h of it, so that at
+  /// a steady rate each sample makes one estimate (at jittered stamps: within h plus the
+  /// intervals' spread; where the rate drops, the samples made overdue are due at once:
+  /// DifferentiatorBank::next()). A Rauch-Tung-Striebel backward pass from the newest
+  /// sample smooths the next B estimates with the data that followed them, B half the
+  /// samples pending (about two backward steps per sample). At least n samples (3 or 4,
+  /// the model's state) follow an estimated sample: a lag shorter than n intervals is n.
   /// Adaptive: the same smoother, its process noise the selected filter's at each sample.
   double lag = 0.0;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
@@ -171,25 +178,32 @@ class DifferentiatorBank {
 
   const DifferentiatorConfig& config() const { return config_; }
   int channels() const { return channels_; }
-  /// Samples needed after a reset before the first estimate (a smoother: known once its
-  /// delay is, after the second sample; before, that of the causal filter).
+  /// Samples needed after a reset before the first estimate (a smoother: lag over the
+  /// mean interval of the samples it holds, plus one, at least n + 1; before its second
+  /// sample that of the causal filter).
   int warmup() const {
     if (delegating()) return smoother_.front().warmup();
-    if (smoothing()) return std::max(n_, delay_ + 1);
+    if (smoothing() && spacing_ > 0.0)
+      return std::max(n_ + 1, static_cast<int>(std::lround(config_.lag / spacing_)) + 1);
     return isKalman() ? n_ : config_.window;
   }
-  /// Samples the estimate describes behind the newest: Savitzky-Golay's `delay`, a
-  /// smoother's D (0 before its second sample), 0 for the causal filters.
+  /// Samples the estimate describes behind the newest: Savitzky-Golay's `delay`, 0 for
+  /// the causal filters; a smoother's pending(): the samples after its last estimate
+  /// (lag over the interval at a steady rate), and an upper bound of the delay of any
+  /// estimate still to come (before the first estimate: the samples taken).
   int delaySamples() const {
     if (delegating()) return smoother_.front().delaySamples();
-    return smoothing() ? delay_ : config_.delay;
+    return smoothing() ? pending() : config_.delay;
   }
-  /// Smoother: samples taken and not yet estimated. finish() smooths them with the data
-  /// there is, after which each call of next() (true while one is left) makes the
-  /// oldest of them the estimate (stamp(), value(), ...): the end of a stream. update()
-  /// after finish() is a fresh start. A gap (max_gap) smooths the samples before it
-  /// alike, and they are the estimates of the first samples after it, in their order
-  /// (the restarted smoother has none yet): every sample is estimated once.
+  /// Smoother: samples taken and not yet estimated. After update() returned true, next()
+  /// makes the next one due at the same newest sample the estimate (true; false when
+  /// none is): several are due at once where the rate drops or after a gap; one not
+  /// taken is the estimate of a later update(), in order. finish() smooths them all with
+  /// the data there is, after which each call of next() (true while one is left) makes
+  /// the oldest of them the estimate (stamp(), value(), ...): the end of a stream.
+  /// update() after finish() is a fresh start. A gap (max_gap) smooths the samples
+  /// before it alike; they are estimated first, each when due by its stamp, then those
+  /// after it: every sample is estimated once, in order.
   int pending() const {
     if (delegating()) return smoother_.front().pending();
     const int own = smoothing() && count_ > 0 ? index_ + 1 - emitted_ : 0;
@@ -199,11 +213,12 @@ class DifferentiatorBank {
     if (delegating()) smoother_.front().finish();
     if (finishing_ || !smoothing()) return;
     if (count_ > 0 && emitted_ <= index_) smoothBack(index_, emitted_, index_);
+    smoothed_through_ = index_;
     finishing_ = true;
   }
   bool next() {
     if (delegating()) return takeSmoothed(smoother_.front().next());
-    if (!finishing_) return false;
+    if (!finishing_) return smoothing() && taken_ > 0 && emitDue();
     if (emitCarry()) return true;
     if (count_ == 0 || emitted_ > index_) return false;
     emitSmoothed();
@@ -212,6 +227,7 @@ class DifferentiatorBank {
 
   void reset() {
     carry_count_ = carry_next_ = 0;
+    spacing_ = 0.0;
     for (DifferentiatorBank& s : smoother_) s.reset();
     resetFilter();
   }
@@ -222,7 +238,9 @@ class DifferentiatorBank {
     index_ = -1;
     emitted_ = 0;
     finishing_ = false;
-    delay_ = 0;
+    smoothed_through_ = -1;
+    taken_ = 0;
+    running_ = catching_up_ = false;
     pass_newest_ = emitted_steps_ = 0;
     emitted_carried_ = false;
     smoothed_gains_valid_ = false;
@@ -244,6 +262,7 @@ class DifferentiatorBank {
         carry_.col(k) = carry_.col(carry_next_ + k);
         carry_gains_.col(k) = carry_gains_.col(carry_next_ + k);
         carry_times_[k] = carry_times_[carry_next_ + k];
+        carry_newest_[k] = carry_newest_[carry_next_ + k];
       }
       carry_count_ = left;
       carry_next_ = 0;
@@ -252,12 +271,14 @@ class DifferentiatorBank {
         carry_.conservativeResize(3 * channels_, total);
         carry_gains_.conservativeResize(9, total);
         carry_times_.conservativeResize(total);
+        carry_newest_.conservativeResize(total);
       }
       while (count_ > 0 && emitted_ <= index_) {
         emitSmoothed();
         carry_.col(carry_count_) = Eigen::Map<const Eigen::VectorXd>(out_.data(), 3 * channels_);
         const Eigen::Matrix3d gain = smoothedNoiseGain();
         carry_gains_.col(carry_count_) = Eigen::Map<const Eigen::VectorXd>(gain.data(), 9);
+        carry_newest_[carry_count_] = newest_used_;
         carry_times_[carry_count_++] = stamp_;
       }
     }
@@ -270,6 +291,7 @@ class DifferentiatorBank {
     out_ = Eigen::Map<const Eigen::MatrixXd>(carry_.col(carry_next_).data(), 3, channels_);
     carried_gain_ = Eigen::Map<const Eigen::Matrix3d>(carry_gains_.col(carry_next_).data());
     emitted_carried_ = true;
+    newest_used_ = carry_newest_[carry_next_];
     stamp_ = carry_times_[carry_next_++];
     if (carry_next_ == carry_count_) carry_count_ = carry_next_ = 0;
     return true;
@@ -306,6 +328,7 @@ class DifferentiatorBank {
       if (dt > config_.max_gap) restart();
     }
     last_time_ = t;
+    newest_used_ = t;
     if (config_.type == DifferentiatorType::kKalman) return updateKalman(t, x);
     if (config_.type == DifferentiatorType::kAdaptive) return updateAdaptive(t, x);
     // Ring buffer of the last `window` samples.
@@ -339,6 +362,9 @@ class DifferentiatorBank {
   }
 
   double stamp() const { return stamp_; }
+  /// The stamp [s] of the newest sample the estimate used: the newest sample itself, but
+  /// for a smoother the one its backward pass started from.
+  double newestUsed() const { return newest_used_; }
   double value(int c) const { return out_(0, c); }
   double rate(int c) const { return out_(1, c); }
   double accel(int c) const { return out_(2, c); }
@@ -401,6 +427,7 @@ class DifferentiatorBank {
     const DifferentiatorBank& s = smoother_.front();
     out_ = s.out_;
     stamp_ = s.stamp_;
+    newest_used_ = s.newest_used_;
     return true;
   }
 
@@ -422,7 +449,8 @@ class DifferentiatorBank {
       const SmallMatrix I = SmallMatrix::Identity(n, n);
       const SmallMatrix base = I - G * F_;
       SmallMatrix P = I, r = SmallMatrix::Zero(n, n);
-      smoothed_gains_.resize(std::max<std::size_t>(m, static_cast<std::size_t>(delay_)) + 1);
+      // Every step count the ring can hold (its capacity reserved: no allocation).
+      smoothed_gains_.resize(std::max<std::size_t>(m + 1, static_cast<std::size_t>(ring_size_)));
       for (std::size_t k = 0; k < smoothed_gains_.size(); ++k) {
         if (k > 0) {
           const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxOrder + 1, 1> PK = P * K_;
@@ -617,9 +645,11 @@ class DifferentiatorBank {
 
   bool updateKalman(double t, const double* x) {
     const int n = n_;
+    running_ = taken_ > 0;  // smoother: whether the last sample made an estimate
+    taken_ = 0;
     if (count_ == 0) {
       startKalman(t, x);
-      return smoothing() && emitCarry();
+      return smoothing() && emitDue();
     }
     const double dt = t - prev_t_;
     prev_t_ = t;
@@ -637,6 +667,9 @@ class DifferentiatorBank {
     double* predicted = nullptr;
     if (smoothing()) {
       if (index_ == 0) startSmoother(dt);
+      // The samples from the oldest not yet estimated to this one (rarely: a faster rate
+      // than the first interval's, a gap's carry, or a drop's backlog).
+      if (index_ + 2 - emitted_ > ring_size_) growRing(2 * (index_ + 2 - emitted_));
       predicted = rememberGain();
     }
     if (n == 3)
@@ -645,21 +678,40 @@ class DifferentiatorBank {
       kalmanChannels<4>(x, predicted);
     stamp_ = t;
     if (count_ < n) ++count_;
-    if (smoothing()) return smoothStep(t);
+    if (smoothing()) return smoothStep(t, dt);
     return count_ >= n;
   }
 
-  // Smoother: its delay from the first interval dt [s], and the ring of the forward
-  // filter's states, predictions and backward gains over the D + 1 newest samples
-  // (allocated only when a restart needs more than the last start did).
+  // Smoother: the ring of the forward filter's states, predictions and backward gains,
+  // sized for twice the lag at the first interval dt [s] (a first interval up to twice
+  // the rate's needs no growth), allocated only when a restart needs more than the last
+  // start did.
   void startSmoother(double dt) {
-    // At least n samples after the oldest estimated: the state is observable.
-    // And no fewer than the estimates carried over a gap, the first ones it makes.
-    delay_ = std::max(n_, static_cast<int>(std::lround(config_.lag / dt)));
-    delay_ = std::max(delay_, carry_count_);
-    block_ = delay_ / 2;
-    ring_size_ = delay_ + 1;
-    if (filtered_.cols() < ring_size_) allocateRing(ring_size_);
+    constexpr double kMostExpected = 1 << 20;  // [samples] beyond: grown as they come
+    const double expected = std::min(config_.lag / dt, kMostExpected);
+    const int size = 2 * std::max(n_ + 1, static_cast<int>(std::lround(expected)) + 1);
+    if (filtered_.cols() < size) allocateRing(size);
+    ring_size_ = static_cast<int>(filtered_.cols());
+  }
+
+  // The ring at `size` columns (one allocation): the samples from the oldest not yet
+  // estimated to the newest moved to their slots at the new length.
+  void growRing(int size) {
+    const auto grow = [&](auto& m, Eigen::Index rows) {
+      std::decay_t<decltype(m)> grown(rows, size);
+      for (int j = emitted_; j <= index_; ++j) grown.col(j % size) = m.col(j % ring_size_);
+      m.swap(grown);
+    };
+    grow(filtered_, filtered_.rows());
+    grow(predicted_, predicted_.rows());
+    grow(smoothed_, smoothed_.rows());
+    grow(gains_, gains_.rows());
+    Eigen::VectorXd times(size);
+    for (int j = emitted_; j <= index_; ++j) times[j % size] = ring_times_[j % ring_size_];
+    ring_times_.swap(times);
+    smoothed_gains_.reserve(static_cast<std::size_t>(size));
+    smoothed_gains_valid_ = false;
+    ring_size_ = size;
   }
 
   // The ring's columns; the first sample's (slot 0) is kept.
@@ -670,11 +722,13 @@ class DifferentiatorBank {
     smoothed_.conservativeResize(3 * channels_, size);
     gains_.conservativeResize(n_ * n_, size);
     ring_times_.conservativeResize(size);
+    smoothed_gains_.reserve(static_cast<std::size_t>(size));
     back_.resize(states);
     if (carry_.cols() < size) {
       carry_.conservativeResize(3 * channels_, size);
       carry_gains_.conservativeResize(9, size);
       carry_times_.conservativeResize(size);
+      carry_newest_.conservativeResize(size);
     }
   }
 
@@ -688,20 +742,62 @@ class DifferentiatorBank {
     return predicted_.col(slot).data();
   }
 
-  // After the forward step of sample index_ + 1 (time t): its state into the ring; every
-  // B samples once D are there the backward pass, then the estimate of the sample D
-  // before the newest.
-  bool smoothStep(double t) {
+  // After the forward step of sample index_ + 1 (time t, dt after the last): its state
+  // into the ring, the pending samples' mean interval, and the estimate if one is due.
+  bool smoothStep(double t, double dt) {
     ++index_;  // the sample whose forward step was just taken
     const int slot = index_ % ring_size_;
     filtered_.col(slot) =
         Eigen::Map<const Eigen::VectorXd>(state_.data(), static_cast<Eigen::Index>(n_) * channels_);
     ring_times_[slot] = t;
-    if (index_ < delay_) return emitCarry();
-    if ((index_ - delay_) % block_ == 0)
-      smoothBack(index_, index_ - delay_, index_ - delay_ + block_ - 1);
-    emitSmoothed();
+    spacing_ =
+        index_ > emitted_ ? (t - ring_times_[emitted_ % ring_size_]) / (index_ - emitted_) : dt;
+    return emitDue();
+  }
+
+  // The next estimate (the oldest carried over a gap, else the oldest of its own, which
+  // needs n samples after it) if due at the newest sample, stamp t_N. With t_j its
+  // stamp and h its interval to the next pending sample: due if t_N - t_j >= lag - h
+  // after a sample that made an estimate, >= lag - h / 2 (the nearest sample) after one
+  // that made none or at a start: the hysteresis keeps one estimate per sample at a
+  // steady rate. After an estimate already taken at this sample, only if that first one
+  // was overdue (t_N - t_j > lag + h: a drop of the rate, a gap), and then every sample
+  // up to the nearest.
+  bool emitDue() {
+    if (taken_ > 0 && !catching_up_) return false;
+    const bool carried = carry_next_ < carry_count_;
+    if (!carried && !(count_ > 0 && index_ - emitted_ >= n_)) return false;
+    const double t = carried ? carry_times_[carry_next_] : ring_times_[emitted_ % ring_size_];
+    const double delay = last_time_ - t, lag = config_.lag, h = pendingInterval(carried);
+    if (delay < lag - (taken_ == 0 && running_ ? h : 0.5 * h)) return false;
+    if (carried)
+      emitCarry();
+    else
+      emitOwn();
+    if (taken_++ == 0) catching_up_ = delay > lag + h;
     return true;
+  }
+
+  // The interval [s] from the next sample to estimate to the one after it (the mean of
+  // the pending samples' when it is the last pending one).
+  double pendingInterval(bool carried) const {
+    if (carried && carry_next_ + 1 < carry_count_)
+      return carry_times_[carry_next_ + 1] - carry_times_[carry_next_];
+    if (!carried && emitted_ < index_)
+      return ring_times_[(emitted_ + 1) % ring_size_] - ring_times_[emitted_ % ring_size_];
+    return spacing_;
+  }
+
+  // The oldest of its own samples not yet estimated as the estimate, after a backward
+  // pass from the newest over it and the next ones, half the pending samples, if the
+  // last pass did not reach it.
+  void emitOwn() {
+    if (emitted_ > smoothed_through_) {
+      const int block = std::max(1, (index_ - emitted_) / 2);
+      smoothed_through_ = std::min(index_, emitted_ + block - 1);
+      smoothBack(index_, emitted_, smoothed_through_);
+    }
+    emitSmoothed();
   }
 
   // Rauch-Tung-Striebel from sample `newest` (the filtered state) back to `oldest`:
@@ -717,6 +813,7 @@ class DifferentiatorBank {
   template <int N>
   void smoothChannels(int newest, int oldest, int last) {
     pass_newest_ = newest;
+    pass_newest_time_ = ring_times_[newest % ring_size_];
     double* back = back_.data();
     const double* start = filtered_.col(newest % ring_size_).data();
     for (int i = 0; i < N * channels_; ++i) back[i] = start[i];
@@ -751,6 +848,7 @@ class DifferentiatorBank {
     const int slot = emitted_ % ring_size_;
     out_ = Eigen::Map<const Eigen::MatrixXd>(smoothed_.col(slot).data(), 3, channels_);
     stamp_ = ring_times_[slot];
+    newest_used_ = pass_newest_time_;
     ++emitted_;
   }
 
@@ -878,13 +976,19 @@ class DifferentiatorBank {
   int count_ = 0;
   int head_ = 0;
   // Smoother: index of the newest sample since the start (-1: none), of the next to
-  // estimate, whether finish() was called; D, B and the ring's length (D + 1).
+  // estimate, of the last whose smoothed estimate is in the ring, whether finish() was
+  // called, the ring's length (its capacity); estimates taken at the newest sample,
+  // whether the sample before made one, whether the first taken was overdue, and the
+  // pending samples' mean interval [s].
   int index_ = -1;
   int emitted_ = 0;
+  int smoothed_through_ = -1;
   bool finishing_ = false;
-  int delay_ = 0;
-  int block_ = 1;
   int ring_size_ = 1;
+  int taken_ = 0;
+  bool running_ = false;
+  bool catching_up_ = false;
+  double spacing_ = 0.0;
   SmallMatrix backward_gain_;
   // Per remembered sample (column: slot index % ring_size_): the filtered state
   // (n x channels, channel-major), the prediction before its measurement, the backward
@@ -894,12 +998,13 @@ class DifferentiatorBank {
   Eigen::VectorXd ring_times_, back_;
   // Smoother: estimates made at a gap from the samples before it, (value, rate, accel)
   // x channels per column, their times [s], how many, and the next to publish.
-  Eigen::MatrixXd carry_, carry_gains_;  // carry_gains_: their noise gains (3x3 per column)
-  Eigen::VectorXd carry_times_;
+  Eigen::MatrixXd carry_, carry_gains_;         // carry_gains_: their noise gains (3x3 per column)
+  Eigen::VectorXd carry_times_, carry_newest_;  // carry_newest_: their newestUsed()
   // Smoother's noise gain: the newest sample of the last backward pass, the steps from
   // it to the estimate emitted last or whether that one was carried (and its gain), and
   // the gains by steps at a steady rate (smoothedNoiseGain()).
   int pass_newest_ = 0;
+  double pass_newest_time_ = 0.0;
   int emitted_steps_ = 0;
   bool emitted_carried_ = false;
   Eigen::Matrix3d carried_gain_ = Eigen::Matrix3d::Zero();
@@ -909,6 +1014,7 @@ class DifferentiatorBank {
   int carry_next_ = 0;
   double last_time_ = 0.0;
   double stamp_ = 0.0;
+  double newest_used_ = 0.0;
   double prev_t_ = 0.0;
   double half_prev_ = 0.0;
   double dt_prev_ = -1.0;  // Kalman: dt of F_ and Q_

@@ -85,6 +85,12 @@ class Estimator {
   /// them as addJointSample would have (status: kPublished, kDecimated or kStale) and
   /// returns true, false when none is left. Nothing to do for a causal filter.
   bool flush(SampleStatus& status);
+  /// With a smoother: the next sample whose loads are due at the newest joint sample
+  /// besides the one addJointSample took (several are where the rate drops or after a
+  /// gap: the delay is differentiator/lag in seconds), taken as addJointSample would
+  /// have (status as flush()); false when none is. One not taken comes with a later
+  /// sample, in order.
+  bool takeDue(SampleStatus& status);
 
   /// Live tuning (the node's ~reconfigure). `decimation` (>= 1) applies in place: the
   /// filters and the decimation phase are kept, so the loads are those of an estimator
@@ -150,8 +156,9 @@ class Estimator {
   Wrench<double> sensorResidual(int k) const;
   /// Samples taken and not yet estimated (a smoother's; flush()).
   int pendingSamples() const { return bank_.pending(); }
-  /// Nominal delay of the estimate behind the newest sample, in samples (a smoother's:
-  /// known from its second sample on).
+  /// Delay of the estimate behind the newest sample, in samples (a smoother's: its
+  /// pending samples, an upper bound of the delay of any estimate still to come:
+  /// DifferentiatorBank::delaySamples()).
   int delaySamples() const { return bank_.delaySamples(); }
   /// Segments whose loads are computed (all, or what the wanted joints need).
   const std::vector<int>& dynamicsSegments() const { return dynamics_segments_; }

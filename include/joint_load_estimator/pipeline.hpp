@@ -164,7 +164,10 @@ class Pipeline {
   bool flush();
   /// With a smoother: the joint states whose loads were still to come when the timeline
   /// restarted (a jump back of time, as a looping bag makes) or retune() replaced the
-  /// filter, smoothed with the data there was, before it was forgotten. Call after every
+  /// filter, smoothed with the data there was, before it was forgotten; then those due
+  /// at the newest joint state besides the one it published (the delay is
+  /// differentiator/lag in seconds: where the rate drops, or after a gap, several are
+  /// due at once; made when taken, estimator() holds their loads). Call after every
   /// input call and retune() until it returns false: each true puts the next of them,
   /// oldest first, in record() (each was counted when it came). The call that restarted
   /// the timeline publishes nothing itself (the new filter is warming up).
@@ -315,9 +318,11 @@ class Pipeline {
                        std::size_t segment);
   const Sample* sampleAt(double t) const;
   void drainSmoother();
-  bool flushStream(Estimator& estimator, LoadsRecord& record);
   static bool takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, std::size_t& next);
   void sampleSmoothed(double t, const BasePose* base);
+  // The next loads `estimator` has (end: flush() at the end of a stream, else those due
+  // now) into `record`, skipping the decimated, stale and unchanged ones.
+  bool nextRecord(Estimator& estimator, LoadsRecord& record, bool end);
 
   Settings settings_;
   FrameSource* frames_;

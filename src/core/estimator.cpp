@@ -251,6 +251,13 @@ bool Estimator::flush(SampleStatus& status) {
   return true;
 }
 
+bool Estimator::takeDue(SampleStatus& status) {
+  if (!bank_.next()) return false;
+  if (velocity_active_) velocity_bank_.next();  // due alike: the same times
+  status = publish();
+  return true;
+}
+
 // The loads of the bank's estimate (a sample taken now, or earlier for a delayed one).
 inline SampleStatus Estimator::publish() {
   if (sample_count_++ % config_.decimation != 0) return SampleStatus::kDecimated;

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace jle {
 namespace {
@@ -521,27 +522,31 @@ bool Pipeline::takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, 
   return true;
 }
 
-bool Pipeline::takeDrained() { return takeFrom(record_, drained_, drained_next_); }
-
-bool Pipeline::takeDrainedSmoothed() {
-  return smoothed_ && takeFrom(smoothed_->record, smoothed_->drained, smoothed_->drained_next);
+bool Pipeline::takeDrained() {
+  return takeFrom(record_, drained_, drained_next_) || nextRecord(estimator_, record_, false);
 }
 
-bool Pipeline::flushStream(Estimator& estimator, LoadsRecord& record) {
+bool Pipeline::takeDrainedSmoothed() {
+  if (!smoothed_) return false;
+  Stream& s = *smoothed_;
+  return takeFrom(s.record, s.drained, s.drained_next) || nextRecord(s.estimator, s.record, false);
+}
+
+bool Pipeline::flush() { return nextRecord(estimator_, record_, true); }
+
+bool Pipeline::flushSmoothed() {
+  return smoothed_ && nextRecord(smoothed_->estimator, smoothed_->record, true);
+}
+
+bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
   SampleStatus status = SampleStatus::kPublished;
-  while (estimator.flush(status)) {
+  while (end ? estimator.flush(status) : estimator.takeDue(status)) {
     if (status != SampleStatus::kPublished) continue;
     if (estimator.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
     fillRecord(estimator, record);
     return true;
   }
   return false;
-}
-
-bool Pipeline::flush() { return flushStream(estimator_, record_); }
-
-bool Pipeline::flushSmoothed() {
-  return smoothed_ && flushStream(smoothed_->estimator, smoothed_->record);
 }
 
 std::string Pipeline::stoppingInputs() const {
@@ -573,12 +578,14 @@ Outcome Pipeline::staleProblem() {
 }
 
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
-  // A smoother's delay is known from its second sample; over a gap its carried estimates
-  // add to it: the ring holds twice the delay (grown here, rarely: a new rate).
+  // The estimates still to come are of the newest sample and the delaySamples() before
+  // it (a smoother's pending samples, its carry over a gap included), in either stream:
+  // grown to twice that when they do not fit (rarely after the warm-up: a faster rate, a
+  // gap).
   const int delay =
       std::max(estimator_.delaySamples(), smoothed_ ? smoothed_->estimator.delaySamples() : 0);
-  const std::size_t needed = 2 * static_cast<std::size_t>(delay) + 2;
-  if (needed > ring_.size()) growRing(needed);
+  const std::size_t needed = static_cast<std::size_t>(delay) + 1;
+  if (needed > ring_.size()) growRing(2 * needed);
   Sample& s = ring_[ring_head_];
   s.t = t;
   s.stamp = stamp;
@@ -589,9 +596,11 @@ void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
 }
 
 void Pipeline::growRing(std::size_t size) {
+  // Every slot's effort at its size now: none allocated when first used.
   std::vector<Sample> grown(size);
+  for (Sample& slot : grown) slot.effort.assign(ring_.front().effort.size(), kNaN);
   for (std::size_t i = 0; i < ring_count_; ++i)  // oldest first
-    grown[i] = ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()];
+    grown[i] = std::move(ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()]);
   ring_head_ = ring_count_;
   ring_.swap(grown);
 }

@@ -389,6 +389,9 @@ py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrench
       const jle::SampleStatus st = estimator_->addJointSample(ti, q.data() + model_.nq * i);
       status[static_cast<std::size_t>(i)] = jle::toString(st);
       if (st == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
+      // A smoother's other samples due at this one (after a longer interval, a gap).
+      for (jle::SampleStatus due = st; estimator_->takeDue(due);)
+        if (due == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
     }
     // A smoother's (differentiator/lag) last samples: smoothed with the data there is.
     jle::SampleStatus st = jle::SampleStatus::kPublished;

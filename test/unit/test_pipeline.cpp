@@ -649,17 +649,17 @@ TEST(Pipeline, StaleStopNamesTheStoppingInputOnly) {
 }  // namespace
 
 // The Kalman smoother (differentiator/lag): each joint state's loads once, with its own
-// stamp and measured effort, in order: during the stream with a delay of D samples
-// (100 at 1 kHz: beyond the ring the pipeline starts with), across a gap beyond max_gap
-// (the samples before it published as the first ones after it), and at the end
-// (flush()).
+// stamp and measured effort, in order: during the stream with a delay of lag = 0.2 s
+// (200 samples at 1 kHz: beyond the ring the pipeline starts with), across a gap beyond
+// max_gap (the 150 samples before it published at the first one after it, all due:
+// takeDrained()), and at the end (flush()).
 namespace {
 
 void expectEveryJointStateOnce(jle::DifferentiatorType type) {
   const jle::Model<double> model = ur5();
   jle::Settings settings;
   settings.estimator.differentiator.type = type;
-  settings.estimator.differentiator.lag = 0.1;
+  settings.estimator.differentiator.lag = 0.2;
   jle::Pipeline pipeline(model, settings, nullptr);
   std::vector<Stamp> sent, published;
   std::vector<double> measured;
@@ -678,9 +678,13 @@ void expectEveryJointStateOnce(jle::DifferentiatorType type) {
     if (pipeline.onJointState(stamp, stamp, model.coordinate_names, p, kNone, e) ==
         Outcome::kPublished)
       take();
+    const std::size_t before = published.size();
+    while (pipeline.takeDrained()) take();
+    // The gap's carry at once, at the first sample after it.
+    EXPECT_EQ(published.size() - before, k == 150 ? 149u : 0u) << k;
   }
-  EXPECT_EQ(pipeline.estimator().delaySamples(), 100);
-  EXPECT_EQ(pipeline.estimator().pendingSamples(), 100);
+  EXPECT_EQ(pipeline.estimator().delaySamples(), 200);
+  EXPECT_EQ(pipeline.estimator().pendingSamples(), 200);
   while (pipeline.flush()) take();
   EXPECT_EQ(pipeline.estimator().pendingSamples(), 0);
   EXPECT_EQ(published, sent);

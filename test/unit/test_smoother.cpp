@@ -11,7 +11,9 @@
 #include <Eigen/LU>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 namespace {
@@ -96,10 +98,17 @@ Stream makeStream(int count, double h, bool jitter) {
   return s;
 }
 
+// The index of stamp t in the stream's times (exact: the bank returns the samples' own).
+int indexOf(const std::vector<double>& times, double t) {
+  const auto it = std::find(times.begin(), times.end(), t);
+  EXPECT_NE(it, times.end()) << t;
+  return static_cast<int>(it - times.begin());
+}
+
 // Runs the stream through the smoother (finish() at the end) and checks each estimate
 // against the batch states given the measurements up to the newest the backward pass
-// that made it used: D + B floor(j / B) for sample j of the stream, all for the ones
-// finish() estimated, from sample check_from on. Tolerance: 1e-8 on values, rates and
+// that made it used (newestUsed(): the pass's start, for the ones finish() estimated
+// the last sample), from sample check_from on. Tolerance: 1e-8 on values, rates and
 // accelerations of order 1, the rounding of a dense solve of a few hundred states. The
 // first samples differ more (measured: 1.7e-5 at sample 0, below 1e-8 from the 15th):
 // the filter's start, a prior variance of 1e12 r^2 on the derivatives, cancels about
@@ -111,15 +120,15 @@ void expectBatch(KalmanModel model, bool jitter, int count, int check_from) {
   c.process_noise = 1.0;
   c.measurement_noise = 0.5;
   c.max_gap = 10.0;
-  c.lag = 9.6;  // with h = 1: D = 10 samples, B = 5
+  c.lag = 9.6;  // with h = 1: about 10 samples, blocks of 5
   const int n = model == KalmanModel::kConstantAcceleration ? 3 : 4;
   const Stream s = makeStream(count, 1.0, jitter);
   DifferentiatorBank bank(c, 2);
   std::vector<int> newest;  // per estimate: the newest sample its pass used
   std::vector<double> stamps;
   std::vector<Eigen::MatrixXd> estimates;  // 3 x 2
-  auto record = [&](int used) {
-    newest.push_back(used);
+  auto record = [&]() {
+    newest.push_back(indexOf(s.t, bank.newestUsed()));
     stamps.push_back(bank.stamp());
     Eigen::MatrixXd e(3, 2);
     for (int ch = 0; ch < 2; ++ch) e.col(ch) << bank.value(ch), bank.rate(ch), bank.accel(ch);
@@ -127,14 +136,16 @@ void expectBatch(KalmanModel model, bool jitter, int count, int check_from) {
   };
   for (int k = 0; k < count; ++k) {
     const double x[2] = {s.y[0][static_cast<std::size_t>(k)], s.y[1][static_cast<std::size_t>(k)]};
-    if (!bank.update(s.t[static_cast<std::size_t>(k)], x)) continue;
-    const int D = bank.delaySamples(), B = D / 2, j = static_cast<int>(stamps.size());
-    record(D + B * (j / B));
+    for (bool ready = bank.update(s.t[static_cast<std::size_t>(k)], x); ready; ready = bank.next())
+      record();
   }
-  ASSERT_EQ(bank.delaySamples(), 10);
-  EXPECT_EQ(bank.pending(), 10);
+  EXPECT_EQ(bank.pending(), count - static_cast<int>(stamps.size()));
+  EXPECT_GE(bank.pending(), 7);  // 9.6 s at intervals of 0.6 to 1.4 s
   bank.finish();
-  while (bank.next()) record(count - 1);
+  while (bank.next()) {
+    record();
+    EXPECT_EQ(newest.back(), count - 1);
+  }
   EXPECT_EQ(bank.pending(), 0);
   // Every sample estimated once, in order, with its own time.
   ASSERT_EQ(static_cast<int>(stamps.size()), count);
@@ -170,8 +181,9 @@ TEST(Smoother, SettledGainEqualsTheBatchEstimate) {
 }
 
 // A gap beyond max_gap restarts the filter: the samples before it are smoothed with the
-// data there was and published in order as the first estimates after it; the end of the
-// stream publishes the rest (finish()). Every sample once, in order.
+// data there was and are the first estimates after it (due at once: the gap is longer
+// than the lag; next() takes them); the end of the stream publishes the rest (finish()).
+// Every sample once, in order, also when next() is not called (then one per sample).
 void expectEverySampleOnce(DifferentiatorType type) {
   DifferentiatorConfig c;
   c.type = type;
@@ -189,18 +201,17 @@ void expectEverySampleOnce(DifferentiatorType type) {
   std::vector<double> stamps;
   for (double ti : t) {
     const double x = std::sin(ti);
-    if (bank.update(ti, &x)) stamps.push_back(bank.stamp());
+    for (bool ready = bank.update(ti, &x); ready; ready = bank.next())
+      stamps.push_back(bank.stamp());
   }
+  // The smoother at 200 Hz after the gaps: 0.02 s is 4 samples (it was 20: the carry's).
+  EXPECT_EQ(bank.delaySamples(), 4);
   bank.finish();
   while (bank.next()) stamps.push_back(bank.stamp());
   EXPECT_EQ(stamps, t);
-  // The smoother at 200 Hz after the gaps: its delay is that of the carry (20 estimates:
-  // the 20 pending before the first of the two gaps, one of them published at the sample
-  // between them, which joined them), not round(0.02 / 5e-3) = 4.
-  EXPECT_EQ(bank.delaySamples(), 20);
   // A fresh start after finish(): the same again.
   stamps.clear();
-  for (double ti : t) {
+  for (double ti : t) {  // next() not called: the estimates due at once come later
     const double x = std::cos(ti);
     if (bank.update(ti + 100.0, &x)) stamps.push_back(bank.stamp() - 100.0);
   }
@@ -288,7 +299,7 @@ TEST(Smoother, AdaptiveEqualsTheBatchEstimateOfItsTimeVaryingModel) {
   c.type = DifferentiatorType::kAdaptive;
   c.min_bandwidth = 0.07;
   c.max_bandwidth = 0.28;
-  c.lag = 9.6;  // D = 10 samples, B = 5
+  c.lag = 9.6;  // about 10 samples, blocks of 5
   c.memory = 6.0;
   c.noise = 0.03;  // given: the choice starts at once
   c.max_gap = 2.0;
@@ -318,21 +329,21 @@ TEST(Smoother, AdaptiveEqualsTheBatchEstimateOfItsTimeVaryingModel) {
     const bool ready = bank.update(s.t[static_cast<std::size_t>(k)], x);
     if (k > 0)
       q[static_cast<std::size_t>(k - 1)] = h * std::pow(2.0 * M_PI * bank.bandwidth(), 2 * kN);
-    if (!ready) continue;
-    const int D = bank.delaySamples(), B = D / 2, j = static_cast<int>(stamps.size());
-    newest.push_back(D + B * (j / B));
-    stamps.push_back(bank.stamp());
-    Eigen::MatrixXd e(3, kChannels);
-    for (int ch = 0; ch < kChannels; ++ch)
-      e.col(ch) << bank.value(ch), bank.rate(ch), bank.accel(ch);
-    estimates.push_back(e);
+    for (bool more = ready; more; more = bank.next()) {
+      newest.push_back(indexOf(s.t, bank.newestUsed()));
+      stamps.push_back(bank.stamp());
+      Eigen::MatrixXd e(3, kChannels);
+      for (int ch = 0; ch < kChannels; ++ch)
+        e.col(ch) << bank.value(ch), bank.rate(ch), bank.accel(ch);
+      estimates.push_back(e);
+    }
   }
-  ASSERT_EQ(bank.delaySamples(), 10);
   int changes = 0;
   for (int k = 1; k + 1 < kCount; ++k)
     changes += q[static_cast<std::size_t>(k)] != q[static_cast<std::size_t>(k - 1)];
   EXPECT_GE(changes, 4) << "the selection did not move: the test checks a fixed model";
-  ASSERT_EQ(static_cast<int>(stamps.size()), kCount - 10);
+  ASSERT_EQ(static_cast<int>(stamps.size()), kCount - bank.pending());
+  EXPECT_GE(bank.pending(), 7);  // 9.6 s at intervals of 0.7 to 1.3 s
   int last_used = -1;
   std::vector<Eigen::MatrixXd> batch(kChannels);
   // From sample 20 on (the start's prior, as above, and the narrow filters' q = 1e-3
@@ -351,6 +362,94 @@ TEST(Smoother, AdaptiveEqualsTheBatchEstimateOfItsTimeVaryingModel) {
         EXPECT_NEAR(estimates[static_cast<std::size_t>(j)](d, ch), batch[ch](d, j), 1e-7 * scale)
             << "sample " << j << " channel " << ch << " derivative " << d;
       }
+  }
+}
+
+// The delay in seconds (differentiator/lag): every estimate describes a sample whose
+// stamp is `lag` before the newest sample's, whatever the first interval, the jitter or
+// a change of rate. The stamps are the test's own; each estimate taken after update()
+// and after each next() that follows it (the estimates due at once after a rate drop).
+struct Delays {
+  std::vector<double> stamps;  // of the estimates, in the order taken
+  std::vector<double> error;   // newest stamp - estimate's stamp - lag [s]
+};
+
+Delays runDelays(DifferentiatorType type, double lag, const std::vector<double>& t) {
+  DifferentiatorConfig c;
+  c.type = type;
+  c.lag = lag;
+  DifferentiatorBank bank(c, 1);
+  Delays d;
+  for (double ti : t) {
+    const double x = std::sin(3.0 * ti);
+    for (bool ready = bank.update(ti, &x); ready; ready = bank.next()) {
+      d.stamps.push_back(bank.stamp());
+      d.error.push_back(ti - bank.stamp() - lag);
+    }
+  }
+  bank.finish();
+  while (bank.next()) d.stamps.push_back(bank.stamp());
+  return d;
+}
+
+double worst(const std::vector<double>& e, std::size_t from = 0) {
+  double w = 0.0;
+  for (std::size_t k = from; k < e.size(); ++k) w = std::max(w, std::abs(e[k]));
+  return w;
+}
+
+// A 1 kHz stream whose first interval is 1.75 ms, the others 0.7 to 1.3 ms apart at
+// random: with lag 0.2 s the delay was round(0.2 / 1.75e-3) = 114 samples, 0.114 s.
+// Bound: the estimate is the pending sample nearest to newest - lag, kept while within
+// one mean interval h (1 ms) of it; an estimate skipped at one sample can be emitted at
+// the next, late by that sample's interval less its own: h + (1.3 - 0.7) ms = 1.6 ms.
+void expectDelayAtJitter(DifferentiatorType type) {
+  jle::PortableRandom random(3);
+  std::vector<double> t{5.0};
+  for (int k = 1; k < 3000; ++k)
+    t.push_back(t.back() + (k == 1 ? 1.75e-3 : random.uniform(0.7e-3, 1.3e-3)));
+  const Delays d = runDelays(type, 0.2, t);
+  EXPECT_EQ(d.stamps, t);  // every sample once, in order
+  ASSERT_GT(d.error.size(), 2700u);
+  EXPECT_LE(worst(d.error), 1.6e-3) << "worst delay error";
+  std::printf("delay error at jitter: worst %.3f ms over %zu estimates\n", 1e3 * worst(d.error),
+              d.error.size());
+}
+
+TEST(Smoother, LagIsSecondsAtAJitteredRateWhateverTheFirstInterval) {
+  expectDelayAtJitter(DifferentiatorType::kKalman);
+}
+
+TEST(Smoother, AdaptiveLagIsSecondsAtAJitteredRateWhateverTheFirstInterval) {
+  expectDelayAtJitter(DifferentiatorType::kAdaptive);
+}
+
+// The rate drops from 1 kHz to 200 Hz after 2 s, and rises back after 4 s: the delay
+// stays 0.2 s (it was 200 samples: 1 s at 200 Hz). Bound: at a steady rate half an
+// interval (the nearest sample); where the rate drops, the samples 1 ms apart made
+// overdue by each 5 ms step are estimated at once up to the nearest, late by up to
+// 5 - 1 ms; where it rises, one 5 ms apart can be taken early by up to 5 - 1 ms.
+TEST(Smoother, LagIsSecondsWhenTheRateChanges) {
+  std::vector<double> t{1.0};
+  for (int k = 1; k < 3000; ++k)
+    t.push_back(t.back() + (t.back() < 3.0 || t.back() >= 5.0 ? 1e-3 : 5e-3));
+  for (DifferentiatorType type : {DifferentiatorType::kKalman, DifferentiatorType::kAdaptive}) {
+    const Delays d = runDelays(type, 0.2, t);
+    EXPECT_EQ(d.stamps, t);
+    ASSERT_GT(d.error.size(), 2000u);
+    EXPECT_LE(worst(d.error), 4e-3 + 1e-9);
+    // At steady rates: before the drop, at 200 Hz once the 1 kHz samples are out, and
+    // at 1 kHz again once the 200 Hz ones are.
+    double steady = 0.0;
+    for (std::size_t k = 0; k < d.error.size(); ++k) {
+      const double stamp = d.stamps[k], newest = stamp + 0.2 + d.error[k];
+      const bool one_rate = (newest < 3.0) || (stamp >= 3.0 && newest < 5.0) || stamp >= 5.0;
+      const double h = stamp >= 3.0 && newest < 5.0 ? 5e-3 : 1e-3;
+      if (one_rate) steady = std::max(steady, std::abs(d.error[k]) / h);
+    }
+    EXPECT_LE(steady, 0.5 + 1e-6) << "worst error at a steady rate, in intervals";
+    std::printf("delay error, rate changes: worst %.3f ms; steady %.3f intervals\n",
+                1e3 * worst(d.error), steady);
   }
 }
 
