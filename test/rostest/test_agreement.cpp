@@ -102,10 +102,12 @@ void writeBag(const std::string& path) {
   }
 }
 
-std::map<std::uint64_t, JointLoads> readLoads(const std::string& path) {
+// The loads of one stream of process_bag's output: "joint_loads" or "smoothed/joint_loads".
+std::map<std::uint64_t, JointLoads> readLoads(const std::string& path, const std::string& topic) {
   std::map<std::uint64_t, JointLoads> loads;
   rosbag::Bag bag(path, rosbag::bagmode::Read);
-  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+  for (const rosbag::MessageInstance& m :
+       rosbag::View(bag, rosbag::TopicQuery("/joint_load_estimator/" + topic))) {
     const JointLoads::ConstPtr msg = m.instantiate<JointLoads>();
     if (msg) loads[msg->header.stamp.toNSec()] = *msg;
   }
@@ -162,8 +164,9 @@ class Agreement : public ::testing::Test {
 };
 std::string Agreement::dir_;
 
-// process_bag with the node's settings file (and, for the sensor, its bias file).
-std::map<std::uint64_t, JointLoads> offline(const std::string& dir, const Scenario& s) {
+// process_bag with the node's settings file (and, for the sensor, its bias file): its
+// output bag.
+std::string offline(const std::string& dir, const Scenario& s) {
   std::ifstream in(std::string(JLE_ROSTEST_DIR) + "/" + s.config);
   std::stringstream yaml;
   yaml << in.rdbuf();
@@ -174,7 +177,29 @@ std::map<std::uint64_t, JointLoads> offline(const std::string& dir, const Scenar
                          config, "--output", out},
                         120.0),
             0);
-  return readLoads(out);
+  return out;
+}
+
+// The smoothed stream (on by default): every stamp the node published, process_bag
+// published alike; process_bag also gives the last `lag` (0.2 s: 20 samples) at the end of
+// the bag, which the live node is still waiting for.
+void compareSmoothed(const Scenario& s, const std::vector<JointLoads>& on,
+                     const std::map<std::uint64_t, JointLoads>& off) {
+  EXPECT_GE(on.size(), static_cast<std::size_t>(kSamples - 10 - 22));
+  EXPECT_GE(off.size(), on.size() + 18);
+  std::size_t common = 0;
+  worst_difference = 0.0;
+  for (const JointLoads& m : on) {
+    const auto it = off.find(m.header.stamp.toNSec());
+    if (it == off.end()) continue;
+    ++common;
+    EXPECT_EQ(m.name, s.joints);
+    expectSameLoads(m, it->second);
+  }
+  EXPECT_EQ(common, on.size()) << "smoothed stamps published by the node only";
+  std::printf("agreement %s, smoothed: %zu stamps compared (%zu offline), worst |difference| / "
+              "max(1, |value|) %.3g\n",
+              s.ns.c_str(), common, off.size(), worst_difference);
 }
 
 TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
@@ -192,12 +217,19 @@ TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
                                             {"j1", "j2"},
                                             true}};
   ros::NodeHandle nh;
-  std::map<std::string, std::vector<JointLoads>> online;
+  // Per scenario, the immediate and the smoothed stream.
+  std::map<std::string, std::vector<JointLoads>> online, online_smoothed;
   std::vector<ros::Subscriber> subs;
-  for (const Scenario& s : scenarios)
+  for (const Scenario& s : scenarios) {
     subs.push_back(nh.subscribe<JointLoads>(
         "/" + s.ns + "/joint_load_estimator/joint_loads", 10000,
         [&online, s](const JointLoads::ConstPtr& m) { online[s.ns].push_back(*m); }));
+    subs.push_back(nh.subscribe<JointLoads>(
+        "/" + s.ns + "/joint_load_estimator/smoothed/joint_loads", 10000,
+        [&online_smoothed, s](const JointLoads::ConstPtr& m) {
+          online_smoothed[s.ns].push_back(*m);
+        }));
+  }
   ASSERT_TRUE(jle_test::waitFor(
       [&] {
         for (const ros::Subscriber& sub : subs)
@@ -213,12 +245,15 @@ TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
   jle_test::spinUntilQuiet([&] {
     std::size_t n = 0;
     for (const auto& o : online) n += o.second.size();
+    for (const auto& o : online_smoothed) n += o.second.size();
     return n;
   });
 
   for (const Scenario& s : scenarios) {
     SCOPED_TRACE(s.ns);
-    const std::map<std::uint64_t, JointLoads> off = offline(dir_, s);
+    const std::string out = offline(dir_, s);
+    compareSmoothed(s, online_smoothed[s.ns], readLoads(out, "smoothed/joint_loads"));
+    const std::map<std::uint64_t, JointLoads> off = readLoads(out, "joint_loads");
     const std::vector<JointLoads>& on = online[s.ns];
     // Every stamp but the filter's start is published, online and offline alike.
     EXPECT_GE(on.size(), static_cast<std::size_t>(kSamples - 10));
