@@ -206,6 +206,7 @@ void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration
   const jle::Model<double> model = jle::modelFromUrdfFile(chainPath());
   jle::Settings settings;
   settings.external_effort = externalConfig(method);
+  settings.smoothed.enabled = false;  // the immediate stream's estimate against KDL's
   jle::Pipeline pipeline(model, settings, nullptr);
   const KDL::Chain chain = kdlChain();
   KDL::ChainExternalWrenchEstimator kdl(chain, KDL::Vector(0, 0, kGravity.z()), 1000.0,

@@ -253,9 +253,9 @@ void decodeJointState(Bytes& in, JointMessage& js) {
   for (double& v : js.velocity) v = in.value();
   for (double& v : js.effort) v = in.value();
   js.valid = np == n && (ne == 0 || ne == n) && (nv == 0 || nv == n);
-  // A non-finite effort only drops its comparison.
-  for (const auto* field : {&js.position, &js.velocity})
-    for (double v : *field) js.valid = js.valid && std::isfinite(v);
+  // A non-finite velocity or effort only drops that value (the velocity: the filter's
+  // prediction instead; the effort: its comparison).
+  for (double v : js.position) js.valid = js.valid && std::isfinite(v);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < i; ++j) js.valid = js.valid && js.names[i] != js.names[j];
 }
@@ -296,6 +296,11 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
   if (outcome == Outcome::kPublished) {
     JLE_FUZZ_CHECK(p.record().stamp <= stamp);
     JLE_FUZZ_CHECK(p.record().effort.size() == p.record().joint.size());
+  }
+  // The smoothed stream describes a sample taken on this timeline, at or before this one.
+  if (p.smoothedPublished()) {
+    JLE_FUZZ_CHECK(p.smoothedRecord().stamp <= stamp);
+    JLE_FUZZ_CHECK(p.smoothedRecord().effort.size() == p.smoothedRecord().joint.size());
   }
 }
 

@@ -197,9 +197,10 @@ void compareSmoothed(const Scenario& s, const std::vector<JointLoads>& on,
     expectSameLoads(m, it->second);
   }
   EXPECT_EQ(common, on.size()) << "smoothed stamps published by the node only";
-  std::printf("agreement %s, smoothed: %zu stamps compared (%zu offline), worst |difference| / "
-              "max(1, |value|) %.3g\n",
-              s.ns.c_str(), common, off.size(), worst_difference);
+  std::printf(
+      "agreement %s, smoothed: %zu stamps compared (%zu offline), worst |difference| / "
+      "max(1, |value|) %.3g\n",
+      s.ns.c_str(), common, off.size(), worst_difference);
 }
 
 TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
@@ -224,11 +225,11 @@ TEST_F(Agreement, NodeAndProcessBagPublishTheSameLoads) {
     subs.push_back(nh.subscribe<JointLoads>(
         "/" + s.ns + "/joint_load_estimator/joint_loads", 10000,
         [&online, s](const JointLoads::ConstPtr& m) { online[s.ns].push_back(*m); }));
-    subs.push_back(nh.subscribe<JointLoads>(
-        "/" + s.ns + "/joint_load_estimator/smoothed/joint_loads", 10000,
-        [&online_smoothed, s](const JointLoads::ConstPtr& m) {
-          online_smoothed[s.ns].push_back(*m);
-        }));
+    subs.push_back(
+        nh.subscribe<JointLoads>("/" + s.ns + "/joint_load_estimator/smoothed/joint_loads", 10000,
+                                 [&online_smoothed, s](const JointLoads::ConstPtr& m) {
+                                   online_smoothed[s.ns].push_back(*m);
+                                 }));
   }
   ASSERT_TRUE(jle_test::waitFor(
       [&] {
