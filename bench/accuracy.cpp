@@ -114,6 +114,10 @@ void addZeroPhase(bool quick, std::vector<Differentiator>& out) {
   d.zero_phase.rule = jle::CutoffRule::kGcv;
   d.label = "ZP auto GCV";
   out.push_back(d);
+  // The former default: GCV searched up to 0.4 of the rate.
+  d.zero_phase.max_cutoff = std::numeric_limits<double>::max();
+  d.label = "ZP auto GCV to 0.4 fs";
+  out.push_back(d);
   // The default rule given the measured velocities as well (the velocity evidence).
   d.zero_phase = jle::ZeroPhaseConfig{};
   d.velocities = true;
@@ -1500,12 +1504,12 @@ void runZeroPhase(SceneRun& run, const Differentiator& diff) {
   ++run.runs;
   writeRows(run.csv, run.scene.spec, diff, 0.0, "double", "default", result, run.described);
   if (diff.zero_phase.rule != jle::CutoffRule::kFixed)
-    run.automatic.push_back({diff.label, result.cutoff_hz, result.joints.back().rms_effort,
-                             !choice.warnings.empty()});
+    run.automatic.push_back(
+        {diff.label, result.cutoff_hz, result.joints.back().rms_effort, !choice.warnings.empty()});
 }
 
 // --cutoffs: the best fixed cutoff (an oracle that knows the truth: fixed cutoffs from
-// 1 Hz at ratio 1.1 up to 0.4 of the rate, at most 60 Hz) and its effort error, then per
+// 1 Hz at ratio 1.1 up to 0.4 of the rate, at most 100 Hz) and its effort error, then per
 // automatic row its cutoff and its effort error over the oracle's ("W": warned), one
 // markdown table row per scene (the header before the first).
 void reportCutoffs(SceneRun& run, bool& header) {
@@ -1514,7 +1518,7 @@ void reportCutoffs(SceneRun& run, bool& header) {
   double best_cutoff = 0.0, best = std::numeric_limits<double>::infinity();
   jle::ZeroPhaseConfig fixed;
   fixed.rule = jle::CutoffRule::kFixed;
-  for (double f = 1.0; f <= std::min(60.0, 0.4 * spec.sensor.rate); f *= 1.1) {
+  for (double f = 1.0; f <= std::min(100.0, 0.4 * spec.sensor.rate); f *= 1.1) {
     fixed.cutoff = f;
     jle::CutoffChoice unused;
     const double e = zeroPhaseRun(run, fixed, false, unused).joints.back().rms_effort;

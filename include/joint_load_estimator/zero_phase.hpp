@@ -26,7 +26,9 @@ enum class CutoffRule : std::uint8_t {
   /// The zero-phase rate of the positions closest (mean square) to measured velocities,
   /// whose noise is independent of the positions': needs the velocities.
   kVelocity,
-  /// kVelocity when measured velocities are given, kSpectrum otherwise.
+  /// kVelocity when measured velocities are given and follow the positions (their
+  /// difference from the rate at kSpectrum's cutoff below half the rate's mean square;
+  /// CutoffChoice warns when they do not), kSpectrum otherwise.
   kAuto,
 };
 

@@ -252,10 +252,11 @@ struct CutoffSearch {
   // finite velocity, at the input stamps (the grid's rate interpolated
   // linearly). With the velocities' noise independent of the positions', its expectation
   // is the rate's mean square error plus the velocities' noise variance, a constant.
-  double velocityScore(double w) const {
+  // `rate_square`: if not null, the mean square of the rate itself over the same samples.
+  double velocityScore(double w, double* rate_square = nullptr) const {
     Eigen::MatrixXd rate, accel;
     differentiate(smoothPadded(xg, w, order, pad), pad, grid.h, rate, accel);
-    double sum = 0.0;
+    double sum = 0.0, sum_rate = 0.0;
     long count = 0;
     // All but a twentieth of the record at each end: the padding's error is the error
     // the loads will have from there on, and the measured velocities see it (at the
@@ -269,12 +270,15 @@ struct CutoffSearch {
       for (Eigen::Index c = 0; c < x.cols(); ++c) {
         const double measured = (*v)(static_cast<Eigen::Index>(i), c);
         if (!std::isfinite(measured)) continue;
-        const double d = (1.0 - f) * rate(k, c) + f * rate(k1, c) - measured;
-        sum += d * d;
+        const double r = (1.0 - f) * rate(k, c) + f * rate(k1, c);
+        sum += (r - measured) * (r - measured);
+        sum_rate += r * r;
         ++count;
       }
     }
-    return count > 0 ? sum / static_cast<double>(count) : 0.0;
+    const double n = static_cast<double>(std::max(1L, count));
+    if (rate_square) *rate_square = sum_rate / n;
+    return sum / n;
   }
 };
 
@@ -341,6 +345,7 @@ constexpr int kAnalysisOrder = 8;
 std::vector<double> bandLevels(const CutoffSearch& search, std::vector<double>& w) {
   w.clear();
   for (double c = search.w_lo; c < 0.4; c *= 1.1) w.push_back(c);
+  if (w.size() < 2) return {};  // a record too short for a band below 0.4 of the rate
   const Eigen::Index n = search.xg.rows();
   const int pad = paddingOf(0, kAnalysisOrder, static_cast<int>(n));
   Eigen::VectorXd tan2(n);
@@ -395,7 +400,7 @@ double spectrumCutoff(const CutoffSearch& search, bool& found) {
   for (int j = bands - 2; j >= 0; --j) envelope[j] = std::max(envelope[j], envelope[j + 1]);
   found = false;
   int knee = 0;
-  for (; knee + octave < bands; ++knee) {
+  for (; knee + octave < bands; ++knee) {  // none when there are octave + 1 bands or fewer
     const double slope = std::log(envelope[knee + octave] / envelope[knee]) /
                          std::log(centre(knee + octave) / centre(knee));
     if (slope > kFlatSlope && envelope[knee] < kFloorBelowPeak * envelope[0]) {
@@ -454,6 +459,19 @@ void warnAbout(const CutoffSearch& search, CutoffRule other, CutoffChoice& choic
            : ": the position noise may be coloured; check the loads or give --cutoff"));
 }
 
+// Whether the measured velocities are evidence: at the noise spectrum's cutoff, their
+// mean square difference from the positions' rate is below kFollow times the rate's
+// own mean square (velocities that are all zero, in another unit or of other joints are
+// not).
+constexpr double kFollow = 0.5;
+
+bool velocitiesFollow(const CutoffSearch& search) {
+  bool found = true;
+  double rate_square = 0.0;
+  const double difference = search.velocityScore(spectrumCutoff(search, found), &rate_square);
+  return difference < kFollow * rate_square;
+}
+
 // The automatic choice: the rule's cutoff, then the checks a user must hear about.
 CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& config) {
   CutoffChoice choice;
@@ -461,11 +479,17 @@ CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& 
   choice.lowest = search.w_lo / h;
   choice.highest = search.w_hi / h;
   choice.rule = config.rule;
-  if (choice.rule == CutoffRule::kAuto)
-    choice.rule = search.v ? CutoffRule::kVelocity : CutoffRule::kSpectrum;
   if (choice.rule == CutoffRule::kVelocity && !search.v)
     throw std::invalid_argument(
         "zero_phase: the velocity rule needs measured velocities (none given, or none finite)");
+  const bool follow = search.v && velocitiesFollow(search);
+  if (search.v && !follow)
+    choice.warnings.push_back(
+        "zero-phase cutoff: the measured velocities do not follow the positions' rate (all "
+        "zero, another unit or other joints?): " +
+        std::string(choice.rule == CutoffRule::kVelocity ? "used all the same" : "not used"));
+  if (choice.rule == CutoffRule::kAuto)
+    choice.rule = follow ? CutoffRule::kVelocity : CutoffRule::kSpectrum;
   bool found = true;
   choice.cutoff = ruleCutoff(search, choice.rule, found) / h;
   if (!found)
@@ -479,7 +503,7 @@ CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& 
                               "): the data do not settle it; check the loads or give --cutoff");
   if (choice.rule != CutoffRule::kSpectrum) warnAbout(search, CutoffRule::kSpectrum, choice);
   if (choice.rule == CutoffRule::kSpectrum) warnAbout(search, CutoffRule::kGcv, choice);
-  if (search.v && choice.rule != CutoffRule::kVelocity)
+  if (follow && choice.rule != CutoffRule::kVelocity)
     warnAbout(search, CutoffRule::kVelocity, choice);
   return choice;
 }

@@ -162,6 +162,19 @@ TEST(ColouredNoise, TheVelocityEvidencePicksNearTheBestFixedCutoff) {
             choice.cutoff);
 }
 
+// Velocities that are all zero (a driver that does not fill them) are no evidence: the
+// default rule falls back to the noise spectrum, and says why.
+TEST(ColouredNoise, ZeroVelocitiesAreNotEvidence) {
+  const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(coloured().q.rows(), coloured().q.cols());
+  const jle::CutoffChoice choice =
+      jle::selectCutoff(coloured().t, coloured().q, jle::ZeroPhaseConfig{}, zero);
+  EXPECT_EQ(choice.rule, jle::CutoffRule::kSpectrum);
+  EXPECT_EQ(choice.cutoff, jle::chooseCutoff(coloured().t, coloured().q, jle::ZeroPhaseConfig{}));
+  ASSERT_FALSE(choice.warnings.empty());
+  EXPECT_NE(choice.warnings.front().find("do not follow"), std::string::npos)
+      << choice.warnings.front();
+}
+
 // A velocity rule without velocities is refused; velocities of another shape too.
 TEST(ColouredNoise, TheVelocityRuleNeedsVelocities) {
   jle::ZeroPhaseConfig config;
@@ -169,6 +182,20 @@ TEST(ColouredNoise, TheVelocityRuleNeedsVelocities) {
   EXPECT_THROW(jle::chooseCutoff(coloured().t, coloured().q, config), std::invalid_argument);
   EXPECT_THROW(jle::chooseCutoff(coloured().t, coloured().q, config, coloured().qd.leftCols(3)),
                std::invalid_argument);
+}
+
+// A record too short for a band of the spectrum (5 samples at 1 kHz: the lowest cutoff
+// searched, one period over the record, is 250 Hz, above the 50 Hz bound): the search
+// sits on its bound, and says so.
+TEST(ColouredNoise, ARecordTooShortForTheSpectrumChoosesTheBoundAndWarns) {
+  const std::vector<double> t{0.0, 0.001, 0.002, 0.003, 0.004};
+  Eigen::MatrixXd x(5, 1);
+  x << 0.0, 1e-3, -2e-3, 1.5e-3, 0.5e-3;
+  const jle::CutoffChoice choice = jle::selectCutoff(t, x, jle::ZeroPhaseConfig{});
+  EXPECT_NEAR(choice.cutoff, 250.0, 1e-9);
+  ASSERT_FALSE(choice.warnings.empty());
+  EXPECT_NE(choice.warnings.front().find("no noise floor"), std::string::npos)
+      << choice.warnings.front();
 }
 
 class JointLoadsColoured : public jle_test::ToolTest {
