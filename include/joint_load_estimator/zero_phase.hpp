@@ -23,8 +23,9 @@ enum class CutoffRule : std::uint8_t {
   /// Where the positions' spectrum meets its noise floor (the first plateau above the
   /// motion's steep fall): coloured noise is not taken for motion.
   kSpectrum,
-  /// The zero-phase rate of the positions closest (mean square) to measured velocities,
-  /// whose noise is independent of the positions': needs the velocities.
+  /// The zero-phase acceleration of the positions closest (mean square) to the central
+  /// differences of measured velocities, whose noise is independent of the positions':
+  /// needs the velocities.
   kVelocity,
   /// kVelocity when measured velocities are given and follow the positions (their
   /// difference from the rate at kSpectrum's cutoff below half the rate's mean square;

@@ -248,36 +248,70 @@ struct CutoffSearch {
     return meanSquareResidual(w) / (dof * dof);
   }
 
-  // Mean square of (zero-phase rate of x at cutoff w) - (measured velocity) over every
-  // finite velocity, at the input stamps (the grid's rate interpolated
-  // linearly). With the velocities' noise independent of the positions', its expectation
-  // is the rate's mean square error plus the velocities' noise variance, a constant.
-  // `rate_square`: if not null, the mean square of the rate itself over the same samples.
-  double velocityScore(double w, double* rate_square = nullptr) const {
+  // The grid's rate (or acceleration) of x at cutoff w, channel c, at stamp i
+  // (interpolated linearly between grid samples).
+  static double atStamp(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& y,
+                        std::size_t i, Eigen::Index c) {
+    double f = 0.0;
+    const int k = grid.uniform ? static_cast<int>(i) : intervalOf(grid, t[i], f);
+    return (1.0 - f) * y(k, c) + f * y(std::min(k + 1, grid.m), c);
+  }
+
+  // Whether stamp i is scored by the velocity evidence: all but the first and the last
+  // twentieth of the record. Beyond them the padding's error is the error the loads will
+  // have, and the measured velocities see it; at the very ends it is large at any cutoff
+  // searched, and would drive the choice.
+  bool evidenceAt(std::size_t i) const {
+    const double end = (t.back() - t.front()) / 20.0;
+    return i > 0 && i + 1 < t.size() && t[i] - t.front() >= end && t.back() - t[i] >= end;
+  }
+
+  // The velocity evidence's score at cutoff w: the mean square of (zero-phase acceleration
+  // of x) - (central difference of the measured velocities, (v[i+1] - v[i-1]) /
+  // (t[i+1] - t[i-1])) over the scored stamps where both velocities are finite. With the
+  // velocities' noise independent of the positions', its expectation is the
+  // acceleration's mean square error (what the loads' error follows) plus a constant, the
+  // difference's own error; the difference's noise is mostly near the Nyquist rate, where
+  // the smoothed acceleration has little, so the score's scatter is small.
+  double velocityScore(double w) const {
+    Eigen::MatrixXd rate, accel;
+    differentiate(smoothPadded(xg, w, order, pad), pad, grid.h, rate, accel);
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (!evidenceAt(i)) continue;
+      const auto row = static_cast<Eigen::Index>(i);
+      for (Eigen::Index c = 0; c < x.cols(); ++c) {
+        const double a_v = ((*v)(row + 1, c) - (*v)(row - 1, c)) / (t[i + 1] - t[i - 1]);
+        if (!std::isfinite(a_v)) continue;
+        const double d = atStamp(grid, t, accel, i, c) - a_v;
+        sum += d * d;
+        ++count;
+      }
+    }
+    return sum / static_cast<double>(std::max(1L, count));
+  }
+
+  // The mean square of (zero-phase rate of x at cutoff w) - (measured velocity), and of
+  // the rate itself (`rate_square`), over the scored stamps with a finite velocity.
+  double rateDifference(double w, double& rate_square) const {
     Eigen::MatrixXd rate, accel;
     differentiate(smoothPadded(xg, w, order, pad), pad, grid.h, rate, accel);
     double sum = 0.0, sum_rate = 0.0;
     long count = 0;
-    // All but a twentieth of the record at each end: the padding's error is the error
-    // the loads will have from there on, and the measured velocities see it (at the
-    // very ends it is large at any cutoff searched, and would drive the choice).
-    const double end = (t.back() - t.front()) / 20.0;
     for (std::size_t i = 0; i < t.size(); ++i) {
-      if (t[i] - t.front() < end || t.back() - t[i] < end) continue;
-      double f = 0.0;
-      const int k = grid.uniform ? static_cast<int>(i) : intervalOf(grid, t[i], f);
-      const int k1 = std::min(k + 1, grid.m);
+      if (!evidenceAt(i)) continue;
       for (Eigen::Index c = 0; c < x.cols(); ++c) {
         const double measured = (*v)(static_cast<Eigen::Index>(i), c);
         if (!std::isfinite(measured)) continue;
-        const double r = (1.0 - f) * rate(k, c) + f * rate(k1, c);
+        const double r = atStamp(grid, t, rate, i, c);
         sum += (r - measured) * (r - measured);
         sum_rate += r * r;
         ++count;
       }
     }
     const double n = static_cast<double>(std::max(1L, count));
-    if (rate_square) *rate_square = sum_rate / n;
+    rate_square = sum_rate / n;
     return sum / n;
   }
 };
@@ -468,7 +502,7 @@ constexpr double kFollow = 0.5;
 bool velocitiesFollow(const CutoffSearch& search) {
   bool found = true;
   double rate_square = 0.0;
-  const double difference = search.velocityScore(spectrumCutoff(search, found), &rate_square);
+  const double difference = search.rateDifference(spectrumCutoff(search, found), rate_square);
   return difference < kFollow * rate_square;
 }
 
