@@ -212,6 +212,10 @@ struct CutoffSearch {
   double w_lo;        // the lowest cutoff searched [1/sample]
   double w_hi;        // the highest [1/sample]
   double margin = 0;  // [s] left out of the scores at each end
+  // The noise spectrum's cutoff once found (it is asked for by several checks), and
+  // whether it found a floor; spectrum_w < 0: not yet.
+  mutable double spectrum_w = -1.0;
+  mutable bool spectrum_found = false;
 
   // Whether time s is far enough from the ends to be scored: there the padding's
   // transient (odd reflection bends the curvature) would dominate at low cutoffs.
@@ -425,7 +429,7 @@ std::vector<double> bandLevels(const CutoffSearch& search, std::vector<double>& 
 constexpr double kFlatSlope = -1.5;
 constexpr double kFloorBelowPeak = 1e-3;
 
-double spectrumCutoff(const CutoffSearch& search, bool& found) {
+double findSpectrumCutoff(const CutoffSearch& search, bool& found) {
   std::vector<double> w;
   const std::vector<double> level = bandLevels(search, w);
   const int bands = static_cast<int>(level.size()), octave = 7;  // 1.1^7 = 1.95
@@ -453,6 +457,14 @@ double spectrumCutoff(const CutoffSearch& search, bool& found) {
   const double u = std::log(envelope[c] / twice_floor) / std::log(envelope[c] / envelope[c + 1]);
   const double crossing = std::exp(std::log(centre(c)) + u * std::log(centre(c + 1) / centre(c)));
   return std::max(search.w_lo, std::min(search.w_hi, crossing));
+}
+
+// findSpectrumCutoff, once per search.
+double spectrumCutoff(const CutoffSearch& search, bool& found) {
+  if (search.spectrum_w < 0.0)
+    search.spectrum_w = findSpectrumCutoff(search, search.spectrum_found);
+  found = search.spectrum_found;
+  return search.spectrum_w;
 }
 
 // One automatic rule's cutoff [1/sample]; `found`: false when kSpectrum found no floor.
