@@ -33,7 +33,7 @@ namespace {
 
 const char* const kUsage =
     R"(usage: accuracy --csv OUT.csv [--quick] [--repeat N] [--scene NAME] [--data DIR]
-                [--offline] [--cutoffs OUT.md]
+                [--offline] [--no-wrenches] [--cutoffs OUT.md]
 
 Runs every scene's sensor readings through jle::Pipeline (the node's message path) for
 each configuration, and through the offline zero-phase smoother, and compares the loads
@@ -50,6 +50,8 @@ with the exact ones at the true instant of the sample each estimate describes.
   --scene NAME  only this scene (repeatable; default: all)
   --data DIR    the test data directory (default: the package's test/data)
   --offline     only the offline zero-phase rows
+  --no-wrenches every scene without its wrench inputs (the loads of the motion alone:
+                what the kinematics' cutoff costs, without the forces filtered alike)
   --cutoffs MD  also the automatic cutoffs against the best fixed one (scanned from 1 Hz at
                 ratio 1.1: an oracle that knows the truth), a markdown table per scene
 
@@ -1212,6 +1214,7 @@ struct Options {
   std::string data = JLE_ACCURACY_DATA;
   std::vector<std::string> only_scenes;
   bool offline = false;      // only the offline zero-phase rows
+  bool no_wrenches = false;  // every scene without its wrench inputs
   std::string cutoffs_path;  // the automatic cutoffs against the best fixed one
 };
 
@@ -1236,6 +1239,8 @@ int parseOptions(int argc, char** argv, Options& o) {
         o.data = value();
       } else if (arg == "--offline") {
         o.offline = true;
+      } else if (arg == "--no-wrenches") {
+        o.no_wrenches = true;
       } else if (arg == "--cutoffs") {
         o.cutoffs_path = value();
       } else if (arg == "--help") {
@@ -1623,7 +1628,8 @@ int main(int argc, char** argv) {
                          [](const Differentiator& d) { return d.family != kZeroPhaseFamily; }),
           diffs.end());
     const auto study_start = std::chrono::steady_clock::now();
-    for (const SceneSpec& spec : sceneSpecs(options.data, options.quick)) {
+    for (SceneSpec spec : sceneSpecs(options.data, options.quick)) {
+      if (options.no_wrenches) spec.wrench_links.clear();
       if (options.only_scenes.empty() ||
           std::find(options.only_scenes.begin(), options.only_scenes.end(), spec.name) !=
               options.only_scenes.end())
