@@ -262,11 +262,12 @@ struct CutoffSearch {
   }
 
   // Whether stamp i is scored by the velocity evidence: all but the first and the last
-  // twentieth of the record. Beyond them the padding's error is the error the loads will
-  // have, and the measured velocities see it; at the very ends it is large at any cutoff
+  // 0.5 s of the record (a tenth of a shorter one), the project's convention for loads
+  // near a record's end. Beyond them the padding's error is the error the loads will
+  // have, and the measured velocities see it; nearer the ends it is large at any cutoff
   // searched, and would drive the choice.
   bool evidenceAt(std::size_t i) const {
-    const double end = (t.back() - t.front()) / 20.0;
+    const double end = std::min(0.5, (t.back() - t.front()) / 10.0);
     return i > 0 && i + 1 < t.size() && t[i] - t.front() >= end && t.back() - t[i] >= end;
   }
 
