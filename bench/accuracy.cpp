@@ -33,6 +33,7 @@ namespace {
 
 const char* const kUsage =
     R"(usage: accuracy --csv OUT.csv [--quick] [--repeat N] [--scene NAME] [--data DIR]
+                [--offline] [--no-wrenches] [--cutoffs OUT.md]
 
 Runs every scene's sensor readings through jle::Pipeline (the node's message path) for
 each configuration, and through the offline zero-phase smoother, and compares the loads
@@ -48,6 +49,11 @@ with the exact ones at the true instant of the sample each estimate describes.
                 other scenes 1)
   --scene NAME  only this scene (repeatable; default: all)
   --data DIR    the test data directory (default: the package's test/data)
+  --offline     only the offline zero-phase rows
+  --no-wrenches every scene without its wrench inputs (the loads of the motion alone:
+                what the kinematics' cutoff costs, without the forces filtered alike)
+  --cutoffs MD  also the automatic cutoffs against the best fixed one (scanned from 1 Hz at
+                ratio 1.1: an oracle that knows the truth), a markdown table per scene
 
 Exit status: 0 success; 1 a failed self-check (exact inputs not reproduced to 1e-9
 relative in double precision; savings.planar not taking the 3x3 path on every
@@ -79,6 +85,8 @@ struct Differentiator {
   bool as_configured = false;
   /// Offline rows (family kZeroPhaseFamily): the zero-phase smoother instead.
   jle::ZeroPhaseConfig zero_phase;
+  /// Offline rows: the readings' measured velocities given to the smoother as evidence.
+  bool velocities = false;
 };
 
 constexpr const char* kDefaultLabel = "default";
@@ -100,9 +108,22 @@ void addZeroPhase(bool quick, std::vector<Differentiator>& out) {
   d.zero_phase.rule = jle::CutoffRule::kResidual;
   d.label = "ZP auto residual";
   out.push_back(d);
+  // What a user who gives positions only runs: the default rule.
+  d.zero_phase = jle::ZeroPhaseConfig{};
+  d.label = "ZP auto";
+  out.push_back(d);
   if (quick) return;
   d.zero_phase.rule = jle::CutoffRule::kGcv;
   d.label = "ZP auto GCV";
+  out.push_back(d);
+  // The former default: GCV searched up to 0.4 of the rate.
+  d.zero_phase.max_cutoff = std::numeric_limits<double>::max();
+  d.label = "ZP auto GCV to 0.4 fs";
+  out.push_back(d);
+  // The default rule given the measured velocities as well (the velocity evidence).
+  d.zero_phase = jle::ZeroPhaseConfig{};
+  d.velocities = true;
+  d.label = "ZP auto with velocities";
   out.push_back(d);
 }
 
@@ -113,10 +134,10 @@ std::vector<Differentiator> differentiators(bool quick) {
   std::vector<Differentiator> out;
   // What a user who changes nothing runs: jle::Settings' differentiator, whatever it is.
   const jle::DifferentiatorConfig node = jle::Settings{}.estimator.differentiator;
-  out.push_back({kDefaultLabel, kDefaultLabel, node, node.measurement_noise, true, {}});
+  out.push_back({kDefaultLabel, kDefaultLabel, node, node.measurement_noise, true, {}, false});
   auto add = [&](const std::string& label, const std::string& family,
                  const jle::DifferentiatorConfig& c) {
-    out.push_back({label, family, c, 0.0, false, {}});
+    out.push_back({label, family, c, 0.0, false, {}, false});
   };
   for (int delay : {0, 1}) {
     jle::DifferentiatorConfig c;
@@ -148,7 +169,7 @@ std::vector<Differentiator> differentiators(bool quick) {
 void addKalman(bool quick, std::vector<Differentiator>& out) {
   auto add = [&](const std::string& label, const std::string& family,
                  const jle::DifferentiatorConfig& c) {
-    out.push_back({label, family, c, 0.0, false, {}});
+    out.push_back({label, family, c, 0.0, false, {}, false});
   };
   // Process-noise densities: white jerk [rad^2/s^5] (CA) or snap [rad^2/s^7] (CJ). With
   // the encoder's r = 1.5e-5 rad the CA settings put the filter's bandwidth (q/r^2)^(1/6)
@@ -180,7 +201,7 @@ void addKalman(bool quick, std::vector<Differentiator>& out) {
   // The adaptive bank (type: adaptive) with its keys' defaults: the noise estimated.
   jle::DifferentiatorConfig adaptive;
   adaptive.type = jle::DifferentiatorType::kAdaptive;
-  out.push_back({"adaptive", "adaptive", adaptive, adaptive.measurement_noise, false, {}});
+  out.push_back({"adaptive", "adaptive", adaptive, adaptive.measurement_noise, false, {}, false});
   if (!quick) {
     // The filters with the measurement noise left at DifferentiatorConfig's default
     // (1e-4 rad), not matched to the encoder: the Kalman settings shipped before the
@@ -224,7 +245,7 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
       char label[64];
       std::snprintf(label, sizeof label, "KS-CJ q=%.0e lag=%.0fms r=%.0e", q, 1e3 * lag,
                     defaults.measurement_noise);
-      out.push_back({label, "kalman_cj_smooth", c, defaults.measurement_noise, false, {}});
+      out.push_back({label, "kalman_cj_smooth", c, defaults.measurement_noise, false, {}, false});
     }
   // The adaptive smoother (type: adaptive with a lag): the bandwidth chosen by likelihood,
   // the noise estimated, nothing tuned.
@@ -234,7 +255,7 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
     c.lag = lag;
     char label[64];
     std::snprintf(label, sizeof label, "KS-adaptive lag=%.0fms", 1e3 * lag);
-    out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}});
+    out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}, false});
   }
 }
 
@@ -308,6 +329,7 @@ struct SceneSpec {
   /// peak (link frame) from each impact's start (heel strike), stance_duration long.
   jle::Stance::Vector6 stance_peak = jle::Stance::Vector6::Zero();
   double stance_duration = 0.25;  // [s]
+  bool velocities = true;         // the sensor reports velocities (JointReading::qd)
 };
 
 // Precomputed per scene: readings, and the truth at each reading's true instant.
@@ -619,6 +641,55 @@ void realLogScenes(const std::string& panda, bool quick, std::vector<SceneSpec>&
   if (quick) specs.back().quick_duration = 2.0;
 }
 
+// A joint encoder as a real arm's log has it (issue 37): receive-time stamps as
+// receivedSensor's, coloured position noise of 2.75e-4 rad flat to 50 Hz (falling as
+// f^-4 above), a vibration line of 3e-5 rad at 80 Hz, and measured velocities with their
+// own 5e-3 rad/s of white noise.
+jle::SensorModel colouredSensor(double rate, int max_gap) {
+  jle::SensorModel s = receivedSensor(rate, 0.0, max_gap);
+  s.coloured_noise = 2.75e-4;
+  s.coloured_corner = 50.0;
+  s.vibration_amplitude = 3e-5;
+  s.vibration_frequency = 80.0;
+  s.velocity_noise = 5e-3;
+  return s;
+}
+
+// The scenes of coloured noise (issue 37): the arm at 1 kHz and 200 Hz, and a gait-like
+// leg at 70 Hz (positions from motion capture: noise flat to 15 Hz, no velocities).
+void colouredScenes(const std::string& panda, bool quick, std::vector<SceneSpec>& specs) {
+  SceneSpec s;
+  s.urdf = panda;
+  s.wrench_links = {"panda_hand"};
+  s.motion = jle::MotionKind::kStopAndGo;
+  s.received = true;
+  s.name = "arm_coloured_1khz";
+  s.description =
+      "Panda, stop-and-go, receive-time stamps (+-10% jitter, bursts, gaps), coloured noise "
+      "2.75e-4 rad flat to 50 Hz, 3e-5 rad line at 80 Hz, velocities with 5e-3 rad/s noise, "
+      "1000 Hz";
+  s.sensor = colouredSensor(1000.0, 8);
+  s.seed = 21;
+  specs.push_back(s);
+  if (quick) return;
+  s.name = "arm_coloured_200hz";
+  s.description = "as arm_coloured_1khz, 200 Hz (coloured noise flat to 50 Hz, line at 80 Hz)";
+  s.sensor = colouredSensor(200.0, 9);
+  s.seed = 22;
+  specs.push_back(s);
+  s = runningLeg();
+  s.name = "leg_gait_70hz";
+  s.description =
+      "planar leg as leg_running_200hz, positions at 70 Hz with 2e-3 rad of noise flat to "
+      "15 Hz (motion capture), no velocities; contact force at 1 kHz";
+  s.sensor.rate = 70.0;
+  s.sensor.coloured_noise = 2e-3;
+  s.sensor.coloured_corner = 15.0;
+  s.velocities = false;
+  s.seed = 23;
+  specs.push_back(s);
+}
+
 std::vector<SceneSpec> sceneSpecs(const std::string& data, bool quick) {
   const std::string panda = readFile(data + "/urdf/chains/panda_chain.urdf");
   std::vector<SceneSpec> specs = mainScenes(panda);
@@ -629,6 +700,7 @@ std::vector<SceneSpec> sceneSpecs(const std::string& data, bool quick) {
     robotScenes(data, specs);
   }
   realLogScenes(panda, quick, specs);
+  colouredScenes(panda, quick, specs);
   if (quick)
     for (SceneSpec& s : specs) s.duration = std::min(s.duration, s.quick_duration);
   return specs;
@@ -1140,6 +1212,9 @@ struct Options {
   int repeat = 5;
   std::string data = JLE_ACCURACY_DATA;
   std::vector<std::string> only_scenes;
+  bool offline = false;      // only the offline zero-phase rows
+  bool no_wrenches = false;  // every scene without its wrench inputs
+  std::string cutoffs_path;  // the automatic cutoffs against the best fixed one
 };
 
 // 0: run; 1: --help printed; 2: a usage error (printed).
@@ -1161,6 +1236,12 @@ int parseOptions(int argc, char** argv, Options& o) {
         o.only_scenes.push_back(value());
       } else if (arg == "--data") {
         o.data = value();
+      } else if (arg == "--offline") {
+        o.offline = true;
+      } else if (arg == "--no-wrenches") {
+        o.no_wrenches = true;
+      } else if (arg == "--cutoffs") {
+        o.cutoffs_path = value();
       } else if (arg == "--help") {
         std::fputs(kUsage, stdout);
         return 1;
@@ -1187,6 +1268,14 @@ struct Checks {
   int exact_runs = 0;
 };
 
+// An automatic cutoff rule's row of the cutoff report: label, cutoff [Hz], effort RMS
+// error over all joints [N m], whether it warned.
+struct AutomaticRow {
+  std::string label;
+  double cutoff, rms_effort;
+  bool warned;
+};
+
 // What one scene's runs share.
 struct SceneRun {
   const Scene& scene;
@@ -1198,6 +1287,8 @@ struct SceneRun {
   bool described = false;
   std::FILE* csv = nullptr;
   Checks* checks = nullptr;
+  std::FILE* cutoffs = nullptr;  // --cutoffs: the report of the automatic cutoffs, or null
+  std::vector<AutomaticRow> automatic;
 };
 
 // One differentiator's (precision, savings) configurations on the scene.
@@ -1345,25 +1436,37 @@ Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutof
   return out;
 }
 
-// Offline: the whole record's positions through smoothZeroPhase at their stamps, every
+// The readings' positions, or their measured velocities (`rates`), samples x nq.
+Eigen::MatrixXd readingMatrix(const Scene& scene, bool rates) {
+  const std::vector<jle::JointReading>& joints = scene.readings.joints;
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(joints.size()), scene.truth->model().nq);
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    x.row(static_cast<Eigen::Index>(k)) = (rates ? joints[k].qd : joints[k].q).transpose();
+  return x;
+}
+
+// Offline: the whole record's positions through smoothZeroPhase at their stamps (with
+// the measured velocities as evidence if `velocities` and the scene has them), every
 // wrench input through lowPassZeroPhase with the same cutoff at its own stamps, and the
 // same inverse dynamics as the online path (the core's forwardKinematics,
-// addExternalWrench, inverseDynamics). An estimate for every sample, no delay.
-void runZeroPhase(SceneRun& run, const Differentiator& diff) {
+// addExternalWrench, inverseDynamics). An estimate for every sample, no delay. `choice`:
+// how the cutoff was chosen.
+RunResult zeroPhaseRun(const SceneRun& run, const jle::ZeroPhaseConfig& config, bool velocities,
+                       jle::CutoffChoice& choice) {
   const Scene& scene = run.scene;
   const jle::Model<double>& model = scene.truth->model();
   const std::size_t n = scene.readings.joints.size();
   const double cpu_start = threadCpuSeconds();
   const auto start = std::chrono::steady_clock::now();
-  Eigen::MatrixXd x(static_cast<Eigen::Index>(n), model.nq);
-  for (std::size_t k = 0; k < n; ++k)
-    x.row(static_cast<Eigen::Index>(k)) = scene.readings.joints[k].q.transpose();
-  const jle::ZeroPhaseResult zp = jle::smoothZeroPhase(scene.stamps, x, diff.zero_phase);
+  const Eigen::MatrixXd v =
+      velocities && scene.spec.velocities ? readingMatrix(scene, true) : Eigen::MatrixXd();
+  const jle::ZeroPhaseResult zp =
+      jle::smoothZeroPhase(scene.stamps, readingMatrix(scene, false), config, v);
   std::vector<Eigen::MatrixXd> wrenches;
   std::vector<int> frames;
   for (std::size_t i = 0; i < run.inputs.size(); ++i) {
-    wrenches.push_back(filteredWrench(scene.readings, static_cast<int>(i), zp.cutoff,
-                                      diff.zero_phase.order, scene.stamps));
+    wrenches.push_back(
+        filteredWrench(scene.readings, static_cast<int>(i), zp.cutoff, config.order, scene.stamps));
     frames.push_back(model.frameIndex(run.inputs[i].link));
   }
   Outputs out;
@@ -1390,16 +1493,65 @@ void runZeroPhase(SceneRun& run, const Differentiator& diff) {
   result.wall_us = elapsed / static_cast<double>(n);
   result.cpu_us = 1e6 * (threadCpuSeconds() - cpu_start) / static_cast<double>(n);
   result.cutoff_hz = zp.cutoff;
+  choice = zp.choice;
+  return result;
+}
+
+// One offline row: the run, its warnings on standard error, its CSV rows; and, for the
+// automatic rules, the cutoff and error into the scene's cutoff report.
+void runZeroPhase(SceneRun& run, const Differentiator& diff) {
+  jle::CutoffChoice choice;
+  const RunResult result = zeroPhaseRun(run, diff.zero_phase, diff.velocities, choice);
+  for (const std::string& warning : choice.warnings)
+    std::fprintf(stderr, "accuracy: %s, %s: %s\n", run.scene.spec.name.c_str(), diff.label.c_str(),
+                 warning.c_str());
   ++run.runs;
-  writeRows(run.csv, scene.spec, diff, 0.0, "double", "default", result, run.described);
+  writeRows(run.csv, run.scene.spec, diff, 0.0, "double", "default", result, run.described);
+  if (diff.zero_phase.rule != jle::CutoffRule::kFixed)
+    run.automatic.push_back(
+        {diff.label, result.cutoff_hz, result.joints.back().rms_effort, !choice.warnings.empty()});
+}
+
+// --cutoffs: the best fixed cutoff (an oracle that knows the truth: fixed cutoffs from
+// 1 Hz at ratio 1.1 up to 0.4 of the rate, at most 100 Hz) and its effort error, then per
+// automatic row its cutoff and its effort error over the oracle's ("W": warned), one
+// markdown table row per scene (the header before the first).
+void reportCutoffs(SceneRun& run, bool& header) {
+  if (!run.cutoffs || run.automatic.empty()) return;
+  const SceneSpec& spec = run.scene.spec;
+  double best_cutoff = 0.0, best = std::numeric_limits<double>::infinity();
+  jle::ZeroPhaseConfig fixed;
+  fixed.rule = jle::CutoffRule::kFixed;
+  for (double f = 1.0; f <= std::min(100.0, 0.4 * spec.sensor.rate); f *= 1.1) {
+    fixed.cutoff = f;
+    jle::CutoffChoice unused;
+    const double e = zeroPhaseRun(run, fixed, false, unused).joints.back().rms_effort;
+    if (e < best) best = e, best_cutoff = f;
+  }
+  if (!header) {
+    std::fprintf(run.cutoffs, "| scene | rate [Hz] | best fixed: cutoff [Hz], effort RMS [N m] |");
+    for (const AutomaticRow& a : run.automatic)
+      std::fprintf(run.cutoffs, " %s: cutoff [Hz], / best |", a.label.c_str());
+    std::fprintf(run.cutoffs, "\n|---|---|---|");
+    for (std::size_t i = 0; i < run.automatic.size(); ++i) std::fprintf(run.cutoffs, "---|");
+    std::fprintf(run.cutoffs, "\n");
+    header = true;
+  }
+  std::fprintf(run.cutoffs, "| `%s` | %g | %.3g, %.3g |", spec.name.c_str(), spec.sensor.rate,
+               best_cutoff, best);
+  for (const AutomaticRow& a : run.automatic)
+    std::fprintf(run.cutoffs, " %.3g, %.2f%s |", a.cutoff, a.rms_effort / best,
+                 a.warned ? " W" : "");
+  std::fprintf(run.cutoffs, "\n");
+  std::fflush(run.cutoffs);
 }
 
 void runScene(const SceneSpec& spec, const std::vector<Differentiator>& diffs, int repeat,
-              std::FILE* csv, Checks& checks) {
+              std::FILE* csv, std::FILE* cutoffs, bool& cutoffs_header, Checks& checks) {
   const auto scene_start = std::chrono::steady_clock::now();
   const Scene scene = buildScene(spec);
   const jle::Model<double>& model = scene.truth->model();
-  SceneRun run{scene, {}, {}, {}, spec.timed ? repeat : 1, 0, false, csv, &checks};
+  SceneRun run{scene, {}, {}, {}, spec.timed ? repeat : 1, 0, false, csv, &checks, cutoffs, {}};
   for (const std::string& link : spec.wrench_links) {
     jle::WrenchInputConfig in;
     in.name = link;
@@ -1425,6 +1577,7 @@ void runScene(const SceneSpec& spec, const std::vector<Differentiator>& diffs, i
                           ? variants
                           : std::vector<SavingsVariant>{variants.front()});
   }
+  reportCutoffs(run, cutoffs_header);
   std::fflush(csv);
   std::fprintf(
       stderr, "accuracy: scene %-18s %4d runs, %6zu samples, %.1f s\n", spec.name.c_str(), run.runs,
@@ -1460,16 +1613,30 @@ int main(int argc, char** argv) {
         "max_moment,rel_rms_effort,rel_rms_force,rel_rms_moment,stamp_lag_ms,"
         "phase_lag_ms,delay_ms,time_per_sample_us,cpu_per_sample_us,rate_hz,"
         "shipped_default,planar_share,overshoot,cutoff_hz,scene_description\n");
+    std::FILE* cutoffs = nullptr;
+    if (!options.cutoffs_path.empty()) {
+      cutoffs = std::fopen(options.cutoffs_path.c_str(), "w");
+      if (!cutoffs) throw std::runtime_error("cannot write " + options.cutoffs_path);
+    }
+    bool cutoffs_header = false;
     Checks checks;
-    const std::vector<Differentiator> diffs = differentiators(options.quick);
+    std::vector<Differentiator> diffs = differentiators(options.quick);
+    if (options.offline)
+      diffs.erase(
+          std::remove_if(diffs.begin(), diffs.end(),
+                         [](const Differentiator& d) { return d.family != kZeroPhaseFamily; }),
+          diffs.end());
     const auto study_start = std::chrono::steady_clock::now();
-    for (const SceneSpec& spec : sceneSpecs(options.data, options.quick)) {
+    for (SceneSpec spec : sceneSpecs(options.data, options.quick)) {
+      if (options.no_wrenches) spec.wrench_links.clear();
       if (options.only_scenes.empty() ||
           std::find(options.only_scenes.begin(), options.only_scenes.end(), spec.name) !=
               options.only_scenes.end())
-        runScene(spec, diffs, options.repeat, csv, checks);
+        runScene(spec, diffs, options.repeat, csv, cutoffs, cutoffs_header, checks);
     }
     if (std::fclose(csv) != 0) throw std::runtime_error("cannot write " + options.csv_path);
+    if (cutoffs && std::fclose(cutoffs) != 0)
+      throw std::runtime_error("cannot write " + options.cutoffs_path);
     reportChecks(checks);
     std::fprintf(
         stderr, "accuracy: study %.1f s\n",

@@ -151,6 +151,7 @@ int main(int argc, char** argv) {
     const Trial trial = makeTrial(truth, s, duration);
     printRow(s, "residual", evaluate(truth, trial, jle::CutoffRule::kResidual, 0.0));
     printRow(s, "GCV", evaluate(truth, trial, jle::CutoffRule::kGcv, 0.0));
+    printRow(s, "noise spectrum", evaluate(truth, trial, jle::CutoffRule::kSpectrum, 0.0));
     printRow(s, "best fixed (oracle)", bestFixed(truth, trial, s.rate));
     std::fflush(stdout);
   }

@@ -17,6 +17,10 @@ jle_add_unit_test(test_zero_phase_reference unit/test_zero_phase_reference.cpp)
 target_compile_definitions(test_zero_phase_reference PRIVATE
   JLE_TEST_SCRIPTS="${PROJECT_SOURCE_DIR}/test/scripts")
 add_dependencies(test_zero_phase_reference joint_loads)
+# The zero-phase cutoff on coloured noise against the truth and the best fixed cutoff;
+# joint_loads' choice, loads and warnings.
+jle_add_unit_test(test_zero_phase_coloured unit/test_zero_phase_coloured.cpp)
+add_dependencies(test_zero_phase_coloured joint_loads)
 jle_add_unit_test(test_adaptive_differentiator unit/test_adaptive_differentiator.cpp)
 jle_add_unit_test(test_estimator unit/test_estimator.cpp)
 # Measured joint velocities (measured_velocity) against the exact loads of an analytic motion.

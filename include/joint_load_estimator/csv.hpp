@@ -147,8 +147,10 @@ struct StateColumns {
   /// JOINT.q, JOINT.qd, JOINT.qdd.
   std::vector<int> q, qd, qdd;
   std::vector<WrenchColumns> wrenches;  ///< in the order of their first column
-  /// ExtraStateInputs::positions_only and the header has no JOINT.qd or JOINT.qdd
-  /// column: qd and qdd are all -1 (the caller estimates them).
+  /// ExtraStateInputs::positions_only and the header has no JOINT.qdd column, and
+  /// JOINT.qd for no joint (qd all -1) or for every joint (measured velocities, the
+  /// evidence of the zero-phase cutoff): qdd is all -1 (the caller estimates q's rate and
+  /// acceleration).
   bool positions_only = false;
 };
 
@@ -160,8 +162,9 @@ struct ExtraStateInputs {
   /// Force plates: for each NAME, plate@NAME.fx ... .mz are required; a plate@ column
   /// of another name is refused.
   std::vector<std::string> plates;
-  /// A header with JOINT.q of every joint and no JOINT.qd or JOINT.qdd at all is
-  /// accepted (StateColumns::positions_only); one that has some of them must have all.
+  /// A header with JOINT.q of every joint, no JOINT.qdd at all and JOINT.qd of no joint
+  /// or of every joint is accepted (StateColumns::positions_only); one that has some
+  /// JOINT.qdd must have all of JOINT.qd and JOINT.qdd.
   bool positions_only = false;
 };
 

@@ -517,11 +517,16 @@ class StateHeader {
   void checkJoints() {
     std::vector<std::string> missing;
     if (out_.t < 0) missing.push_back("t");
-    // Positions only: no JOINT.qd or JOINT.qdd column at all, when the caller allows it.
-    out_.positions_only =
-        extra_.positions_only && model_.nq > 0 &&
-        std::all_of(out_.qd.begin(), out_.qd.end(), [](int c) { return c < 0; }) &&
-        std::all_of(out_.qdd.begin(), out_.qdd.end(), [](int c) { return c < 0; });
+    // Positions only: no JOINT.qdd column at all and JOINT.qd for no joint or for every
+    // joint (measured velocities), when the caller allows it.
+    const auto none = [](const std::vector<int>& c) {
+      return std::all_of(c.begin(), c.end(), [](int i) { return i < 0; });
+    };
+    const auto every = [](const std::vector<int>& c) {
+      return std::all_of(c.begin(), c.end(), [](int i) { return i >= 0; });
+    };
+    out_.positions_only = extra_.positions_only && model_.nq > 0 && none(out_.qdd) &&
+                          (none(out_.qd) || every(out_.qd));
     const int kinds = out_.positions_only ? 1 : 3;
     for (int k = 0; k < model_.nq; ++k)
       for (int kind = 0; kind < kinds; ++kind)

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace jle {
 namespace {
@@ -183,27 +185,51 @@ double relativeCutoff(const Grid& grid, double cutoff) {
   return w;
 }
 
-// The channels that a cutoff is chosen for: x at the stamps t, xg on the grid; and the
-// search's constants.
+// Rate and acceleration of the padded smoothed channels at the grid's samples, by 5-point
+// central differences (error O(h^4)); the padding supplies the neighbours at the ends.
+void differentiate(const Eigen::MatrixXd& padded, int pad, double h, Eigen::MatrixXd& rate,
+                   Eigen::MatrixXd& accel) {
+  const Eigen::Index n = padded.rows() - 2 * pad;
+  const auto y = [&](Eigen::Index k, int d) { return padded.row(pad + k + d); };
+  rate.resize(n, padded.cols());
+  accel.resize(n, padded.cols());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    rate.row(k) = (y(k, -2) - 8.0 * y(k, -1) + 8.0 * y(k, 1) - y(k, 2)) / (12.0 * h);
+    accel.row(k) =
+        (-y(k, -2) + 16.0 * y(k, -1) - 30.0 * y(k, 0) + 16.0 * y(k, 1) - y(k, 2)) / (12.0 * h * h);
+  }
+}
+
+// The channels that a cutoff is chosen for: x at the stamps t, xg on the grid, the
+// measured velocities v at t (null: none); and the search's constants.
 struct CutoffSearch {
   const Grid& grid;
   const std::vector<double>& t;
   const Eigen::MatrixXd& x;
   const Eigen::MatrixXd& xg;
+  const Eigen::MatrixXd* v;
   int order, pad;
   double w_lo;        // the lowest cutoff searched [1/sample]
-  double margin = 0;  // [s] left out of the residual at each end
+  double w_hi;        // the highest [1/sample]
+  double margin = 0;  // [s] left out of the scores at each end
+  // The noise spectrum's cutoff once found (it is asked for by several checks), and
+  // whether it found a floor; spectrum_w < 0: not yet.
+  mutable double spectrum_w = -1.0;
+  mutable bool spectrum_found = false;
+
+  // Whether time s is far enough from the ends to be scored: there the padding's
+  // transient (odd reflection bends the curvature) would dominate at low cutoffs.
+  bool inside(double s) const { return s - t.front() >= margin && t.back() - s >= margin; }
 
   // Mean square of x - smooth(x) over every channel at cutoff w [1/sample], at the input
   // stamps (the measurements themselves, not their resampling, whose interpolation
-  // colours the noise), away from the ends: there the padding's transient (odd
-  // reflection bends the curvature) would dominate the residual at low cutoffs.
+  // colours the noise), away from the ends.
   double meanSquareResidual(double w) const {
     const Eigen::MatrixXd s = atStamps(grid, t, smoothPadded(xg, w, order, pad), pad);
     double sum = 0.0;
     long count = 0;
     for (std::size_t i = 0; i < t.size(); ++i) {
-      if (t[i] - t.front() < margin || t.back() - t[i] < margin) continue;
+      if (!inside(t[i])) continue;
       const auto row = static_cast<Eigen::Index>(i);
       sum += (x.row(row) - s.row(row)).squaredNorm();
       ++count;
@@ -225,11 +251,80 @@ struct CutoffSearch {
     const double dof = 1.0 - trace / static_cast<double>(n);
     return meanSquareResidual(w) / (dof * dof);
   }
+
+  // The grid's rate (or acceleration) of x at cutoff w, channel c, at stamp i
+  // (interpolated linearly between grid samples).
+  static double atStamp(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& y,
+                        std::size_t i, Eigen::Index c) {
+    double f = 0.0;
+    const int k = grid.uniform ? static_cast<int>(i) : intervalOf(grid, t[i], f);
+    return (1.0 - f) * y(k, c) + f * y(std::min(k + 1, grid.m), c);
+  }
+
+  // Whether stamp i is scored by the velocity evidence: all but the first and the last
+  // 0.5 s of the record (a tenth of a shorter one), the project's convention for loads
+  // near a record's end. Beyond them the padding's error is the error the loads will
+  // have, and the measured velocities see it; nearer the ends it is large at any cutoff
+  // searched, and would drive the choice.
+  bool evidenceAt(std::size_t i) const {
+    const double end = std::min(0.5, (t.back() - t.front()) / 10.0);
+    return i > 0 && i + 1 < t.size() && t[i] - t.front() >= end && t.back() - t[i] >= end;
+  }
+
+  // The velocity evidence's score at cutoff w: the mean square of (zero-phase acceleration
+  // of x) - (central difference of the measured velocities, (v[i+1] - v[i-1]) /
+  // (t[i+1] - t[i-1])) over the scored stamps where both velocities are finite. With the
+  // velocities' noise independent of the positions', its expectation is the
+  // acceleration's mean square error (what the loads' error follows) plus a constant, the
+  // difference's own error; the difference's noise is mostly near the Nyquist rate, where
+  // the smoothed acceleration has little, so the score's scatter is small.
+  double velocityScore(double w) const {
+    Eigen::MatrixXd rate, accel;
+    differentiate(smoothPadded(xg, w, order, pad), pad, grid.h, rate, accel);
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (!evidenceAt(i)) continue;
+      const auto row = static_cast<Eigen::Index>(i);
+      for (Eigen::Index c = 0; c < x.cols(); ++c) {
+        const double a_v = ((*v)(row + 1, c) - (*v)(row - 1, c)) / (t[i + 1] - t[i - 1]);
+        if (!std::isfinite(a_v)) continue;
+        const double d = atStamp(grid, t, accel, i, c) - a_v;
+        sum += d * d;
+        ++count;
+      }
+    }
+    return sum / static_cast<double>(std::max(1L, count));
+  }
+
+  // The mean square of (zero-phase rate of x at cutoff w) - (measured velocity), and of
+  // the rate itself (`rate_square`), over the scored stamps with a finite velocity.
+  double rateDifference(double w, double& rate_square) const {
+    Eigen::MatrixXd rate, accel;
+    differentiate(smoothPadded(xg, w, order, pad), pad, grid.h, rate, accel);
+    double sum = 0.0, sum_rate = 0.0;
+    long count = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (!evidenceAt(i)) continue;
+      for (Eigen::Index c = 0; c < x.cols(); ++c) {
+        const double measured = (*v)(static_cast<Eigen::Index>(i), c);
+        if (!std::isfinite(measured)) continue;
+        const double r = atStamp(grid, t, rate, i, c);
+        sum += (r - measured) * (r - measured);
+        sum_rate += r * r;
+        ++count;
+      }
+    }
+    const double n = static_cast<double>(std::max(1L, count));
+    rate_square = sum_rate / n;
+    return sum / n;
+  }
 };
 
 // Winter's residual analysis: the residual's RMS R(w) is a straight line where it holds
 // only noise (fitted over 0.2 .. 0.4 of the sampling rate); its intercept a at w = 0
-// estimates the noise, and the cutoff is where R(w) = a (bisection on log w).
+// estimates the noise, and the cutoff is where R(w) = a (bisection on log w), at most
+// w_hi.
 double residualCutoff(const CutoffSearch& search) {
   const int fits = 9;
   double sw = 0, sr = 0, sww = 0, swr = 0;
@@ -247,15 +342,17 @@ double residualCutoff(const CutoffSearch& search) {
     const double mid = 0.5 * (lo + hi);
     (above(std::exp(mid)) ? lo : hi) = mid;
   }
-  return std::exp(hi);
+  return std::min(search.w_hi, std::exp(hi));
 }
 
-// The GCV minimum over w_lo .. 0.4: a scan at ratio 1.1, then a golden section between the
-// best scanned point's neighbours (on log w).
-double gcvCutoff(const CutoffSearch& search) {
-  const auto score = [&](double log_w) { return search.gcvScore(std::exp(log_w)); };
-  const double step = std::log(1.1), lo = std::log(search.w_lo);
-  const int steps = std::max(1, static_cast<int>(std::ceil((std::log(0.4) - lo) / step)));
+// The minimum of score(w) over w_lo .. w_hi: a scan at ratio 1.1, then a golden section
+// between the best scanned point's neighbours (on log w).
+template <typename Score>
+double minimiseOnLog(const Score& score_of_w, double w_lo, double w_hi) {
+  const auto score = [&](double log_w) { return score_of_w(std::exp(log_w)); };
+  const double lo = std::log(w_lo), hi = std::log(w_hi);
+  const int steps = std::max(1, static_cast<int>(std::ceil((hi - lo) / std::log(1.1))));
+  const double step = (hi - lo) / steps;
   int best = 0;
   double best_score = score(lo);
   for (int j = 1; j <= steps; ++j) {
@@ -276,36 +373,220 @@ double gcvCutoff(const CutoffSearch& search) {
   return std::exp(0.5 * (a + b));
 }
 
-// The cutoff [Hz] of the rule for the channels x at the stamps t (xg on the grid). The
-// lowest cutoff searched is a thousandth of the rate or one period over the record; the
-// residual leaves out two periods of that cutoff at each end, at most a quarter of the
-// record.
-double cutoffOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
-                const Eigen::MatrixXd& xg, const ZeroPhaseConfig& config) {
-  if (config.rule == CutoffRule::kFixed) return config.cutoff;
-  const double w_lo = std::max(1e-3, 1.0 / grid.m);
-  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
-  CutoffSearch search{grid, t, x, xg, config.order, pad, w_lo};
-  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
-                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
-  const double w =
-      config.rule == CutoffRule::kResidual ? residualCutoff(search) : gcvCutoff(search);
-  return w / grid.h;
+// The spectrum of the grid channels in bands between the cutoffs w[j] and w[j + 1] (ratio
+// 1.1 from w_lo to 0.4): each band's power (the difference of two zero-phase low-passes
+// of order kAnalysisOrder per pass, steep enough that the motion's lines do not leak
+// into the noise floor), over the power that white noise of unit variance puts in it
+// (the same difference of gains, averaged over the L DFT frequencies): the level of
+// white noise that would give the band's power.
+constexpr int kAnalysisOrder = 8;
+
+std::vector<double> bandLevels(const CutoffSearch& search, std::vector<double>& w) {
+  w.clear();
+  for (double c = search.w_lo; c < 0.4; c *= 1.1) w.push_back(c);
+  if (w.size() < 2) return {};  // a record too short for a band below 0.4 of the rate
+  const Eigen::Index n = search.xg.rows();
+  const int pad = paddingOf(0, kAnalysisOrder, static_cast<int>(n));
+  Eigen::VectorXd tan2(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double tk = std::tan(M_PI * static_cast<double>(k) / static_cast<double>(n));
+    tan2[k] = tk * tk;
+  }
+  const auto gains = [&](double wc) {
+    const double tc = std::tan(M_PI * wc);
+    return Eigen::VectorXd((1.0 + (tan2 / (tc * tc)).array().pow(kAnalysisOrder)).inverse());
+  };
+  std::vector<double> level;
+  Eigen::MatrixXd before = smoothPadded(search.xg, w[0], kAnalysisOrder, pad);
+  Eigen::VectorXd gain_before = gains(w[0]);
+  for (std::size_t j = 0; j + 1 < w.size(); ++j) {
+    const Eigen::MatrixXd after = smoothPadded(search.xg, w[j + 1], kAnalysisOrder, pad);
+    const Eigen::VectorXd gain_after = gains(w[j + 1]);
+    double power = 0.0;
+    long count = 0;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (!search.inside(search.grid.at(static_cast<int>(k)))) continue;
+      power += (after.row(pad + k) - before.row(pad + k)).squaredNorm();
+      count += search.xg.cols();
+    }
+    const double white = (gain_after - gain_before).squaredNorm() / static_cast<double>(n);
+    level.push_back(std::max(1e-300, power / static_cast<double>(std::max(1L, count))) /
+                    std::max(1e-300, white));
+    before = after;
+    gain_before = gain_after;
+  }
+  return level;
 }
 
-// Rate and acceleration of the padded smoothed channels at the grid's samples, by 5-point
-// central differences (error O(h^4)); the padding supplies the neighbours at the ends.
-void differentiate(const Eigen::MatrixXd& padded, int pad, double h, Eigen::MatrixXd& rate,
-                   Eigen::MatrixXd& accel) {
-  const Eigen::Index n = padded.rows() - 2 * pad;
-  const auto y = [&](Eigen::Index k, int d) { return padded.row(pad + k + d); };
-  rate.resize(n, padded.cols());
-  accel.resize(n, padded.cols());
-  for (Eigen::Index k = 0; k < n; ++k) {
-    rate.row(k) = (y(k, -2) - 8.0 * y(k, -1) + 8.0 * y(k, 1) - y(k, 2)) / (12.0 * h);
-    accel.row(k) =
-        (-y(k, -2) + 16.0 * y(k, -1) - 30.0 * y(k, 0) + 16.0 * y(k, 1) - y(k, 2)) / (12.0 * h * h);
+// Where the positions' spectrum meets its noise floor. The levels' upper envelope from
+// above (the highest level at or above each band: a motion's spectrum is lumpy, a
+// periodic one made of lines) is followed up in frequency; the first band from which it
+// falls by less than kFlatSlope (log-log) over the next octave, kFloorBelowPeak under the
+// highest level, starts the floor; the floor is the median level of that octave, and the
+// cutoff is where the envelope, coming down, crosses twice the floor (motion's power
+// equal to the noise's: a Wiener filter's gain of 1/2). Coloured noise that is flat to a
+// corner and falls above it has its floor below the corner, as white noise has.
+// `found`: false when there is no floor up to 0.4 of the rate; then w_hi.
+constexpr double kFlatSlope = -1.5;
+constexpr double kFloorBelowPeak = 1e-3;
+
+double findSpectrumCutoff(const CutoffSearch& search, bool& found) {
+  std::vector<double> w;
+  const std::vector<double> level = bandLevels(search, w);
+  const int bands = static_cast<int>(level.size()), octave = 7;  // 1.1^7 = 1.95
+  const auto centre = [&](int j) { return std::sqrt(w[j] * w[j + 1]); };
+  std::vector<double> envelope(level);
+  for (int j = bands - 2; j >= 0; --j) envelope[j] = std::max(envelope[j], envelope[j + 1]);
+  found = false;
+  int knee = 0;
+  for (; knee + octave < bands; ++knee) {  // none when there are octave + 1 bands or fewer
+    const double slope = std::log(envelope[knee + octave] / envelope[knee]) /
+                         std::log(centre(knee + octave) / centre(knee));
+    if (slope > kFlatSlope && envelope[knee] < kFloorBelowPeak * envelope[0]) {
+      found = true;
+      break;
+    }
   }
+  if (!found) return search.w_hi;
+  std::vector<double> floor(level.begin() + knee, level.begin() + knee + octave + 1);
+  std::nth_element(floor.begin(), floor.begin() + octave / 2, floor.end());
+  const double twice_floor = 2.0 * floor[octave / 2];
+  int c = knee;
+  while (c >= 0 && envelope[c] <= twice_floor) --c;
+  if (c < 0) return search.w_lo;
+  // The crossing between the centres of bands c and c + 1, interpolated on log-log.
+  const double u = std::log(envelope[c] / twice_floor) / std::log(envelope[c] / envelope[c + 1]);
+  const double crossing = std::exp(std::log(centre(c)) + u * std::log(centre(c + 1) / centre(c)));
+  return std::max(search.w_lo, std::min(search.w_hi, crossing));
+}
+
+// findSpectrumCutoff, once per search.
+double spectrumCutoff(const CutoffSearch& search, bool& found) {
+  if (search.spectrum_w < 0.0)
+    search.spectrum_w = findSpectrumCutoff(search, search.spectrum_found);
+  found = search.spectrum_found;
+  return search.spectrum_w;
+}
+
+// One automatic rule's cutoff [1/sample]; `found`: false when kSpectrum found no floor.
+double ruleCutoff(const CutoffSearch& search, CutoffRule rule, bool& found) {
+  found = true;
+  switch (rule) {
+    case CutoffRule::kResidual: return residualCutoff(search);
+    case CutoffRule::kGcv:
+      return minimiseOnLog([&](double w) { return search.gcvScore(w); }, search.w_lo, search.w_hi);
+    case CutoffRule::kVelocity:
+      return minimiseOnLog([&](double w) { return search.velocityScore(w); }, search.w_lo,
+                           search.w_hi);
+    default: return spectrumCutoff(search, found);
+  }
+}
+
+std::string hz(double f) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g Hz", f);
+  return text;
+}
+
+// A warning when the `other` rule's cutoff and the choice's differ by more than
+// kCutoffDisagreement.
+void warnAbout(const CutoffSearch& search, CutoffRule other, CutoffChoice& choice) {
+  bool found = true;
+  const double f = ruleCutoff(search, other, found) / search.grid.h;
+  const double ratio = std::max(f / choice.cutoff, choice.cutoff / f);
+  if (!(ratio > kCutoffDisagreement)) return;
+  char text[64];
+  std::snprintf(text, sizeof text, "%.3g Hz, %.1fx ", f, ratio);
+  choice.warnings.push_back(
+      std::string("zero-phase cutoff: ") + toString(other) + " chooses " + text +
+      (f > choice.cutoff ? "above " : "below ") + "the " + hz(choice.cutoff) + " of " +
+      toString(choice.rule) +
+      (other == CutoffRule::kVelocity
+           ? ": the measured velocities contradict it"
+           : ": the position noise may be coloured; check the loads or give --cutoff"));
+}
+
+// Whether the measured velocities are evidence: at the noise spectrum's cutoff, their
+// mean square difference from the positions' rate is below kFollow times the rate's
+// own mean square (velocities that are all zero, in another unit or of other joints are
+// not).
+constexpr double kFollow = 0.5;
+
+bool velocitiesFollow(const CutoffSearch& search) {
+  bool found = true;
+  double rate_square = 0.0;
+  const double difference = search.rateDifference(spectrumCutoff(search, found), rate_square);
+  return difference < kFollow * rate_square;
+}
+
+// The automatic choice: the rule's cutoff, then the checks a user must hear about.
+CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& config) {
+  CutoffChoice choice;
+  const double h = search.grid.h;
+  choice.lowest = search.w_lo / h;
+  choice.highest = search.w_hi / h;
+  choice.rule = config.rule;
+  if (choice.rule == CutoffRule::kVelocity && !search.v)
+    throw std::invalid_argument(
+        "zero_phase: the velocity rule needs measured velocities (none given, or none finite)");
+  const bool follow = search.v && velocitiesFollow(search);
+  if (search.v && !follow)
+    choice.warnings.push_back(
+        "zero-phase cutoff: the measured velocities do not follow the positions' rate (all "
+        "zero, another unit or other joints?): " +
+        std::string(choice.rule == CutoffRule::kVelocity ? "used all the same" : "not used"));
+  if (choice.rule == CutoffRule::kAuto)
+    choice.rule = follow ? CutoffRule::kVelocity : CutoffRule::kSpectrum;
+  bool found = true;
+  choice.cutoff = ruleCutoff(search, choice.rule, found) / h;
+  if (!found)
+    choice.warnings.push_back("zero-phase cutoff: the positions' spectrum falls steeply up to " +
+                              hz(0.4 / h) + " (no noise floor found)");
+  if (choice.cutoff >= 0.99 * choice.highest || choice.cutoff <= 1.01 * choice.lowest)
+    choice.warnings.push_back(std::string("zero-phase cutoff: ") + hz(choice.cutoff) + " (" +
+                              toString(choice.rule) + ") is on the search's " +
+                              (choice.cutoff <= 1.01 * choice.lowest ? "lowest" : "highest") +
+                              " bound (" + hz(choice.lowest) + " .. " + hz(choice.highest) +
+                              "): the data do not settle it; check the loads or give --cutoff");
+  if (choice.rule != CutoffRule::kSpectrum) warnAbout(search, CutoffRule::kSpectrum, choice);
+  if (choice.rule == CutoffRule::kSpectrum) warnAbout(search, CutoffRule::kGcv, choice);
+  if (follow && choice.rule != CutoffRule::kVelocity)
+    warnAbout(search, CutoffRule::kVelocity, choice);
+  return choice;
+}
+
+// The cutoff of config.rule for the channels x at the stamps t (xg on the grid; v the
+// measured velocities at t or null). The lowest cutoff searched is a thousandth of the
+// rate or one period over the record, the highest config.max_cutoff or 0.4 of the rate;
+// the scores leave out two periods of the lowest at each end, at most a quarter of the
+// record.
+CutoffChoice cutoffOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
+                      const Eigen::MatrixXd& xg, const Eigen::MatrixXd* v,
+                      const ZeroPhaseConfig& config) {
+  if (config.rule == CutoffRule::kFixed) {
+    CutoffChoice choice;
+    choice.cutoff = choice.lowest = choice.highest = config.cutoff;
+    return choice;
+  }
+  const double w_lo = std::max(1e-3, 1.0 / grid.m);
+  const double w_hi = std::max(w_lo, std::min(0.4, config.max_cutoff * grid.h));
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  CutoffSearch search{grid, t, x, xg, v, config.order, pad, w_lo, w_hi};
+  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
+                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
+  return chooseAutomatic(search, config);
+}
+
+// The measured velocities if they are usable evidence (the shape of x, at least half of
+// them finite), else null.
+const Eigen::MatrixXd* evidenceOf(const Eigen::MatrixXd& x, const Eigen::MatrixXd& velocities) {
+  if (velocities.size() == 0) return nullptr;
+  if (velocities.rows() != x.rows() || velocities.cols() != x.cols())
+    throw std::invalid_argument("zero_phase: velocities are " + std::to_string(velocities.rows()) +
+                                " x " + std::to_string(velocities.cols()) + ", positions " +
+                                std::to_string(x.rows()) + " x " + std::to_string(x.cols()));
+  const long finite = static_cast<long>(velocities.array().isFinite().count());
+  return 2 * finite >= static_cast<long>(velocities.size()) ? &velocities : nullptr;
 }
 
 // The grid's smoothed value, rate and acceleration evaluated at the stamps t: value by the
@@ -339,20 +620,34 @@ const char* toString(CutoffRule rule) {
     case CutoffRule::kFixed: return "given";
     case CutoffRule::kResidual: return "residual analysis";
     case CutoffRule::kGcv: return "generalised cross-validation";
+    case CutoffRule::kSpectrum: return "noise spectrum";
+    case CutoffRule::kVelocity: return "velocity evidence";
+    case CutoffRule::kAuto: return "auto";
   }
   return "";
 }
 
 bool parseCutoffRule(const std::string& text, CutoffRule& rule) {
-  if (text != "gcv" && text != "residual") return false;
-  rule = text == "gcv" ? CutoffRule::kGcv : CutoffRule::kResidual;
-  return true;
+  const std::pair<const char*, CutoffRule> names[] = {{"auto", CutoffRule::kAuto},
+                                                      {"spectrum", CutoffRule::kSpectrum},
+                                                      {"velocity", CutoffRule::kVelocity},
+                                                      {"gcv", CutoffRule::kGcv},
+                                                      {"residual", CutoffRule::kResidual}};
+  for (const auto& [name, value] : names)
+    if (text == name) {
+      rule = value;
+      return true;
+    }
+  return false;
 }
 
 void validate(const ZeroPhaseConfig& config) {
   if (config.rule == CutoffRule::kFixed && !(config.cutoff > 0.0 && std::isfinite(config.cutoff)))
     throw std::invalid_argument("zero_phase cutoff must be finite and > 0 [Hz] (got " +
                                 std::to_string(config.cutoff) + ")");
+  if (!(config.max_cutoff > 0.0 && std::isfinite(config.max_cutoff)))
+    throw std::invalid_argument("zero_phase max_cutoff must be finite and > 0 [Hz] (got " +
+                                std::to_string(config.max_cutoff) + ")");
   if (config.order < 1 || config.order > 8)
     throw std::invalid_argument("zero_phase order must be 1..8 (got " +
                                 std::to_string(config.order) + ")");
@@ -361,22 +656,29 @@ void validate(const ZeroPhaseConfig& config) {
                                 std::to_string(config.padding) + ")");
 }
 
-double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
-                    const ZeroPhaseConfig& config) {
+CutoffChoice selectCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                          const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities) {
   validate(config);
   checkInput(t, x);
   const Grid grid = gridOf(t);
-  return cutoffOf(grid, t, x, grid.uniform ? x : resample(grid, t, x), config);
+  return cutoffOf(grid, t, x, grid.uniform ? x : resample(grid, t, x), evidenceOf(x, velocities),
+                  config);
+}
+
+double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                    const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities) {
+  return selectCutoff(t, x, config, velocities).cutoff;
 }
 
 ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
-                                const ZeroPhaseConfig& config) {
+                                const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities) {
   validate(config);
   checkInput(t, x);
   const Grid grid = gridOf(t);
   const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
   ZeroPhaseResult r;
-  r.cutoff = cutoffOf(grid, t, x, xg, config);
+  r.choice = cutoffOf(grid, t, x, xg, evidenceOf(x, velocities), config);
+  r.cutoff = r.choice.cutoff;
   const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
   const Eigen::MatrixXd padded =
       smoothPadded(xg, relativeCutoff(grid, r.cutoff), config.order, pad);

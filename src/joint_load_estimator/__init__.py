@@ -97,12 +97,13 @@ def inverse_dynamics(model, q, qd, qdd, wrenches=None, frame="child", gravity=No
     return Loads(_core._inverse_dynamics(model, q, qd, qdd, wrenches, frame, gravity, base))
 
 
-def smooth_zero_phase(t, x, cutoff=None, rule="gcv", order=4, padding=0):
+def smooth_zero_phase(t, x, cutoff=None, rule="auto", order=4, padding=0):
     """Zero-phase Butterworth smoothing and differentiation of a whole record
     (docs/zero_phase.md; joint_loads' positions-only path).
 
     t: N stamps [s], increasing; x: N x channels. cutoff [Hz], or None to choose it by
-    ``rule`` ('gcv' or 'residual'); order of each pass; padding (0: 3 (order + 1)).
+    ``rule`` ('auto': the noise spectrum of the positions, 'spectrum', 'gcv' or
+    'residual'); order of each pass; padding (0: 3 (order + 1)).
     Returns (value, rate, accel, cutoff): N x channels arrays and the cutoff used [Hz].
     """
     r = _core._smooth_zero_phase(t, x, cutoff, rule, order, padding)
@@ -114,7 +115,7 @@ def low_pass_zero_phase(t, x, cutoff, order=4, padding=0):
     return _core._low_pass_zero_phase(t, x, cutoff, order, padding)
 
 
-def process_bag(bag, urdf, config="", zero_phase=None, cutoff_rule="gcv", summary=False):
+def process_bag(bag, urdf, config="", zero_phase=None, cutoff_rule="auto", summary=False):
     """The node's estimate over a bag, through process_bag's own code (jle::processBag).
 
     bag, urdf: paths; config: the node's parameters as a YAML file ('' : defaults);

@@ -416,7 +416,8 @@ jle::ZeroPhaseConfig zeroPhaseConfig(const py::object& cutoff, const std::string
     z.rule = jle::CutoffRule::kFixed;
     z.cutoff = cutoff.cast<double>();
   } else if (!jle::parseCutoffRule(rule, z.rule)) {
-    throw std::invalid_argument("rule must be 'gcv' or 'residual', not '" + rule + "'");
+    throw std::invalid_argument(
+        "rule must be 'auto', 'spectrum', 'velocity', 'gcv' or 'residual', not '" + rule + "'");
   }
   z.order = order;
   z.padding = padding;

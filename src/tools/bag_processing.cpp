@@ -70,8 +70,9 @@ class SmoothedBag {
 
   /// Every message of the joint and force topics in `view`.
   void read(rosbag::View& view, ReuseBuffer& buffer);
-  /// Smooths them; the cutoff [Hz].
-  double smooth(const jle::ZeroPhaseConfig& config);
+  /// Smooths them (the joint states' velocities, when every message has them, as the
+  /// cutoff rule's evidence); how the cutoff was chosen.
+  jle::CutoffChoice smooth(const jle::ZeroPhaseConfig& config);
   const sensor_msgs::JointState& nextJoint() { return joints_.at(next_joint_++); }
   const geometry_msgs::WrenchStamped& nextForce(const std::string& topic) {
     Series& s = forces_.at(topic);
@@ -86,6 +87,7 @@ class SmoothedBag {
   };
   std::vector<double> times(const std::vector<jle::Stamp>& stamps, const std::string& topic) const;
   Eigen::MatrixXd positions() const;
+  Eigen::MatrixXd velocities() const;
   void filterForces(const std::string& topic, Series& s, double cutoff, int order);
 
   std::string joint_topic_;
@@ -161,11 +163,23 @@ void SmoothedBag::filterForces(const std::string& topic, Series& s, double cutof
   }
 }
 
-double SmoothedBag::smooth(const jle::ZeroPhaseConfig& config) {
+// The joint states' measured velocities, samples x joints, when every message carries
+// one per joint; else empty (no evidence).
+Eigen::MatrixXd SmoothedBag::velocities() const {
+  const std::size_t joints = joints_.front().name.size();
+  for (const sensor_msgs::JointState& m : joints_)
+    if (m.velocity.size() != joints) return Eigen::MatrixXd();
+  Eigen::MatrixXd v(joints_.size(), joints);
+  for (std::size_t i = 0; i < joints_.size(); ++i)
+    for (std::size_t j = 0; j < joints; ++j) v(i, j) = joints_[i].velocity[j];
+  return v;
+}
+
+jle::CutoffChoice SmoothedBag::smooth(const jle::ZeroPhaseConfig& config) {
   const Eigen::MatrixXd q = positions();
   jle::ZeroPhaseResult r;
   try {
-    r = jle::smoothZeroPhase(times(joint_stamps_, joint_topic_), q, config);
+    r = jle::smoothZeroPhase(times(joint_stamps_, joint_topic_), q, config, velocities());
     for (auto& [topic, series] : forces_) filterForces(topic, series, r.cutoff, config.order);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("--zero-phase: ") + e.what());
@@ -176,7 +190,7 @@ double SmoothedBag::smooth(const jle::ZeroPhaseConfig& config) {
     for (std::size_t j = 0; j < m.position.size(); ++j)
       m.position[j] = r.value(i, j), m.velocity[j] = r.rate(i, j);
   }
-  return r.cutoff;
+  return r.choice;
 }
 
 /// The bag's messages through the pipeline, in the bag's order. Everything the loop
@@ -321,12 +335,14 @@ void BagProcessor::smoothInputs(rosbag::View& view) {
   forces.insert(forces.end(), plate_topics_.begin(), plate_topics_.end());
   smoothed_ = std::make_unique<SmoothedBag>(joint_topic_, forces);
   smoothed_->read(view, buffer_);
-  const double cutoff = smoothed_->smooth(options_.smoothing);
+  const jle::CutoffChoice choice = smoothed_->smooth(options_.smoothing);
   std::fprintf(stderr,
                "process_bag: --zero-phase: Butterworth order %d per pass, forward and backward, "
                "cutoff %.6g Hz (%s); differentiator: central differences of the smoothed "
                "positions\n",
-               options_.smoothing.order, cutoff, jle::toString(options_.smoothing.rule));
+               options_.smoothing.order, choice.cutoff, jle::toString(choice.rule));
+  for (const std::string& warning : choice.warnings)
+    std::fprintf(stderr, "process_bag: warning: %s\n", warning.c_str());
 }
 
 void BagProcessor::onTf(const rosbag::MessageInstance& m, bool is_static) {

@@ -121,15 +121,20 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    error. Not with --plate, --frame parent|world, --kinematics,
                    --friction (the 6x6 path's outputs)
   --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
-  --cutoff HZ|auto positions only (no JOINT.qd, JOINT.qdd column): q, and with the
+  --cutoff HZ|auto positions only (no JOINT.qdd column; JOINT.qd for every joint or
+                   none: measured velocities only guide the cutoff): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
                    Butterworth low-pass run forward and backward (zero phase), and
                    q is differentiated (docs/zero_phase.md); the cutoff [Hz] given
                    (> 0 and below half the sampling rate),
                    or chosen from the q columns by --cutoff-rule (default: auto).
                    The cutoff used is printed on standard error.
-  --cutoff-rule R  gcv (generalised cross-validation, default) or residual
-                   (Winter's residual analysis); with --cutoff auto
+  --cutoff-rule R  with --cutoff auto: auto (default: the JOINT.qd columns as
+                   evidence when the CSV has them, else the positions' noise
+                   spectrum), spectrum, velocity, gcv (generalised
+                   cross-validation) or residual (Winter's residual analysis).
+                   The rule used is printed, and a warning when the choice is
+                   doubtful (on a bound of the search, or rules disagreeing)
   --filter-order N Butterworth order of each pass, 1..8 (default 4)
   --write-kinematics PATH
                    positions only: also write the smoothed inputs as a joint-state
@@ -254,7 +259,8 @@ void parseSmoothing(std::map<std::string, std::string>& v, Options& options) {
   if (v.count("--cutoff-rule")) {
     if (cutoff != "auto") throw UsageError("--cutoff-rule is only used with --cutoff auto");
     if (!jle::parseCutoffRule(v["--cutoff-rule"], z.rule))
-      throw UsageError("--cutoff-rule: '" + v["--cutoff-rule"] + "' is not gcv or residual");
+      throw UsageError("--cutoff-rule: '" + v["--cutoff-rule"] +
+                       "' is not auto, spectrum, velocity, gcv or residual");
   }
   if (v.count("--filter-order"))
     z.order = static_cast<int>(parseInteger("--filter-order", v["--filter-order"], 1, 8));
@@ -714,13 +720,17 @@ std::vector<int> forceColumns(const jle::StateColumns& columns) {
   return forces;
 }
 
-// q and the forces smoothed alike, q's rate and acceleration appended to every row and
-// `columns` pointed at them. Returns the cutoff [Hz].
-double smoothPositions(const Options& options, jle::StateColumns& columns, Record& r) {
+// q and the forces smoothed alike (the JOINT.qd columns, if any, as the cutoff rule's
+// evidence), q's rate and acceleration appended to every row and `columns` pointed at
+// them. Returns how the cutoff was chosen.
+jle::CutoffChoice smoothPositions(const Options& options, jle::StateColumns& columns, Record& r) {
   const jle::ZeroPhaseConfig& z = options.smoothing;
   const std::size_t width = r.cells.front().size(), nq = columns.q.size();
+  const bool measured =
+      std::all_of(columns.qd.begin(), columns.qd.end(), [](int c) { return c >= 0; });
   try {
-    const jle::ZeroPhaseResult k = jle::smoothZeroPhase(r.t, gather(r, columns.q), z);
+    const jle::ZeroPhaseResult k = jle::smoothZeroPhase(
+        r.t, gather(r, columns.q), z, measured ? gather(r, columns.qd) : Eigen::MatrixXd());
     for (std::size_t j = 0; j < nq; ++j) {
       columns.qd[j] = static_cast<int>(width + j);
       columns.qdd[j] = static_cast<int>(width + nq + j);
@@ -733,7 +743,7 @@ double smoothPositions(const Options& options, jle::StateColumns& columns, Recor
     if (!forces.empty())
       scatter(jle::lowPassZeroPhase(r.t, gather(r, forces), k.cutoff, z.order, z.padding), forces,
               r);
-    return k.cutoff;
+    return k.choice;
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(options.input + ": smoothing the positions (--cutoff): " + e.what());
   }
@@ -766,11 +776,13 @@ void writeKinematics(const Options& options, const jle::Model<double>& model,
 void runPositionsOnly(const Options& options, const jle::Model<double>& model,
                       jle::CsvReader& reader, jle::StateColumns columns) {
   Record record = readRecord(reader, columns, options.input);
-  const double cutoff = smoothPositions(options, columns, record);
+  const jle::CutoffChoice choice = smoothPositions(options, columns, record);
   std::fprintf(stderr,
                "joint_loads: positions only: zero-phase Butterworth, order %d per pass, "
                "cutoff %.17g Hz (%s)\n",
-               options.smoothing.order, cutoff, jle::toString(options.smoothing.rule));
+               options.smoothing.order, choice.cutoff, jle::toString(choice.rule));
+  for (const std::string& warning : choice.warnings)
+    std::fprintf(stderr, "joint_loads: warning: %s\n", warning.c_str());
   if (!options.write_kinematics.empty()) writeKinematics(options, model, columns, record);
   Processor processor(options, model, columns, record.cells.front().size());
   Output out(options, model, processor.names());

@@ -35,7 +35,7 @@ const char* const kUsage =
                    [--output OUT.bag | --csv OUT.csv [--kinematics]] [--sto OUT.sto]
                    [--smoothed-csv OUT.csv]
                    [--topic-prefix /joint_load_estimator]
-                   [--zero-phase HZ|auto [--cutoff-rule gcv|residual]]
+                   [--zero-phase HZ|auto [--cutoff-rule RULE]]
 
 Runs the joint_load_estimator node's estimate over a bag, offline and as fast as the
 machine allows: the joint states, the configured wrench and force plate topics and
@@ -85,8 +85,12 @@ bag is played to it, without the timing of a live system.
                        messages, its differentiator set to central differences
                        (finite_difference, order 2, delay 1) of the smoothed
                        positions. Every joint state must carry the same joints, in
-                       increasing stamps. The cutoff is printed.
-  --cutoff-rule R      with --zero-phase auto: gcv (default) or residual
+                       increasing stamps. The cutoff and the rule that chose it
+                       are printed, and a warning when the choice is doubtful.
+  --cutoff-rule R      with --zero-phase auto: auto (default: the joint states'
+                       velocities as evidence when every message has them, else
+                       the positions' noise spectrum), spectrum, velocity, gcv or
+                       residual (docs/zero_phase.md)
   --help               this text
 
 Frames: a wrench's frame that is not a URDF link rigid to its link, a floating base's
@@ -122,7 +126,8 @@ void parseSmoothing(std::map<std::string, std::string>& v, Options& o) {
   if (!v.count("--cutoff-rule")) return;
   if (cutoff != "auto") throw UsageError("--cutoff-rule is only used with --zero-phase auto");
   if (!jle::parseCutoffRule(v["--cutoff-rule"], o.smoothing.rule))
-    throw UsageError("--cutoff-rule: '" + v["--cutoff-rule"] + "' is not gcv or residual");
+    throw UsageError("--cutoff-rule: '" + v["--cutoff-rule"] +
+                     "' is not auto, spectrum, velocity, gcv or residual");
 }
 
 Options parseOptions(int argc, char** argv) {

@@ -207,7 +207,7 @@ def test_zero_phase_is_joint_loads_positions_only(tmp_path):
     columns, stderr = joint_loads(tmp_path, ["--urdf", PANDA, "--cutoff", "auto",
                                              "--write-kinematics", kinematics],
                                   header, np.column_stack([t, q, wrench]))
-    value, rate, accel, cutoff = jle.smooth_zero_phase(t, q)  # gcv, as joint_loads' default
+    value, rate, accel, cutoff = jle.smooth_zero_phase(t, q)  # auto, as joint_loads' default
     printed = float(re.search(r"cutoff (\S+) Hz", stderr).group(1))
     assert cutoff == pytest.approx(printed, rel=1e-15)
     smoothed = read_csv(kinematics)

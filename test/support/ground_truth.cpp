@@ -303,6 +303,55 @@ class SensorDefects {
   bool lost_ = false;  // the previous sample was lost to a gap
 };
 
+// Coloured noise and the vibration line of every coordinate at samples 0 .. samples - 1
+// (samples x nq), from stream kColouredStream; zero when the sensor has neither.
+Eigen::MatrixXd colouredNoise(const SensorModel& sensor, long samples, int nq, std::uint64_t seed) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(samples, nq);
+  if (!(sensor.coloured_noise > 0.0) && !(sensor.vibration_amplitude > 0.0)) return out;
+  PortableRandom rng(deriveSeed(seed, kColouredStream));
+  std::vector<double> phase(static_cast<std::size_t>(nq));
+  for (double& p : phase) p = rng.uniform(0.0, kTwoPi);
+  // 2nd-order Butterworth by the bilinear transform (prewarped), unit DC gain.
+  const double w = sensor.coloured_corner / sensor.rate;
+  const bool white = !(w < 0.5);
+  const double k = white ? 0.0 : std::tan(0.5 * kTwoPi * w),
+               norm = 1.0 + std::sqrt(2.0) * k + k * k;
+  const double b0 = k * k / norm, b1 = 2.0 * b0, b2 = b0;
+  const double a1 = 2.0 * (k * k - 1.0) / norm, a2 = (1.0 - std::sqrt(2.0) * k + k * k) / norm;
+  // The output's variance for unit white input: the impulse response's energy.
+  double energy = 1.0;
+  const long warm_up = white ? 0 : static_cast<long>(std::ceil(20.0 / w));
+  if (!white) {
+    energy = 0.0;
+    double z1 = 0.0, z2 = 0.0;
+    for (long i = 0; i < 4 * warm_up + 100; ++i) {
+      const double x = i == 0 ? 1.0 : 0.0, y = b0 * x + z1;
+      z1 = b1 * x - a1 * y + z2;
+      z2 = b2 * x - a2 * y;
+      energy += y * y;
+    }
+  }
+  const double scale = sensor.coloured_noise / std::sqrt(energy);
+  for (int c = 0; c < nq; ++c) {
+    double z1 = 0.0, z2 = 0.0;
+    for (long i = -warm_up; i < samples; ++i) {
+      const double x = rng.gaussian();
+      double y = x;
+      if (!white) {
+        y = b0 * x + z1;
+        z1 = b1 * x - a1 * y + z2;
+        z2 = b2 * x - a2 * y;
+      }
+      if (i < 0) continue;
+      out(i, c) = scale * y +
+                  sensor.vibration_amplitude * std::sin(kTwoPi * sensor.vibration_frequency *
+                                                            static_cast<double>(i) / sensor.rate +
+                                                        phase[static_cast<std::size_t>(c)]);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<JointReading> GroundTruth::sampleJoints(const SensorModel& sensor, double duration,
@@ -318,6 +367,7 @@ std::vector<JointReading> GroundTruth::sampleJoints(const SensorModel& sensor, d
   SensorDefects defects(sensor, seed);
   const double jitter_limit = 0.2 / sensor.rate;
   const long samples = static_cast<long>(std::floor(duration * sensor.rate + 1e-9)) + 1;
+  const Eigen::MatrixXd coloured = colouredNoise(sensor, samples, nq, seed);
   std::vector<JointReading> out;
   out.reserve(static_cast<std::size_t>(samples));
   VectorX<double> noise_q(nq), noise_qd(nq);
@@ -341,7 +391,7 @@ std::vector<JointReading> GroundTruth::sampleJoints(const SensorModel& sensor, d
     r.qd.resize(nq);
     for (int c = 0; c < nq; ++c) {
       const CoordinateState s = motion_[static_cast<std::size_t>(c)].at(r.time);
-      r.q[c] = quantise(s.q + sensor.position_noise * noise_q[c],
+      r.q[c] = quantise(s.q + sensor.position_noise * noise_q[c] + coloured(k, c),
                         resolution[static_cast<std::size_t>(c)]);
       r.qd[c] = s.qd + sensor.velocity_noise * noise_qd[c];
     }

@@ -427,6 +427,48 @@ TEST(GroundTruth, GapsLeaveTheKeptReadingsUnchanged) {
   }
 }
 
+// Coloured noise (a 2nd-order Butterworth at 50 Hz on white noise, 1 kHz): its standard
+// deviation as stated; its first difference far smaller than white noise's (sqrt(2)
+// sigma), as a low-pass at a twentieth of the rate makes it (the difference's variance
+// over the noise's is 2 (1 - rho(1)), rho(1) > 0.9 for this filter); the vibration line's
+// amplitude as stated. Drawn from its own stream: the stamps, the velocities and
+// everything else read exactly as without it.
+TEST(GroundTruth, ColouredNoiseHasItsLevelAndSpectrumAndItsOwnStream) {
+  const jle::GroundTruth truth = pandaTruth(jle::MotionKind::kStopAndGo);
+  jle::SensorModel sensor;
+  sensor.position_noise = 1e-4;
+  sensor.velocity_noise = 1e-3;
+  sensor.stamp_jitter = 1e-5;
+  jle::SensorModel coloured = sensor;
+  coloured.coloured_noise = 2.75e-4;
+  coloured.coloured_corner = 50.0;
+  const double seconds = 20.0;
+  const jle::SensorReadings a = truth.sample(sensor, seconds, 9);
+  const jle::SensorReadings b = truth.sample(coloured, seconds, 9);
+  ASSERT_EQ(a.joints.size(), b.joints.size());
+  std::vector<double> noise, step;
+  for (std::size_t k = 0; k < a.joints.size(); ++k) {
+    EXPECT_EQ(a.joints[k].stamp, b.joints[k].stamp);
+    EXPECT_EQ(a.joints[k].qd, b.joints[k].qd);
+    noise.push_back(b.joints[k].q[0] - a.joints[k].q[0]);
+    if (k > 0) step.push_back(noise[k] - noise[k - 1]);
+  }
+  // 20000 samples correlated over about 1 / (2 pi 50 Hz): some 2000 independent ones,
+  // a standard deviation known to about 2 %; 6 % is three times that.
+  EXPECT_NEAR(moments(noise).std, 2.75e-4, 0.06 * 2.75e-4);
+  EXPECT_LT(moments(step).std, 0.45 * 2.75e-4);
+  jle::SensorModel line;
+  line.vibration_amplitude = 3e-5;
+  line.vibration_frequency = 80.0;
+  const jle::SensorReadings c = truth.sample(line, 1.0, 9), exact = truth.sample({}, 1.0, 9);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < c.joints.size(); ++k)
+    largest = std::max(largest, std::abs(c.joints[k].q[1] - exact.joints[k].q[1]));
+  // 80 Hz at 1 kHz: every 25 samples hit the same phases, 14.4 degrees apart, so one lies
+  // within 7.2 degrees of a peak (cos 7.2 = 0.992).
+  EXPECT_NEAR(largest, 3e-5, 1e-6);
+}
+
 // The planar arm, from its stated geometry: link lengths L = 0.5, 0.4, 0.3 m, masses
 // m = 3, 2, 1 kg, thin rods (centre of mass at L/2, inertia m L^2 / 12 about y). A
 // rotation about +y takes x towards -z, so gravity (-z) at a horizontal offset x from a

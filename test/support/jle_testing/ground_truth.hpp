@@ -143,6 +143,8 @@ WrenchMotion randomWrench(const std::string& link, std::uint64_t seed);
 
 /// The stream of GroundTruth::sample's bursts and gaps (beyond any wrench input's).
 constexpr std::uint64_t kDefectStream = 1000;
+/// The stream of the coloured position noise and the vibration line's phases.
+constexpr std::uint64_t kColouredStream = 1001;
 
 /// What the sensors of a scene report, and how they err.
 struct SensorModel {
@@ -156,6 +158,17 @@ struct SensorModel {
   /// velocities [rad/s or m/s] (reported, not used by the Estimator).
   double position_noise = 0.0;
   double velocity_noise = 0.0;
+  /// Coloured position noise [rad or m], standard deviation: white Gaussian noise through
+  /// a 2nd-order Butterworth low-pass at coloured_corner (flat below the corner, its
+  /// power falling as f^-4 above), one independent sequence per coordinate at every
+  /// sample instant k / rate (lost samples included), added to position_noise's.
+  /// coloured_corner [Hz] at or above rate / 2: white.
+  double coloured_noise = 0.0;
+  double coloured_corner = 50.0;
+  /// A vibration line on every position: vibration_amplitude [rad or m]
+  /// sin(2 pi vibration_frequency [Hz] t + phase), the phase per coordinate uniform.
+  double vibration_amplitude = 0.0;
+  double vibration_frequency = 0.0;
   /// Standard deviation [s] of the sampling instants about k / rate; the stamps report
   /// the instants exactly (irregular sampling). Truncated at +-0.2 / rate.
   double sample_jitter = 0.0;
@@ -240,7 +253,9 @@ class GroundTruth {
   /// per sample, the drop draw, then the six noises fx .. mz. Bursts and gaps draw from
   /// stream kDefectStream, per sample: the burst start (uniform), the gap start
   /// (uniform), the gap length (index) and the burst's stamp error (gaussian); so a scene
-  /// without them reads as before they existed.
+  /// without them reads as before they existed. Coloured noise and the vibration line draw
+  /// from stream kColouredStream: the phases (one uniform per coordinate), then per
+  /// coordinate its gaussians (a warm-up of the shaping filter first, then one per sample).
   SensorReadings sample(const SensorModel& sensor, double duration, std::uint64_t seed) const;
 
  private:

@@ -1,0 +1,307 @@
+// The offline zero-phase cutoff on coloured position noise (issue 37): a 1 kHz Panda
+// recording whose encoder noise is flat to 50 Hz and falls above it, with a vibration
+// line and measured velocities of their own noise (jle_testing::GroundTruth). The loads
+// are checked against the exact ones, the cutoffs against the best fixed cutoff (an
+// oracle scanned here with the truth), and joint_loads (the real CLI, on a CSV written
+// here) for its choice, its loads and its warnings.
+#include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/zero_phase.hpp>
+
+#include <jle_testing/ground_truth.hpp>
+
+#include "tool_test.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace {
+
+const std::string kPandaChain = std::string(JLE_TEST_DATA) + "/urdf/chains/panda_chain.urdf";
+constexpr double kDuration = 6.0;  // [s]
+constexpr double kSettle = 0.5;    // [s] left out of the errors at each end (the record's ends)
+
+// The scene: stop-and-go motion, 1 kHz, exact stamps; coloured noise 2.75e-4 rad flat to
+// 50 Hz, a 3e-5 rad line at 80 Hz, velocities with 5e-3 rad/s of white noise; or none of
+// it (`noisy` false: exact positions).
+struct Recording {
+  std::unique_ptr<jle::GroundTruth> truth;
+  std::vector<double> t;
+  Eigen::MatrixXd q, qd;           // samples x nq, as the sensors report them
+  Eigen::MatrixXd true_effort;     // samples x moving joints
+  std::vector<std::string> joint;  // the moving joints' names
+};
+
+Recording record(bool noisy) {
+  const jle::Model<double> model = jle::modelFromUrdfString(jle_test::readFile(kPandaChain));
+  Recording r;
+  r.truth = std::make_unique<jle::GroundTruth>(
+      model, jle::randomMotion(model, jle::MotionKind::kStopAndGo, kDuration, 31),
+      std::vector<jle::WrenchMotion>{});
+  jle::SensorModel sensor;
+  sensor.rate = 1000.0;
+  if (noisy) {
+    sensor.coloured_noise = 2.75e-4;
+    sensor.coloured_corner = 50.0;
+    sensor.vibration_amplitude = 3e-5;
+    sensor.vibration_frequency = 80.0;
+    sensor.velocity_noise = 5e-3;
+  }
+  const std::vector<jle::JointReading> readings = r.truth->sample(sensor, kDuration, 32).joints;
+  const auto n = static_cast<Eigen::Index>(readings.size());
+  const std::vector<int>& moving = model.moving_segments;
+  r.q.resize(n, model.nq);
+  r.qd.resize(n, model.nq);
+  r.true_effort.resize(n, static_cast<Eigen::Index>(moving.size()));
+  jle::Data<double> data(model);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const jle::JointReading& reading = readings[static_cast<std::size_t>(k)];
+    r.t.push_back(reading.time);
+    r.q.row(k) = reading.q.transpose();
+    r.qd.row(k) = reading.qd.transpose();
+    r.truth->loads(reading.time, data);
+    for (std::size_t j = 0; j < moving.size(); ++j)
+      r.true_effort(k, static_cast<Eigen::Index>(j)) = data.effort[moving[j]];
+  }
+  for (int s : moving) r.joint.push_back(model.joint_name[static_cast<std::size_t>(s)]);
+  return r;
+}
+
+const Recording& coloured() {
+  static const Recording r = record(true);
+  return r;
+}
+
+// RMS over the moving joints and the samples kSettle or more from the ends of
+// (effort - true effort).
+double effortError(const Recording& r, const Eigen::MatrixXd& effort) {
+  double sum = 0.0;
+  long count = 0;
+  for (Eigen::Index k = 0; k < effort.rows(); ++k) {
+    const double t = r.t[static_cast<std::size_t>(k)];
+    if (t < kSettle || t > r.t.back() - kSettle) continue;
+    sum += (effort.row(k) - r.true_effort.row(k)).squaredNorm();
+    count += effort.cols();
+  }
+  return std::sqrt(sum / static_cast<double>(count));
+}
+
+// The efforts of the positions smoothed at `cutoff` [Hz] (the core's filter and inverse
+// dynamics), samples x moving joints.
+Eigen::MatrixXd effortsAt(const Recording& r, double cutoff) {
+  jle::ZeroPhaseConfig config;
+  config.rule = jle::CutoffRule::kFixed;
+  config.cutoff = cutoff;
+  const jle::ZeroPhaseResult zp = jle::smoothZeroPhase(r.t, r.q, config);
+  const jle::Model<double>& model = r.truth->model();
+  jle::Data<double> data(model);
+  Eigen::MatrixXd effort(r.q.rows(), r.true_effort.cols());
+  for (Eigen::Index k = 0; k < r.q.rows(); ++k) {
+    jle::forwardKinematics(model, data, jle::VectorX<double>(zp.value.row(k).transpose()),
+                           jle::VectorX<double>(zp.rate.row(k).transpose()),
+                           jle::VectorX<double>(zp.accel.row(k).transpose()), r.truth->gravity());
+    jle::inverseDynamics(model, data);
+    for (std::size_t j = 0; j < model.moving_segments.size(); ++j)
+      effort(k, static_cast<Eigen::Index>(j)) = data.effort[model.moving_segments[j]];
+  }
+  return effort;
+}
+
+// The best fixed cutoff: scanned from 1 Hz at ratio 1.1 to 40 Hz against the truth.
+struct Oracle {
+  double cutoff = 0.0, error = std::numeric_limits<double>::infinity();
+};
+
+const Oracle& oracle() {
+  static const Oracle best = [] {
+    Oracle o;
+    for (double f = 1.0; f < 40.0; f *= 1.1) {
+      const double e = effortError(coloured(), effortsAt(coloured(), f));
+      if (e < o.error) o.error = e, o.cutoff = f;
+    }
+    return o;
+  }();
+  return best;
+}
+
+// The best fixed cutoff lies where the motion meets the noise (a few Hz: the noise is
+// flat to 50 Hz), its error tens of mN m; GCV, which takes noise flat to 50 Hz for
+// motion, climbs to its bound and errs a hundred times more (docs/zero_phase.md).
+TEST(ColouredNoise, TheOracleAndGcvAreWhatTheStudyFound) {
+  EXPECT_GT(oracle().cutoff, 2.0);
+  EXPECT_LT(oracle().cutoff, 10.0);
+  jle::ZeroPhaseConfig gcv;
+  gcv.rule = jle::CutoffRule::kGcv;
+  const jle::CutoffChoice choice = jle::selectCutoff(coloured().t, coloured().q, gcv);
+  EXPECT_GT(effortError(coloured(), effortsAt(coloured(), choice.cutoff)), 10.0 * oracle().error)
+      << choice.cutoff << " Hz";
+  EXPECT_FALSE(choice.warnings.empty()) << "GCV at " << choice.cutoff << " Hz, not warned";
+}
+
+// The velocity evidence: within 1.3 times the oracle's error, its cutoff within a factor
+// of 1.5 of the oracle's.
+TEST(ColouredNoise, TheVelocityEvidencePicksNearTheBestFixedCutoff) {
+  jle::ZeroPhaseConfig config;
+  config.rule = jle::CutoffRule::kVelocity;
+  const jle::CutoffChoice choice =
+      jle::selectCutoff(coloured().t, coloured().q, config, coloured().qd);
+  EXPECT_EQ(choice.rule, jle::CutoffRule::kVelocity);
+  EXPECT_NEAR(std::log(choice.cutoff / oracle().cutoff), 0.0, std::log(1.5))
+      << choice.cutoff << " Hz against " << oracle().cutoff;
+  EXPECT_LT(effortError(coloured(), effortsAt(coloured(), choice.cutoff)), 1.3 * oracle().error);
+  EXPECT_TRUE(choice.warnings.empty()) << choice.warnings.front();
+  // The default rule with velocities given is this one.
+  EXPECT_EQ(jle::chooseCutoff(coloured().t, coloured().q, jle::ZeroPhaseConfig{}, coloured().qd),
+            choice.cutoff);
+}
+
+// Velocities that are all zero (a driver that does not fill them) are no evidence: the
+// default rule falls back to the noise spectrum, and says why.
+TEST(ColouredNoise, ZeroVelocitiesAreNotEvidence) {
+  const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(coloured().q.rows(), coloured().q.cols());
+  const jle::CutoffChoice choice =
+      jle::selectCutoff(coloured().t, coloured().q, jle::ZeroPhaseConfig{}, zero);
+  EXPECT_EQ(choice.rule, jle::CutoffRule::kSpectrum);
+  EXPECT_EQ(choice.cutoff, jle::chooseCutoff(coloured().t, coloured().q, jle::ZeroPhaseConfig{}));
+  ASSERT_FALSE(choice.warnings.empty());
+  EXPECT_NE(choice.warnings.front().find("do not follow"), std::string::npos)
+      << choice.warnings.front();
+}
+
+// A velocity rule without velocities is refused; velocities of another shape too.
+TEST(ColouredNoise, TheVelocityRuleNeedsVelocities) {
+  jle::ZeroPhaseConfig config;
+  config.rule = jle::CutoffRule::kVelocity;
+  EXPECT_THROW(jle::chooseCutoff(coloured().t, coloured().q, config), std::invalid_argument);
+  EXPECT_THROW(jle::chooseCutoff(coloured().t, coloured().q, config, coloured().qd.leftCols(3)),
+               std::invalid_argument);
+}
+
+// A record too short for a band of the spectrum (5 samples at 1 kHz: the lowest cutoff
+// searched, one period over the record, is 250 Hz, above the 50 Hz bound): the search
+// sits on its bound, and says so.
+TEST(ColouredNoise, ARecordTooShortForTheSpectrumChoosesTheBoundAndWarns) {
+  const std::vector<double> t{0.0, 0.001, 0.002, 0.003, 0.004};
+  Eigen::MatrixXd x(5, 1);
+  x << 0.0, 1e-3, -2e-3, 1.5e-3, 0.5e-3;
+  const jle::CutoffChoice choice = jle::selectCutoff(t, x, jle::ZeroPhaseConfig{});
+  EXPECT_NEAR(choice.cutoff, 250.0, 1e-9);
+  ASSERT_FALSE(choice.warnings.empty());
+  EXPECT_NE(choice.warnings.front().find("no noise floor"), std::string::npos)
+      << choice.warnings.front();
+}
+
+class JointLoadsColoured : public jle_test::ToolTest {
+ protected:
+  JointLoadsColoured() : ToolTest("jle_coloured") {}
+
+  // The recording as a joint_loads CSV: t, every J.q, and every J.qd if `velocities`.
+  void writeCsv(const std::string& name, const Recording& r, bool velocities) const {
+    const std::vector<std::string>& names = r.truth->model().coordinate_names;
+    std::string text = "t";
+    for (const std::string& j : names) text += "," + j + ".q";
+    if (velocities)
+      for (const std::string& j : names) text += "," + j + ".qd";
+    text += "\n";
+    char cell[40];
+    for (Eigen::Index k = 0; k < r.q.rows(); ++k) {
+      std::snprintf(cell, sizeof cell, "%.17g", r.t[static_cast<std::size_t>(k)]);
+      text += cell;
+      for (Eigen::Index c = 0; c < r.q.cols(); ++c) {
+        std::snprintf(cell, sizeof cell, ",%.17g", r.q(k, c));
+        text += cell;
+      }
+      for (Eigen::Index c = 0; velocities && c < r.qd.cols(); ++c) {
+        std::snprintf(cell, sizeof cell, ",%.17g", r.qd(k, c));
+        text += cell;
+      }
+      text += "\n";
+    }
+    write(name, text);
+  }
+
+  // joint_loads on the CSV; its efforts (samples x moving joints) and standard error.
+  Eigen::MatrixXd efforts(const Recording& r, const std::string& csv,
+                          const std::vector<std::string>& extra, std::string& err) const {
+    std::vector<std::string> args{"--urdf", kPandaChain, "--input", path(csv)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const jle_test::Result result = run(JLE_JOINT_LOADS, args);
+    err = result.err;
+    EXPECT_EQ(result.status, 0) << result.err;
+    const jle_test::Table table = jle_test::parseCsv(result.out);
+    Eigen::MatrixXd effort(static_cast<Eigen::Index>(table.rows.size()),
+                           static_cast<Eigen::Index>(r.joint.size()));
+    for (std::size_t k = 0; k < table.rows.size(); ++k)
+      for (std::size_t j = 0; j < r.joint.size(); ++j)
+        effort(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) =
+            table.number(k, r.joint[j] + ".effort");
+    return effort;
+  }
+
+  // The cutoff [Hz] that joint_loads printed.
+  static double printedCutoff(const std::string& err) {
+    const std::size_t at = err.find("cutoff ");
+    return at == std::string::npos ? std::nan("") : std::strtod(err.c_str() + at + 7, nullptr);
+  }
+};
+
+// Positions only, the default rule: the cutoff within a factor of 2 of the oracle's, the
+// loads within 1.3 times its error, the rule printed.
+TEST_F(JointLoadsColoured, PositionsOnlyChoosesASaneCutoffAndBoundedLoads) {
+  const Recording& r = coloured();
+  writeCsv("q.csv", r, false);
+  std::string err;
+  const Eigen::MatrixXd effort = efforts(r, "q.csv", {}, err);
+  ASSERT_EQ(effort.rows(), r.q.rows()) << err;
+  const double cutoff = printedCutoff(err);
+  EXPECT_NEAR(std::log(cutoff / oracle().cutoff), 0.0, std::log(2.0)) << err;
+  EXPECT_NE(err.find("(noise spectrum)"), std::string::npos) << err;
+  EXPECT_LT(effortError(r, effort), 1.3 * oracle().error)
+      << err << "oracle " << oracle().cutoff << " Hz, " << oracle().error << " N m";
+}
+
+// With J.qd columns: the velocity evidence chooses, and says so.
+TEST_F(JointLoadsColoured, MeasuredVelocitiesGuideTheCutoff) {
+  const Recording& r = coloured();
+  writeCsv("qqd.csv", r, true);
+  std::string err;
+  const Eigen::MatrixXd effort = efforts(r, "qqd.csv", {}, err);
+  ASSERT_EQ(effort.rows(), r.q.rows()) << err;
+  EXPECT_NE(err.find("(velocity evidence)"), std::string::npos) << err;
+  EXPECT_LT(effortError(r, effort), 1.3 * oracle().error) << err;
+}
+
+// GCV asked for on coloured noise: it climbs to the search's upper bound, and joint_loads
+// warns (the bound, and the noise spectrum's far lower choice).
+TEST_F(JointLoadsColoured, WarnsWhenTheChoiceSitsOnABound) {
+  writeCsv("q.csv", coloured(), false);
+  std::string err;
+  efforts(coloured(), "q.csv", {"--cutoff-rule", "gcv"}, err);
+  EXPECT_NE(err.find("joint_loads: warning: zero-phase cutoff: 50 Hz (generalised "
+                     "cross-validation) is on the search's highest bound"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("joint_loads: warning: zero-phase cutoff: noise spectrum chooses"),
+            std::string::npos)
+      << err;
+  // Exact positions: no noise floor for the spectrum to find; its choice is the bound.
+  const Recording exact = record(false);
+  writeCsv("exact.csv", exact, false);
+  efforts(exact, "exact.csv", {}, err);
+  EXPECT_NE(err.find("joint_loads: warning: zero-phase cutoff: 50 Hz (noise spectrum) is on "
+                     "the search's highest bound"),
+            std::string::npos)
+      << err;
+  // A given cutoff: nothing to warn about.
+  efforts(coloured(), "q.csv", {"--cutoff", "5"}, err);
+  EXPECT_EQ(err.find("warning"), std::string::npos) << err;
+}
+
+}  // namespace
