@@ -85,7 +85,9 @@ struct Differentiator {
   bool as_configured = false;
   /// Offline rows (family kZeroPhaseFamily): the zero-phase smoother instead.
   jle::ZeroPhaseConfig zero_phase;
-  /// Offline rows: the readings' measured velocities given to the smoother as evidence.
+  /// Offline rows: the readings' measured velocities given to the smoother as evidence;
+  /// online rows: given to the pipeline with the positions (measured_velocity: auto), where
+  /// the scene's sensor reports them.
   bool velocities = false;
 };
 
@@ -135,6 +137,16 @@ std::vector<Differentiator> differentiators(bool quick) {
   // What a user who changes nothing runs: jle::Settings' differentiator, whatever it is.
   const jle::DifferentiatorConfig node = jle::Settings{}.estimator.differentiator;
   out.push_back({kDefaultLabel, kDefaultLabel, node, node.measurement_noise, true, {}, false});
+  // And with the joint states' velocities where the scene has them; and the smoothed
+  // stream's default filter (README "Two streams"), without and with them: what the node
+  // publishes on ~joint_loads and ~smoothed/joint_loads.
+  out.push_back({"default + velocities", kDefaultLabel, node, node.measurement_noise, true, {},
+                 true});
+  const jle::DifferentiatorConfig smoothed = jle::Settings{}.smoothed.differentiator;
+  out.push_back({"smoothed default", "default_smoothed", smoothed, smoothed.measurement_noise,
+                 true, {}, false});
+  out.push_back({"smoothed default + velocities", "default_smoothed", smoothed,
+                 smoothed.measurement_noise, true, {}, true});
   auto add = [&](const std::string& label, const std::string& family,
                  const jle::DifferentiatorConfig& c) {
     out.push_back({label, family, c, 0.0, false, {}, false});
@@ -838,6 +850,7 @@ double threadCpuSeconds() {
 jle::Settings nodeSettings(const jle::EstimatorConfig& config) {
   jle::Settings settings;
   settings.estimator = config;
+  settings.smoothed.enabled = false;  // the configuration's own stream, timed alone
   for (const jle::WrenchInputConfig& w : config.wrenches) {
     jle::WrenchTopicSettings topic;
     topic.topic = w.name;
@@ -881,7 +894,7 @@ long readingOf(const Scene& scene, jle::Stamp stamp) {
 // named as the URDF's joints) and wrench messages in their stamp order, each with its
 // stamp as the message would carry it and the same as the arrival clock.
 Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
-                const std::vector<int>& segments) {
+                const std::vector<int>& segments, bool velocities) {
   const jle::Model<double>& model = scene.truth->model();
   const jle::SensorReadings& r = scene.readings;
   const std::size_t n = r.joints.size();
@@ -892,6 +905,8 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
   out.qdd.resize(model.nq, static_cast<Eigen::Index>(n));
   jle::Pipeline pipeline(model, nodeSettings(config), nullptr);
   std::vector<double> position(static_cast<std::size_t>(model.nq));
+  std::vector<double> velocity;
+  if (velocities && scene.spec.velocities) velocity.resize(position.size());
   const std::vector<double> none;
   std::size_t w = 0;
   Eigen::Index published = 0;
@@ -916,8 +931,9 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
                         x.force, x.moment);
     }
     for (int c = 0; c < model.nq; ++c) position[static_cast<std::size_t>(c)] = j.q[c];
+    for (std::size_t c = 0; c < velocity.size(); ++c) velocity[c] = j.qd[static_cast<int>(c)];
     if (pipeline.onJointState(scene.stamp_ns[k], scene.stamp_ns[k], model.coordinate_names,
-                              position, none, none) == jle::Outcome::kPublished)
+                              position, velocity, none) == jle::Outcome::kPublished)
       take(j.stamp);
     // A smoother's other loads due at this sample (after a longer interval or a gap).
     while (pipeline.takeDrained()) take(j.stamp);
@@ -1382,7 +1398,7 @@ void runDifferentiator(SceneRun& run, const Differentiator& diff,
   std::vector<double> default_loads;  // double, default savings: for "planar off"
   for (int rep = 0; rep < run.repeats; ++rep)
     for (std::size_t i = 0; i < v.configs.size(); ++i) {
-      const Outputs out = runOnce(run.scene, v.configs[i], v.segments[i]);
+      const Outputs out = runOnce(run.scene, v.configs[i], v.segments[i], diff.velocities);
       ++run.runs;
       if (rep == 0) {
         results[i] = score(run.scene, out, v.segments[i], i == 0);
