@@ -1184,7 +1184,7 @@ bool isShippedDefault(const Differentiator& diff) {
   const jle::DifferentiatorConfig d = formerDefault(), &c = diff.config;
   if (c.type != d.type) return false;
   if (c.type == jle::DifferentiatorType::kKalman)
-    return c.kalman_model == d.kalman_model && c.process_noise == d.process_noise &&
+    return c.kalman_model == d.kalman_model && jle::processNoise(c) == jle::processNoise(d) &&
            diff.measurement_noise == d.measurement_noise;
   return c.order == d.order && c.delay == d.delay &&
          (c.type == jle::DifferentiatorType::kFiniteDifference || c.window == d.window);
@@ -1210,7 +1210,7 @@ void writeRows(std::FILE* csv, const SceneSpec& spec, const Differentiator& diff
                  "%s,%s,%s,%d,%d,%d,%.3g,%.3g,%s,%s,%s,%ld,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
                  "%.6g,%.4f,%.4f,%.4f,%.4f,%.4f,%g,%d,%.4g,%.4g,%.4g,\"%s\"\n",
                  spec.name.c_str(), diff.label.c_str(), diff.family.c_str(), window, order,
-                 kalman || offline ? 0 : c.delay, kalman && !offline ? c.process_noise : 0.0,
+                 kalman || offline ? 0 : c.delay, kalman && !offline ? jle::processNoise(c) : 0.0,
                  kalman && !offline ? measurement_noise : 0.0, precision, savings.c_str(),
                  s.joint.c_str(), s.samples, s.rms_effort, s.max_effort, s.rms_force, s.max_force,
                  s.rms_moment, s.max_moment, relative(s.rms_effort, s.rms_true_effort),

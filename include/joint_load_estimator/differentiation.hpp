@@ -38,9 +38,9 @@ enum class KalmanModel : std::uint8_t {
 };
 
 /// The default is what the node runs (config/default.yaml): the constant-jerk Kalman
-/// filter, process noise 1e4, measurement noise 1e-4 rad. The adaptive filter is an
-/// option: better on the accuracy study's scenes of real logs, worse on clean ones, and
-/// its noise gain understates the q'' noise (README "Differentiators").
+/// filter, its default process noise 1e4 (processNoise()), measurement noise 1e-4 rad. The adaptive
+/// filter is an option: better on the accuracy study's scenes of real logs, worse on clean ones,
+/// and its noise gain understates the q'' noise (README "Differentiators").
 struct DifferentiatorConfig {
   DifferentiatorType type = DifferentiatorType::kKalman;
   /// Savitzky-Golay: samples in the fit and degree of the polynomial (2..5). The
@@ -50,18 +50,19 @@ struct DifferentiatorConfig {
   int order = 2;
   int delay = 0;
   /// Kalman: spectral density of the white noise driving the highest derivative
-  /// [unit^2 / s^(2n-1)], and standard deviation of the position measurement [unit].
+  /// [unit^2 / s^(2n-1)] (0: the model's default, processNoise()), and standard
+  /// deviation of the position measurement [unit].
   KalmanModel kalman_model = KalmanModel::kConstantJerk;
-  double process_noise = 1e4;
+  double process_noise = 0.0;
   double measurement_noise = 1e-4;
   /// Kalman: delay [s] of the smoothed estimate behind the newest sample's stamp (0: the
   /// causal filter). With lag > 0 the filter runs forward as with 0 and remembers its
   /// states; the estimate of a sample is made once the newest stamp is `lag` after its
-  /// own, within h (the mean interval of the samples not yet estimated): the sample
-  /// nearest to newest - lag, kept from sample to sample while within h of it, so that at
-  /// a steady rate each sample makes one estimate (at jittered stamps: within h plus the
-  /// intervals' spread; where the rate drops, the samples made overdue are due at once:
-  /// DifferentiatorBank::next()). A Rauch-Tung-Striebel backward pass from the newest
+  /// own, within h (the median of the last 5 intervals): the sample nearest to newest -
+  /// lag, kept from sample to sample while within h of it, so that at a steady rate each
+  /// sample makes one estimate (at jittered stamps: within h plus the intervals' spread;
+  /// where the rate drops or after a gap, the samples made overdue are due at once, up to
+  /// the nearest: DifferentiatorBank::next()). A Rauch-Tung-Striebel backward pass from the newest
   /// sample smooths the next B estimates with the data that followed them, B half the
   /// samples pending (about two backward steps per sample). At least n samples (3 or 4,
   /// the model's state) follow an estimated sample: a lag shorter than n intervals is n.
@@ -80,10 +81,23 @@ struct DifferentiatorConfig {
   double max_gap = 0.5;
 };
 
+/// The process noise the Kalman filter of `c` runs with: c.process_noise, or where it is
+/// 0 the model's default: 1e4 for constant jerk [unit^2/s^7], 10 for constant
+/// acceleration [unit^2/s^5]. Both put the bandwidth (q / r^2)^(1 / (2n)) at 31.6 rad/s
+/// with the default r = 1e-4; measured (accuracy study, 21 scenes, r = 1e-4): constant
+/// acceleration with q = 10 is within 1.30x of its best q per scene on geometric mean
+/// (2.12x at worst), where 1e4 was 5.3x (36.6x).
+inline double processNoise(const DifferentiatorConfig& c) {
+  constexpr double kConstantJerk = 1e4, kConstantAcceleration = 10.0;
+  if (c.process_noise > 0.0) return c.process_noise;
+  return c.kalman_model == KalmanModel::kConstantAcceleration ? kConstantAcceleration
+                                                              : kConstantJerk;
+}
+
 /// Whether two configurations make the same filter (every field equal).
 inline bool sameDifferentiator(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
   return a.type == b.type && a.window == b.window && a.order == b.order && a.delay == b.delay &&
-         a.kalman_model == b.kalman_model && a.process_noise == b.process_noise &&
+         a.kalman_model == b.kalman_model && processNoise(a) == processNoise(b) &&
          a.measurement_noise == b.measurement_noise && a.lag == b.lag &&
          a.min_bandwidth == b.min_bandwidth && a.max_bandwidth == b.max_bandwidth &&
          a.noise == b.noise && a.memory == b.memory && a.max_gap == b.max_gap;
@@ -108,8 +122,8 @@ inline void validate(const DifferentiatorConfig& c) {
     if (!(c.lag >= 0.0) || !(c.lag <= kMaxLag))
       fail("lag", "must be 0..10 [s] (0: the causal filter)");
   } else if (c.type == DifferentiatorType::kKalman) {
-    if (!(c.process_noise > 0.0) || !std::isfinite(c.process_noise))
-      fail("process_noise", "must be finite and > 0");
+    if (!(c.process_noise >= 0.0) || !std::isfinite(c.process_noise))
+      fail("process_noise", "must be finite and >= 0 (0: the model's default)");
     if (!(c.measurement_noise > 0.0) || !std::isfinite(c.measurement_noise))
       fail("measurement_noise", "must be finite and > 0");
     if (!(c.lag >= 0.0) || !(c.lag <= kMaxLag))
@@ -179,8 +193,8 @@ class DifferentiatorBank {
   const DifferentiatorConfig& config() const { return config_; }
   int channels() const { return channels_; }
   /// Samples needed after a reset before the first estimate (a smoother: lag over the
-  /// mean interval of the samples it holds, plus one, at least n + 1; before its second
-  /// sample that of the causal filter).
+  /// recent interval, plus one, at least n + 1; before its second sample that of the
+  /// causal filter).
   int warmup() const {
     if (delegating()) return smoother_.front().warmup();
     if (smoothing() && spacing_ > 0.0)
@@ -227,6 +241,7 @@ class DifferentiatorBank {
 
   void reset() {
     carry_count_ = carry_next_ = 0;
+    recent_count_ = 0;
     spacing_ = 0.0;
     for (DifferentiatorBank& s : smoother_) s.reset();
     resetFilter();
@@ -743,43 +758,57 @@ class DifferentiatorBank {
   }
 
   // After the forward step of sample index_ + 1 (time t, dt after the last): its state
-  // into the ring, the pending samples' mean interval, and the estimate if one is due.
+  // into the ring, the recent interval, and the estimate if one is due.
   bool smoothStep(double t, double dt) {
     ++index_;  // the sample whose forward step was just taken
     const int slot = index_ % ring_size_;
     filtered_.col(slot) =
         Eigen::Map<const Eigen::VectorXd>(state_.data(), static_cast<Eigen::Index>(n_) * channels_);
     ring_times_[slot] = t;
-    spacing_ =
-        index_ > emitted_ ? (t - ring_times_[emitted_ % ring_size_]) / (index_ - emitted_) : dt;
+    noteInterval(dt);
     return emitDue();
   }
 
+  // spacing_: the median of the last kRecent intervals (a gap or a burst does not move
+  // it; a change of rate does, in kRecent / 2 samples).
+  void noteInterval(double dt) {
+    recent_[recent_count_++ % kRecent] = dt;
+    const int k = std::min(recent_count_, kRecent);
+    double sorted[kRecent];
+    for (int i = 0; i < k; ++i) {
+      int j = i;
+      for (; j > 0 && sorted[j - 1] > recent_[i]; --j) sorted[j] = sorted[j - 1];
+      sorted[j] = recent_[i];
+    }
+    spacing_ = k % 2 == 1 ? sorted[k / 2] : 0.5 * (sorted[k / 2 - 1] + sorted[k / 2]);
+  }
+
   // The next estimate (the oldest carried over a gap, else the oldest of its own, which
-  // needs n samples after it) if due at the newest sample, stamp t_N. With t_j its
-  // stamp and h its interval to the next pending sample: due if t_N - t_j >= lag - h
-  // after a sample that made an estimate, >= lag - h / 2 (the nearest sample) after one
-  // that made none or at a start: the hysteresis keeps one estimate per sample at a
-  // steady rate. After an estimate already taken at this sample, only if that first one
-  // was overdue (t_N - t_j > lag + h: a drop of the rate, a gap), and then every sample
-  // up to the nearest.
+  // needs n samples after it) if due at the newest sample, stamp t_N. With t_j its stamp
+  // and u the recent interval (spacing_: what waiting one more sample adds to the
+  // delay): due if t_N - t_j >= lag - u after a sample that made an estimate, >= lag -
+  // u / 2 (the nearest) after one that made none or at a start: the hysteresis keeps
+  // one estimate per sample at a steady rate, jitter included. After an estimate
+  // already taken at this sample, only if that first one was overdue (t_N - t_j >
+  // lag + its interval to the next pending sample: a drop of the rate, a gap), and
+  // then each with t_N - t_j >= lag - u / 2 (the nearest).
   bool emitDue() {
     if (taken_ > 0 && !catching_up_) return false;
     const bool carried = carry_next_ < carry_count_;
     if (!carried && !(count_ > 0 && index_ - emitted_ >= n_)) return false;
     const double t = carried ? carry_times_[carry_next_] : ring_times_[emitted_ % ring_size_];
-    const double delay = last_time_ - t, lag = config_.lag, h = pendingInterval(carried);
-    if (delay < lag - (taken_ == 0 && running_ ? h : 0.5 * h)) return false;
+    const double delay = last_time_ - t, lag = config_.lag, u = spacing_;
+    if (delay < lag - (taken_ == 0 && running_ ? u : 0.5 * u)) return false;
+    if (taken_++ == 0) catching_up_ = delay > lag + pendingInterval(carried);
     if (carried)
       emitCarry();
     else
       emitOwn();
-    if (taken_++ == 0) catching_up_ = delay > lag + h;
     return true;
   }
 
-  // The interval [s] from the next sample to estimate to the one after it (the mean of
-  // the pending samples' when it is the last pending one).
+  // The interval [s] from the next sample to estimate to the one after it (the recent
+  // interval when it is the last pending one).
   double pendingInterval(bool carried) const {
     if (carried && carry_next_ + 1 < carry_count_)
       return carry_times_[carry_next_ + 1] - carry_times_[carry_next_];
@@ -898,7 +927,7 @@ class DifferentiatorBank {
     Q_.resize(n, n);
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j) F_(i, j) = dt_pow[j - i] / fact[j - i];
-    const double q = config_.process_noise;
+    const double q = processNoise(config_);
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
         const int a = n - 1 - i, b = n - 1 - j;
@@ -978,8 +1007,8 @@ class DifferentiatorBank {
   // Smoother: index of the newest sample since the start (-1: none), of the next to
   // estimate, of the last whose smoothed estimate is in the ring, whether finish() was
   // called, the ring's length (its capacity); estimates taken at the newest sample,
-  // whether the sample before made one, whether the first taken was overdue, and the
-  // pending samples' mean interval [s].
+  // whether the sample before made one, whether the first taken was overdue; the last
+  // kRecent intervals [s], how many were taken, and their median [s].
   int index_ = -1;
   int emitted_ = 0;
   int smoothed_through_ = -1;
@@ -988,6 +1017,9 @@ class DifferentiatorBank {
   int taken_ = 0;
   bool running_ = false;
   bool catching_up_ = false;
+  static constexpr int kRecent = 5;
+  double recent_[kRecent] = {};
+  int recent_count_ = 0;
   double spacing_ = 0.0;
   SmallMatrix backward_gain_;
   // Per remembered sample (column: slot index % ring_size_): the filtered state

@@ -74,7 +74,8 @@ TEST(Config, DefaultsAreTheNodes) {
   const jle::DifferentiatorConfig d;
   EXPECT_EQ(d.type, jle::DifferentiatorType::kKalman);
   EXPECT_EQ(d.kalman_model, jle::KalmanModel::kConstantJerk);
-  EXPECT_EQ(d.process_noise, 1e4);
+  EXPECT_EQ(d.process_noise, 0.0);  // the model's: 1e4 for constant jerk
+  EXPECT_EQ(jle::processNoise(d), 1e4);
   EXPECT_EQ(d.measurement_noise, 1e-4);
   EXPECT_EQ(d.lag, 0.0);
   EXPECT_EQ(d.max_gap, 0.5);
@@ -234,7 +235,7 @@ TEST(Config, Differentiator) {
        {"differentiator/process_noise",
         [&](Settings& s) {
           kalman(s);
-          s.estimator.differentiator.process_noise = 0;
+          s.estimator.differentiator.process_noise = -1.0;
         }},
        {"differentiator/measurement_noise",
         [&](Settings& s) {

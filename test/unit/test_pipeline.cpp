@@ -6,10 +6,12 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/portable_random.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -700,6 +702,46 @@ TEST(Pipeline, SmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
 // The adaptive smoother (type adaptive with a lag) through the same path.
 TEST(Pipeline, AdaptiveSmootherPublishesEveryJointStateOnceAcrossAGapAndAtTheEnd) {
   expectEveryJointStateOnce(jle::DifferentiatorType::kAdaptive);
+}
+
+// differentiator/lag in seconds through the message path: a 1 kHz stream whose first
+// interval is 1.75 ms (it made the delay 114 samples, 0.114 s), then 0.8 to 1.2 ms
+// apart, and 200 Hz from its second second (5 ms steps after 1 ms ones: several loads
+// due at once, takeDrained()). Each record's stamp is 0.2 s before the newest joint
+// state's within 1.4 ms at 1 kHz (the recent interval plus the intervals' spread,
+// 0.4 ms, as test_smoother) and where the rate drops within the 5 ms step (a sample made
+// overdue by it was not due at the sample before: measured 4.4 ms); every joint state
+// once.
+TEST(Pipeline, SmootherDelayIsTheLagInSeconds) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  settings.estimator.differentiator.lag = 0.2;
+  jle::Pipeline pipeline(model, settings, nullptr);
+  jle::PortableRandom random(5);
+  std::vector<Stamp> sent, published;
+  double worst_1khz = 0.0, worst = 0.0;
+  Stamp stamp = kStart;
+  for (int k = 0; k < 1500; ++k) {
+    const Stamp step = k < 1000 ? static_cast<Stamp>(random.uniform(0.8, 1.2) * kMs) : 5 * kMs;
+    stamp += k == 0 ? 0 : (k == 1 ? 1750000 : step);
+    std::vector<double> p(6);
+    for (int i = 0; i < 6; ++i) p[static_cast<std::size_t>(i)] = q(i, 1e-9 * (stamp - kStart));
+    sent.push_back(stamp);
+    const auto take = [&]() {
+      published.push_back(pipeline.record().stamp);
+      const double error = std::abs(1e-9 * static_cast<double>(stamp - published.back()) - 0.2);
+      worst = std::max(worst, error);
+      if (k < 1000) worst_1khz = std::max(worst_1khz, error);
+    };
+    if (pipeline.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone) ==
+        Outcome::kPublished)
+      take();
+    while (pipeline.takeDrained()) take();
+  }
+  EXPECT_LE(worst_1khz, 1.4e-3);
+  EXPECT_LE(worst, 5e-3);
+  while (pipeline.flush()) published.push_back(pipeline.record().stamp);
+  EXPECT_EQ(published, sent);
 }
 
 namespace {

@@ -401,8 +401,10 @@ double worst(const std::vector<double>& e, std::size_t from = 0) {
 // A 1 kHz stream whose first interval is 1.75 ms, the others 0.7 to 1.3 ms apart at
 // random: with lag 0.2 s the delay was round(0.2 / 1.75e-3) = 114 samples, 0.114 s.
 // Bound: the estimate is the pending sample nearest to newest - lag, kept while within
-// one mean interval h (1 ms) of it; an estimate skipped at one sample can be emitted at
-// the next, late by that sample's interval less its own: h + (1.3 - 0.7) ms = 1.6 ms.
+// one recent interval u (about 1 ms) of it; the newest interval and the estimated
+// sample's differ by up to 1.3 - 0.7 ms from one sample to the next, so an estimate
+// kept can drift past u by that before the next one is corrected: u + 0.6 ms = 1.6 ms
+// (measured 1.25 ms).
 void expectDelayAtJitter(DifferentiatorType type) {
   jle::PortableRandom random(3);
   std::vector<double> t{5.0};
