@@ -269,6 +269,18 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
     std::snprintf(label, sizeof label, "KS-adaptive lag=%.0fms", 1e3 * lag);
     out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}, false});
   }
+  // The smoothers at the smoothed stream's delay (0.2 s) given the joint states'
+  // velocities too, where the scene has them: the candidates for its default.
+  if (quick) return;
+  const std::size_t smoothers = out.size();
+  for (std::size_t i = 0; i < smoothers; ++i)
+    if ((out[i].family == "kalman_cj_smooth" || out[i].family == "adaptive_smooth") &&
+        out[i].config.lag == 0.2) {
+      Differentiator d = out[i];
+      d.label += " + velocities";
+      d.velocities = true;
+      out.push_back(d);
+    }
 }
 
 struct SavingsVariant {

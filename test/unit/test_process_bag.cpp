@@ -186,13 +186,13 @@ wrenches:
 
 // The estimator of kConfig, configured here by hand (not by the settings parser); with
 // `smoothed`, its smoothed stream's (the default: constant-jerk Kalman smoother, process
-// noise 1e2, measurement noise 1e-4, lag 0.2 s; README "Two streams").
+// noise 1e3, measurement noise 1e-4, lag 0.2 s; README "Two streams").
 jle::Estimator referenceEstimator(const jle::Model<double>& model, bool smoothed) {
   jle::EstimatorConfig config;
   if (smoothed) {
     config.differentiator.type = jle::DifferentiatorType::kKalman;
     config.differentiator.kalman_model = jle::KalmanModel::kConstantJerk;
-    config.differentiator.process_noise = 1e2;
+    config.differentiator.process_noise = 1e3;
     config.differentiator.measurement_noise = 1e-4;
     config.differentiator.lag = 0.2;
   } else {
