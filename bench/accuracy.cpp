@@ -140,13 +140,23 @@ std::vector<Differentiator> differentiators(bool quick) {
   // And with the joint states' velocities where the scene has them; and the smoothed
   // stream's default filter (README "Two streams"), without and with them: what the node
   // publishes on ~joint_loads and ~smoothed/joint_loads.
-  out.push_back({"default + velocities", kDefaultLabel, node, node.measurement_noise, true, {},
-                 true});
+  out.push_back(
+      {"default + velocities", kDefaultLabel, node, node.measurement_noise, true, {}, true});
   const jle::DifferentiatorConfig smoothed = jle::Settings{}.smoothed.differentiator;
-  out.push_back({"smoothed default", "default_smoothed", smoothed, smoothed.measurement_noise,
-                 true, {}, false});
-  out.push_back({"smoothed default + velocities", "default_smoothed", smoothed,
-                 smoothed.measurement_noise, true, {}, true});
+  out.push_back({"smoothed default",
+                 "default_smoothed",
+                 smoothed,
+                 smoothed.measurement_noise,
+                 true,
+                 {},
+                 false});
+  out.push_back({"smoothed default + velocities",
+                 "default_smoothed",
+                 smoothed,
+                 smoothed.measurement_noise,
+                 true,
+                 {},
+                 true});
   auto add = [&](const std::string& label, const std::string& family,
                  const jle::DifferentiatorConfig& c) {
     out.push_back({label, family, c, 0.0, false, {}, false});
