@@ -388,11 +388,24 @@ TEST_F(BadInput, NaNPositionIsDropped) {
   expectDropped(bad, {"position", "'elbow_joint'"}, "dropped: invalid");
 }
 
-TEST_F(BadInput, InfiniteVelocityIsDropped) {
-  sensor_msgs::JointState bad = good(ros::Time());
-  bad.velocity.assign(6, 0.0);
-  bad.velocity[4] = std::numeric_limits<double>::infinity();
-  expectDropped(bad, {"velocity", "'wrist_2_joint'"}, "dropped: invalid");
+// A non-finite velocity costs that velocity only (measured_velocity, issue 37): the
+// message is used and its loads published; warned naming the joint, and counted.
+TEST_F(BadInput, InfiniteVelocityCostsOnlyThatVelocity) {
+  prime();
+  const long before = counter("velocities not used: non-finite");
+  const long invalid = counter("dropped: invalid");
+  sensor_msgs::JointState js = good(tick());
+  js.velocity.assign(6, 0.0);
+  js.velocity[4] = std::numeric_limits<double>::infinity();
+  node_.send(js);
+  const auto msg = node_.loads().waitForStamp(js.header.stamp);
+  ASSERT_TRUE(msg) << "a message with an infinite velocity was not used";
+  for (double e : msg->effort) EXPECT_TRUE(std::isfinite(e));
+  EXPECT_TRUE(
+      log_.waitFor(node_.name(), rosgraph_msgs::Log::WARN, {"velocity", "'wrist_2_joint'"}));
+  prime();
+  EXPECT_EQ(counter("velocities not used: non-finite"), before + 1);
+  EXPECT_EQ(counter("dropped: invalid"), invalid);
 }
 
 // The effort is kept only for comparison (issue 14): a NaN drops that joint's comparison,
