@@ -884,6 +884,27 @@ jle::Settings nodeSettings(const jle::EstimatorConfig& config) {
 
 jle::Stamp nanoseconds(double t) { return kEpoch + static_cast<jle::Stamp>(std::llround(t * 1e9)); }
 
+// The record's index of each segment of `segments` (published joints).
+std::vector<std::size_t> recordSlots(const jle::LoadsRecord& r, const std::vector<int>& segments) {
+  std::vector<std::size_t> slots;
+  for (int s : segments) {
+    const auto i = std::find(r.segment.begin(), r.segment.end(), s) - r.segment.begin();
+    if (i == static_cast<long>(r.segment.size()))
+      throw std::logic_error("a scored segment is not published");
+    slots.push_back(static_cast<std::size_t>(i));
+  }
+  return slots;
+}
+
+// The loads of a published record at `slots` (recordSlots).
+void recordLoads(const jle::LoadsRecord& r, const std::vector<std::size_t>& slots, Outputs& out) {
+  for (std::size_t i : slots) {
+    out.loads.push_back(r.effort[i]);
+    out.loads.insert(out.loads.end(), r.force[i].data(), r.force[i].data() + 3);
+    out.loads.insert(out.loads.end(), r.moment[i].data(), r.moment[i].data() + 3);
+  }
+}
+
 // The loads of the last published estimate, per segment of `segments`.
 void recordLoads(const jle::Data<double>& d, const std::vector<int>& segments, Outputs& out) {
   for (int s : segments) {
@@ -926,6 +947,7 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
   out.loads.reserve(n * 7 * segments.size());
   out.qdd.resize(model.nq, static_cast<Eigen::Index>(n));
   jle::Pipeline pipeline(model, nodeSettings(config), nullptr);
+  const std::vector<std::size_t> slots = recordSlots(pipeline.record(), segments);
   std::vector<double> position(static_cast<std::size_t>(model.nq));
   std::vector<double> velocity;
   if (velocities && scene.spec.velocities) velocity.resize(position.size());
@@ -934,13 +956,14 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
   Eigen::Index published = 0;
   // Recording the outputs is inside the timed loop: a copy of 7 numbers per joint, small
   // against the estimator's work, and the same for every configuration.
-  // The loads in record() and estimator(), the newest sample's stamp then.
+  // The loads in record(), the newest sample's stamp then.
   const auto take = [&](double newest) {
-    out.index.push_back(readingOf(scene, pipeline.record().stamp));
+    const jle::LoadsRecord& record = pipeline.record();
+    out.index.push_back(readingOf(scene, record.stamp));
     out.newest.push_back(newest);
-    recordLoads(pipeline.estimator().data(), segments, out);
-    out.qdd.col(published++) = pipeline.estimator().qdd();
-    if (pipeline.estimator().lastWasPlanar()) ++out.planar_published;
+    recordLoads(record, slots, out);
+    out.qdd.col(published++) = record.qdd;
+    if (record.planar) ++out.planar_published;
   };
   const double cpu_start = threadCpuSeconds();
   const auto start = std::chrono::steady_clock::now();
@@ -971,7 +994,7 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
       std::chrono::duration<double, std::micro>(stop - start).count() / static_cast<double>(n);
   out.cpu_us = 1e6 * (cpu_stop - cpu_start) / static_cast<double>(n);
   out.qdd.conservativeResize(Eigen::NoChange, published);
-  out.planar = pipeline.estimator().planar();
+  out.planar = pipeline.planar();
   return out;
 }
 

@@ -96,8 +96,30 @@ class FrameSource {
                       Eigen::Isometry3d& X_target_frame, std::string& error) = 0;
 };
 
-/// The loads of one published sample, sized at construction (no allocation per sample).
-/// Index i runs over the published joints.
+/// A wrench input (settings.wrenches[k]) as it entered one published sample.
+struct InputRecord {
+  bool stale = false;  ///< stale at the sample (its stale_policy applied)
+  /// A force/torque sensor (sensor_joint set): whether its reading was used (not while it
+  /// is stale with the zero policy), and the reading minus the model's prediction: the
+  /// load the distal side exerts beyond what the model and the other inputs explain (a
+  /// tool's contact, or a bias), in the reading's frame `frame`, moment about its origin,
+  /// the reading's sign [N, N m]. Zero when unused or not a sensor.
+  bool used = false;
+  Wrench<double> residual;
+  std::string frame;  ///< the reading's frame (the input's link when it has none)
+};
+
+/// A force plate (settings.force_plates[k]) as it entered one published sample.
+struct PlateRecord {
+  bool stale = false;  ///< stale at the sample
+  /// Contact, centre of pressure and free moment (plate frame), reaction on the foot.
+  PlateReading reading;
+  std::string frame;  ///< the frame of the centre of pressure (the plate's)
+};
+
+/// The whole result of one published sample, sized at construction (no allocation per
+/// sample): every front end (node, process_bag, joint_loads, the writers) reads this and
+/// nothing else. Index i runs over the published joints.
 struct LoadsRecord {
   Stamp stamp = 0;                 ///< the stamp of the joint state the loads describe
   std::vector<std::string> joint;  ///< URDF joint names
@@ -129,6 +151,17 @@ struct LoadsRecord {
   /// distal joint over its threshold when it started, with its child link.
   bool in_contact = false, contact_started = false, contact_ended = false;
   std::string contact_joint, contact_link;
+  /// The estimated q, q-dot, q-ddot of every coordinate (model coordinate order) [rad or
+  /// m, /s, /s^2].
+  Eigen::VectorXd q, qd, qdd;
+  /// Per wrench input and per force plate (settings order).
+  std::vector<InputRecord> inputs;
+  std::vector<PlateRecord> plates;
+  /// A floating base: the wrench the model needs at the base beyond every input (root
+  /// link frame, about its origin) [N, N m], zero when the inputs explain the motion (a
+  /// check of the model and the inputs). Zero for a fixed base.
+  Eigen::Vector3d base_force = Eigen::Vector3d::Zero(), base_moment = Eigen::Vector3d::Zero();
+  bool planar = false;  ///< computed by the planar 3x3 path (savings.planar)
 };
 
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
@@ -234,11 +267,29 @@ class Pipeline {
   /// immediate stream's: each puts the next of its records in smoothedRecord()).
   bool flushSmoothed();
   bool takeDrainedSmoothed();
-  /// The smoothed stream's estimator (null without one).
-  const Estimator* smoothedEstimator() const { return smoothed_ ? &smoothed_->estimator : nullptr; }
   const PipelineCounters& counters() const { return counters_; }
   const Settings& settings() const { return settings_; }
-  const Estimator& estimator() const { return estimator_; }
+  /// What the computed loads need, fixed at construction: coordinate i, wrench input k,
+  /// force plate k (an input on no computed segment is not needed: a front end need not
+  /// subscribe to it).
+  bool coordinateNeeded(int i) const { return estimator_.coordinateNeeded(i); }
+  bool inputNeeded(int k) const { return estimator_.inputNeeded(k); }
+  bool plateNeeded(int k) const { return estimator_.plateNeeded(k); }
+  /// How many coordinates take their q-dot from the measured velocities, and whether
+  /// coordinate i does (decided at the first sample after a start, reset or retune).
+  int velocitiesUsed() const { return estimator_.velocitiesUsed(); }
+  bool velocityUsed(int i) const { return estimator_.velocityUsed(i); }
+  /// The immediate stream's delay behind the newest joint state in samples, and the
+  /// samples taken whose loads are still to come (a smoother's; Estimator::delaySamples,
+  /// pendingSamples).
+  int delaySamples() const { return estimator_.delaySamples(); }
+  int pendingSamples() const { return estimator_.pendingSamples(); }
+  /// Whether the planar 3x3 path is in use (savings.planar), and why not if it is not.
+  bool planar() const { return estimator_.planar(); }
+  const std::string& planarReason() const { return estimator_.planarReason(); }
+  /// The topics of every wrench input and force plate that was stale at the last joint
+  /// sample, whatever its policy, ", " between them; empty if none.
+  std::string staleInputs() const;
   /// The external-effort estimator (external_effort/enabled), or null.
   const ExternalEffort* externalEffort() const { return external_.get(); }
   /// The joint-state stream's sample clock (stamps/regularize).
@@ -252,12 +303,8 @@ class Pipeline {
   bool hasTimeOrigin() const { return have_ref_; }
   Stamp timeOrigin() const { return time_ref_; }
 
-  /// Wrench input k's last resolved frame and its pose in the input's link (the
-  /// sensor residual is re-expressed in it).
+  /// Wrench input k's last resolved frame (the frame of its sensor residual), or empty.
   const std::string& wrenchFrame(int k) const { return wrenches_[ix(k)].frame; }
-  const Eigen::Isometry3d& wrenchFramePose(int k) const { return wrenches_[ix(k)].X_link_frame; }
-  /// The frame of plate k whose pose the estimator holds (the COP's frame), or empty.
-  const std::string& plateFrame(int k) const { return plates_[ix(k)].frame; }
 
  private:
   struct WrenchInput {
@@ -312,6 +359,7 @@ class Pipeline {
   bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord(const Estimator& estimator, LoadsRecord& rec);
+  void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
   void setUpExternal();
   void fillExternal();
   void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,

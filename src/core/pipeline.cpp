@@ -1,6 +1,7 @@
 #include <joint_load_estimator/frames.hpp>
 #include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/sensor_bias.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -182,6 +183,13 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
                           std::to_string(body_mass_) + " kg");
     record_.effort_per_kg.assign(n, 0.0);
   }
+  record_.q.setZero(m.nq);
+  record_.qd.setZero(m.nq);
+  record_.qdd.setZero(m.nq);
+  record_.inputs.resize(wrenches_.size());
+  for (std::size_t k = 0; k < wrenches_.size(); ++k)
+    record_.inputs[k].frame = settings_.estimator.wrenches[k].link;
+  record_.plates.resize(plates_.size());
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
@@ -549,6 +557,17 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
   return false;
 }
 
+std::string Pipeline::staleInputs() const {
+  std::string stale;
+  for (std::size_t k = 0; k < wrenches_.size(); ++k)
+    if (estimator_.stale(static_cast<int>(k)))
+      stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
+  for (std::size_t k = 0; k < plates_.size(); ++k)
+    if (estimator_.plateStale(static_cast<int>(k)))
+      stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
+  return stale;
+}
+
 std::string Pipeline::stoppingInputs() const {
   // Only the inputs with the stop policy stop the loads; a stale hold or zero input
   // does not.
@@ -642,7 +661,36 @@ void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
           cov[r] = C(r, r);
     rec.effort_stddev[i] = std::sqrt(estimator.effortVariance(segment));
   }
+  fillSideOutputs(estimator, rec);
   if (external_ && &rec == &record_) fillExternal();
+}
+
+void Pipeline::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) {
+  rec.q = estimator.q();  // same sizes: no allocation
+  rec.qd = estimator.qd();
+  rec.qdd = estimator.qdd();
+  rec.planar = estimator.lastWasPlanar();
+  for (std::size_t k = 0; k < rec.inputs.size(); ++k) {
+    const int input = static_cast<int>(k);
+    InputRecord& in = rec.inputs[k];
+    in.stale = estimator.stale(input);
+    in.used = estimator.sensorSegment(input) >= 0 && estimator.sensorUsed(input);
+    const WrenchInput& w = wrenches_[k];
+    if (!w.frame.empty() && in.frame != w.frame) in.frame = w.frame;  // rare: a new frame
+    in.residual = in.used ? residualInReading(estimator.sensorResidual(input),
+                                              w.X_link_frame.linear(), w.X_link_frame.translation())
+                          : Wrench<double>();
+  }
+  for (std::size_t k = 0; k < rec.plates.size(); ++k) {
+    PlateRecord& p = rec.plates[k];
+    p.stale = estimator.plateStale(static_cast<int>(k));
+    p.reading = estimator.plateReading(static_cast<int>(k));
+    if (p.frame != plates_[k].frame) p.frame = plates_[k].frame;  // rare: a new frame
+  }
+  if (model().floating_base) {
+    rec.base_force = estimator.data().force[0];
+    rec.base_moment = estimator.data().moment[0];
+  }
 }
 
 void Pipeline::fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,

@@ -60,40 +60,31 @@ void EstimatorNode::applyPendingBias() {
   bias_pending_ = false;
 }
 
-void EstimatorNode::publishConsistency(const ros::Time& stamp) {
-  const Estimator& estimator = pipeline_->estimator();
-  const Data<double>& data = estimator.data();
-  if (estimator.model().floating_base) {
-    base_force_max_ = std::max(base_force_max_, data.force[0].norm());
-    base_moment_max_ = std::max(base_moment_max_, data.moment[0].norm());
+void EstimatorNode::publishConsistency(const LoadsRecord& record, const ros::Time& stamp) {
+  if (pipeline_->model().floating_base) {
+    base_force_max_ = std::max(base_force_max_, record.base_force.norm());
+    base_moment_max_ = std::max(base_moment_max_, record.base_moment.norm());
   }
-  for (std::size_t k : sensor_topics_) {
-    const int input = static_cast<int>(k);
-    if (!estimator.sensorUsed(input)) continue;
-    const Eigen::Isometry3d& X = pipeline_->wrenchFramePose(input);
-    wrench_topics_[k].residual =
-        residualInReading(estimator.sensorResidual(input), X.linear(), X.translation());
-    publishResidual(k, stamp);
-  }
-  if (!sensor_topics_.empty() && calibrating_.load()) collectBiasSample();
+  for (std::size_t k : sensor_topics_)
+    if (record.inputs[k].used) publishResidual(record.inputs[k], k, stamp);
+  if (!sensor_topics_.empty() && calibrating_.load()) collectBiasSample(record);
 }
 
-void EstimatorNode::publishResidual(std::size_t k, const ros::Time& stamp) {
+void EstimatorNode::publishResidual(const InputRecord& input, std::size_t k,
+                                    const ros::Time& stamp) {
   WrenchTopic& topic = wrench_topics_[k];
-  const Wrench<double>& r = topic.residual;
+  const Wrench<double>& r = input.residual;
   topic.max_force = std::max(topic.max_force, r.force.norm());
   topic.max_moment = std::max(topic.max_moment, r.moment.norm());
   if (topic.consistency_pub.getNumSubscribers() == 0) return;
-  const std::string& frame = pipeline_->wrenchFrame(static_cast<int>(k));
   wrench_msg_.header.stamp = stamp;
-  wrench_msg_.header.frame_id = frame.empty() ? settings_.estimator.wrenches[k].link : frame;
+  wrench_msg_.header.frame_id = input.frame;
   tf2::toMsg(r.force, wrench_msg_.wrench.force);
   tf2::toMsg(r.moment, wrench_msg_.wrench.torque);
   topic.consistency_pub.publish(wrench_msg_);
 }
 
-void EstimatorNode::collectBiasSample() {
-  const Estimator& estimator = pipeline_->estimator();
+void EstimatorNode::collectBiasSample(const LoadsRecord& record) {
   std::lock_guard<std::mutex> lock(calibration_mutex_);
   Calibration& c = calibration_;
   if (c.active && c.estimator.collecting()) {
@@ -101,13 +92,13 @@ void EstimatorNode::collectBiasSample() {
       const std::size_t k = sensor_topics_[i];
       const int input = static_cast<int>(k);
       BiasSample& sample = c.sample[i];
-      sample.used = estimator.sensorUsed(input);
+      sample.used = record.inputs[k].used;
       if (sample.used)
         sample.offset =
-            readingOffset(wrench_topics_[k].residual, settings_.estimator.wrenches[k].sign,
+            readingOffset(record.inputs[k].residual, settings_.estimator.wrenches[k].sign,
                           {pipeline_->sensorBiasForce(input), pipeline_->sensorBiasTorque(input)});
     }
-    if (c.estimator.add(estimator.stamp(), c.sample, estimator.qd(), c.needed))
+    if (c.estimator.add(1e-9 * static_cast<double>(record.stamp), c.sample, record.qd, c.needed))
       c.last_sample = ros::WallTime::now();
   }
   // The service thread waits for the window to fill or fail.
@@ -214,7 +205,7 @@ void EstimatorNode::startCalibration(double duration, bool assume_still) {
   c.sample.assign(sensor_topics_.size(), BiasSample());
   c.needed.assign(static_cast<std::size_t>(model.nq), 0);
   for (int i = 0; i < model.nq; ++i)
-    c.needed[static_cast<std::size_t>(i)] = pipeline_->estimator().coordinateNeeded(i);
+    c.needed[static_cast<std::size_t>(i)] = pipeline_->coordinateNeeded(i);
   c.last_sample = ros::WallTime::now();
   c.active = true;
   calibrating_ = true;

@@ -122,12 +122,11 @@ ros::Subscriber EstimatorNode::subscribeInput(const std::string& topic,
 }
 
 void EstimatorNode::subscribe() {
-  const Estimator& estimator = pipeline_->estimator();
   joint_health_ = InputHealth(nh_.resolveName(settings_.joint_states_topic));
   for (std::size_t k = 0; k < wrench_topics_.size(); ++k) {
     const std::string& topic = settings_.wrenches[k].topic;
     wrench_topics_[k].health = InputHealth(topic);
-    if (!estimator.inputNeeded(static_cast<int>(k))) {  // nothing to subscribe to
+    if (!pipeline_->inputNeeded(static_cast<int>(k))) {  // nothing to subscribe to
       ROS_INFO("wrench '%s' on link '%s' affects none of the published joints: not subscribed",
                topic.c_str(), settings_.estimator.wrenches[k].link.c_str());
       continue;
@@ -137,7 +136,7 @@ void EstimatorNode::subscribe() {
   }
   for (std::size_t k = 0; k < plate_topics_.size(); ++k) {
     plate_topics_[k].health = InputHealth(settings_.force_plates[k].topic);
-    if (!estimator.plateNeeded(static_cast<int>(k))) {
+    if (!pipeline_->plateNeeded(static_cast<int>(k))) {
       ROS_INFO(
           "force plate '%s' under link '%s' affects none of the published joints: not "
           "subscribed",
@@ -275,21 +274,20 @@ void EstimatorNode::publish(const ros::Time& received) {
       wrench_pubs_[i].publish(wrench_msg_);
     }
   const ros::Time stamp = loads->header.stamp;
-  publishPlates(stamp);
+  publishPlates(record, stamp);
   loads_pub_.publish(joint_load_estimator::JointLoadsConstPtr(loads));
   if (efforts_pub_.getNumSubscribers() > 0) {
     toJointState(record, efforts_msg_);
     efforts_pub_.publish(efforts_msg_);
   }
-  const Data<double>& data = pipeline_->estimator().data();
   if (residual_pub_ && residual_pub_.getNumSubscribers() > 0) {
     wrench_msg_.header.stamp = stamp;
     wrench_msg_.header.frame_id = pipeline_->model().link_name[0];
-    tf2::toMsg(data.force[0], wrench_msg_.wrench.force);
-    tf2::toMsg(data.moment[0], wrench_msg_.wrench.torque);
+    tf2::toMsg(record.base_force, wrench_msg_.wrench.force);
+    tf2::toMsg(record.base_moment, wrench_msg_.wrench.torque);
     residual_pub_.publish(wrench_msg_);
   }
-  publishConsistency(stamp);
+  publishConsistency(record, stamp);
   external_outputs_.publish(record);
   const double latency = (ros::Time::now() - received).toSec();
   latency_sum_ += latency;
@@ -320,12 +318,12 @@ void EstimatorNode::publishSmoothed() {
     }
 }
 
-void EstimatorNode::publishPlates(const ros::Time& stamp) {
+void EstimatorNode::publishPlates(const LoadsRecord& record, const ros::Time& stamp) {
   for (std::size_t k = 0; k < plate_topics_.size(); ++k) {
-    const PlateReading& r = pipeline_->estimator().plateReading(static_cast<int>(k));
+    const PlateReading& r = record.plates[k].reading;
     if (!r.contact) continue;
     cop_msg_.header.stamp = stamp;
-    cop_msg_.header.frame_id = pipeline_->plateFrame(static_cast<int>(k));
+    cop_msg_.header.frame_id = record.plates[k].frame;
     cop_msg_.point.x = r.cop_plate.x();
     cop_msg_.point.y = r.cop_plate.y();
     cop_msg_.point.z = r.cop_plate.z();
@@ -358,14 +356,7 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("output rate [Hz]", dt > 0 ? (published - published_at_last_diag_) / dt : 0.0);
   received_at_last_diag_ = received;
   published_at_last_diag_ = published;
-  std::string stale;
-  const Estimator& estimator = pipeline_->estimator();
-  for (std::size_t k = 0; k < settings_.wrenches.size(); ++k)
-    if (estimator.stale(static_cast<int>(k)))
-      stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
-  for (std::size_t k = 0; k < settings_.force_plates.size(); ++k)
-    if (estimator.plateStale(static_cast<int>(k)))
-      stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
+  const std::string stale = pipeline_->staleInputs();
   const std::string inputs = diagnoseInputs(status);
   if (!inputs.empty())
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, inputs);
@@ -450,7 +441,7 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("messages with unknown joints", c.unknown_joints);
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
   status.add("velocities not used: non-finite", c.nonfinite_velocities);
-  status.add("joints with measured velocities", pipeline_->estimator().velocitiesUsed());
+  status.add("joints with measured velocities", pipeline_->velocitiesUsed());
   status.add("not published: stale input", c.count(Outcome::kStale));
   status.add("time jumps back", c.backJumps());
   status.add("time jumps forward", c.forward_jumps);

@@ -231,8 +231,7 @@ struct JointMessage {
 bool moves(const jle::Pipeline& p, const JointMessage& js) {
   for (const std::string& name : js.names)
     for (int k = 0; k < p.model().nq; ++k)
-      if (name == p.model().coordinate_names[static_cast<std::size_t>(k)] &&
-          p.estimator().coordinateNeeded(k))
+      if (name == p.model().coordinate_names[static_cast<std::size_t>(k)] && p.coordinateNeeded(k))
         return true;
   return false;
 }

@@ -109,8 +109,8 @@ TEST(MeasuredVelocity, UsedByDefaultAndCloserToTheTruthThanThePositions) {
   jle::Pipeline positions(model, with(jle::MeasuredVelocity::kNever), nullptr);
   const Errors m = run(measured, Stream{}, nullptr);
   const Errors p = run(positions, Stream{}, nullptr);
-  EXPECT_EQ(measured.estimator().velocitiesUsed(), model.nq);
-  EXPECT_EQ(positions.estimator().velocitiesUsed(), 0);
+  EXPECT_EQ(measured.velocitiesUsed(), model.nq);
+  EXPECT_EQ(positions.velocitiesUsed(), 0);
   EXPECT_EQ(m.published, p.published);
   // Position noise 2e-4 rad at 1 kHz is 1e2-1e3x the velocities' 2e-3 rad/s in q-ddot;
   // the same filter delays both alike, so the velocities must win on every figure.
@@ -139,8 +139,8 @@ TEST(MeasuredVelocity, PositionsOnlyStreamsAreUnchangedBySetting) {
   Stream all_nan = s;
   all_nan.velocity_noise = std::nan("");
   run(nan_mode, all_nan, &c);
-  EXPECT_EQ(auto_mode.estimator().velocitiesUsed(), 0);
-  EXPECT_EQ(nan_mode.estimator().velocitiesUsed(), 0);
+  EXPECT_EQ(auto_mode.velocitiesUsed(), 0);
+  EXPECT_EQ(nan_mode.velocitiesUsed(), 0);
   EXPECT_EQ(nan_mode.counters().nonfinite_velocities, 4000);
   EXPECT_EQ(nan_mode.counters().count(InputKind::kJointState, Outcome::kInvalid), 0);
   ASSERT_EQ(a.size(), b.size());
@@ -167,7 +167,7 @@ TEST(MeasuredVelocity, ANonFiniteVelocityCostsThatVelocityOnly) {
   EXPECT_EQ(n.nonfinite_velocities, 400);
   EXPECT_EQ(n.count(InputKind::kJointState, Outcome::kInvalid), 0);
   EXPECT_EQ(e.published, c.published);  // every sample published
-  EXPECT_EQ(pipeline.estimator().velocitiesUsed(), model.nq);
+  EXPECT_EQ(pipeline.velocitiesUsed(), model.nq);
   // One velocity in ten replaced by the velocity filter's prediction: the loads stay
   // near the clean run's, far from the positions-only error.
   jle::Pipeline positions(model, with(jle::MeasuredVelocity::kNever), nullptr);
@@ -186,9 +186,9 @@ TEST(MeasuredVelocity, AFirstSampleWithoutVelocityKeepsThatJointOnItsPositions) 
   s.nan_phase = 0;  // only the first message's velocity of joint 4 is NaN
   jle::Pipeline pipeline(model, with(jle::MeasuredVelocity::kAuto), nullptr);
   run(pipeline, s, nullptr);
-  EXPECT_EQ(pipeline.estimator().velocitiesUsed(), model.nq - 1);
-  EXPECT_FALSE(pipeline.estimator().velocityUsed(4));
-  EXPECT_TRUE(pipeline.estimator().velocityUsed(3));
+  EXPECT_EQ(pipeline.velocitiesUsed(), model.nq - 1);
+  EXPECT_FALSE(pipeline.velocityUsed(4));
+  EXPECT_TRUE(pipeline.velocityUsed(3));
 }
 
 TEST(MeasuredVelocity, AlwaysWithUncertaintyIsRefused) {

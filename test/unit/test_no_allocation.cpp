@@ -4,6 +4,7 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
@@ -169,6 +170,52 @@ TEST(NoAllocation, EstimatorOnThePlanarPath) {
   }
   EXPECT_EQ(g_allocations - before, 0);
   EXPECT_GT(planar, 1700);
+}
+
+// The message path the node takes (jle::Pipeline with both streams, a sensor's wrench
+// messages, joint states with names, velocities and efforts, every record with its side
+// outputs) allocates nothing per message once its buffers are built and filled.
+TEST(NoAllocation, PipelineWithBothStreams) {
+  jle::ModelOptions options;
+  options.keep_fixed_joints = {"panda_joint8"};
+  const jle::Model<double> model =
+      jle::modelFromUrdfFile(kData + "/urdf/chains/panda_chain.urdf", options);
+  jle::Settings settings;  // both streams by default
+  jle::WrenchInputConfig ft;
+  ft.name = "ft";
+  ft.sensor_joint = "panda_joint8";
+  settings.estimator.wrenches.push_back(ft);
+  jle::WrenchTopicSettings topic;
+  topic.topic = "ft";
+  settings.wrenches.push_back(topic);
+  ASSERT_TRUE(settings.smoothed.enabled);
+  jle::Pipeline pipeline(model, settings, nullptr);
+  const std::vector<std::string> names = model.coordinate_names;
+  std::vector<double> q(names.size()), qd(names.size()), effort(names.size());
+  const std::string frame = "panda_link8";
+  long published = 0, smoothed = 0, before = 0;
+  const int n = 3000;
+  for (int k = 0; k < n; ++k) {
+    if (k == 1000) before = g_allocations;  // buffers built, both streams' filters warm
+    const double t = 1e-3 * k + 2e-4 * std::sin(k);
+    const jle::Stamp stamp = 1700000000000000000 + static_cast<jle::Stamp>(std::llround(1e9 * t));
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      q[i] = 0.5 * std::sin(t + i);
+      qd[i] = 0.5 * std::cos(t + i);
+      effort[i] = 0.1 * i;
+    }
+    pipeline.onWrench(0, stamp, stamp, frame, Eigen::Vector3d(1, 0, -5),
+                      Eigen::Vector3d(0, 0.1, 0));
+    published +=
+        pipeline.onJointState(stamp, stamp, names, q, qd, effort) == jle::Outcome::kPublished;
+    while (pipeline.takeDrained()) ++published;
+    smoothed += pipeline.smoothedPublished();
+    while (pipeline.takeDrainedSmoothed()) ++smoothed;
+  }
+  EXPECT_EQ(g_allocations - before, 0);
+  EXPECT_GT(published, n - 50);
+  EXPECT_GT(smoothed, n - 300);  // 0.2 s pending at the end
+  EXPECT_TRUE(pipeline.record().inputs[0].used);
 }
 
 }  // namespace

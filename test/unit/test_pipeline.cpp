@@ -262,7 +262,7 @@ TEST(Pipeline, FloatingBasePoseFromTheFrameSource) {
   for (int k = 1; k < 5; ++k)
     last = pipeline.onJointState(kStart + k * kMs, kStart + k * kMs, {}, kNone, kNone, kNone);
   ASSERT_EQ(last, Outcome::kPublished);
-  EXPECT_NEAR(pipeline.estimator().data().force[0].norm(), model.totalMass() * 9.80665, 1e-9);
+  EXPECT_NEAR(pipeline.record().base_force.norm(), model.totalMass() * 9.80665, 1e-9);
 }
 
 TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
@@ -314,7 +314,7 @@ TEST(Pipeline, TimeJumpsAreConfirmedAndFarStampsReanchorTheTimeAxis) {
   EXPECT_EQ(pipeline.counters().forward_jumps, 1);
   EXPECT_EQ(pipeline.counters().backJumps(), 2);
   EXPECT_EQ(pipeline.timeOrigin(), far + 2 * kMs + 1);
-  EXPECT_EQ(pipeline.record().stamp, far + (4 - pipeline.estimator().delaySamples()) * kMs + 1);
+  EXPECT_EQ(pipeline.record().stamp, far + (4 - pipeline.delaySamples()) * kMs + 1);
 }
 
 // A wrench stamped by a clock from 0 (a simulation's) before any joint state, the joint
@@ -346,7 +346,7 @@ TEST(Pipeline, JointStatesFarFromTheWrenchesOriginRestartTheTimeline) {
   EXPECT_EQ(feed(kStart + 32), Outcome::kUsed);
   EXPECT_FALSE(pipeline.jumped());
   EXPECT_EQ(feed(kStart + 64), Outcome::kPublished);
-  EXPECT_EQ(pipeline.record().stamp, kStart + 64 - 32 * pipeline.estimator().delaySamples());
+  EXPECT_EQ(pipeline.record().stamp, kStart + 64 - 32 * pipeline.delaySamples());
   EXPECT_EQ(pipeline.counters().count(InputKind::kJointState, Outcome::kOrder), 0);
   EXPECT_EQ(pipeline.counters().resets, 1);
   // The wrench's stamps afterwards (received by the wall clock): 54 years behind the
@@ -372,7 +372,7 @@ TEST(Pipeline, StampZeroIsTheClockOnlyOnAStreamThatNeverHadStamps) {
     const Outcome o = pipeline.onJointState(0, clock, model.coordinate_names, p, kNone, kNone);
     ASSERT_EQ(o, k < 2 ? Outcome::kUsed : Outcome::kPublished);
   }
-  EXPECT_EQ(pipeline.record().stamp, kStart + (3 - pipeline.estimator().delaySamples()) * kMs);
+  EXPECT_EQ(pipeline.record().stamp, kStart + (3 - pipeline.delaySamples()) * kMs);
   // Once a stream has had a stamp, a stamp 0 is dropped and counted, whatever the clock.
   const std::vector<double> p(6, 0.5);
   EXPECT_EQ(pipeline.onJointState(kStart + 5 * kMs, kStart + 5 * kMs, model.coordinate_names, p,
@@ -685,10 +685,10 @@ void expectEveryJointStateOnce(jle::DifferentiatorType type) {
     // The gap's carry at once, at the first sample after it.
     EXPECT_EQ(published.size() - before, k == 150 ? 149u : 0u) << k;
   }
-  EXPECT_EQ(pipeline.estimator().delaySamples(), 200);
-  EXPECT_EQ(pipeline.estimator().pendingSamples(), 200);
+  EXPECT_EQ(pipeline.delaySamples(), 200);
+  EXPECT_EQ(pipeline.pendingSamples(), 200);
   while (pipeline.flush()) take();
-  EXPECT_EQ(pipeline.estimator().pendingSamples(), 0);
+  EXPECT_EQ(pipeline.pendingSamples(), 0);
   EXPECT_EQ(published, sent);
   for (std::size_t k = 0; k < measured.size(); ++k) EXPECT_EQ(measured[k], static_cast<double>(k));
 }
@@ -828,10 +828,76 @@ TEST(Pipeline, SmootherDrainsItsPendingSamplesOnAJumpBackAndOnRetune) {
   bad.lag = -1.0;
   EXPECT_THROW(tuned.retune(bad, 1), std::invalid_argument);
   EXPECT_FALSE(tuned.takeDrained());  // a refused retune changes nothing
-  EXPECT_EQ(tuned.estimator().pendingSamples(), 100);
+  EXPECT_EQ(tuned.pendingSamples(), 100);
   EXPECT_FALSE(tuned.retune(causal, 1));
   drained.clear();
   while (tuned.takeDrained()) drained.push_back(taken(tuned));
   expectSame(drained, "retune");
-  EXPECT_EQ(tuned.estimator().pendingSamples(), 0);
+  EXPECT_EQ(tuned.pendingSamples(), 0);
+}
+
+// A drained record (a smoother's loads still to come when time jumps back) carries the
+// side outputs of its own sample: the sensor's residual, the base residual, the
+// coordinates, the inputs' staleness, equal to those the same samples give when the
+// stream ends (flush()), and different from one sample to the next (the sensor's reading
+// and the motion change at every sample), so that outputs of another sample would show.
+TEST(Pipeline, DrainedRecordsCarryTheSideOutputsOfTheirOwnSample) {
+  jle::ModelOptions options;
+  options.floating_base = true;
+  options.keep_fixed_joints = {"wrist_3_link-tool0_fixed_joint"};
+  const jle::Model<double> model =
+      jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf", options);
+  jle::Settings settings;
+  settings.floating_base = true;
+  settings.estimator.differentiator.lag = 0.05;  // 50 samples at 1 kHz
+  addWrenchInput(settings, "");
+  settings.estimator.wrenches[0].sensor_joint = "wrist_3_link-tool0_fixed_joint";
+  FixedFrames frames;
+  frames.poses[{"world", model.link_name[0]}] = Eigen::Isometry3d::Identity();
+  constexpr int kFirst = 200;
+  const auto feed = [&](jle::Pipeline& p, int k) {
+    const Stamp stamp = kStart + k * kMs;
+    const double t = 1e-3 * k;
+    p.onWrench(0, stamp, stamp, "tool0", Eigen::Vector3d(1.0 + t, -2.0, 30.0 * t),
+               Eigen::Vector3d(0.1, 0.2 * t, -0.3));
+    std::vector<double> position(6);
+    for (int i = 0; i < 6; ++i) position[static_cast<std::size_t>(i)] = q(i, t);
+    return p.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone);
+  };
+  std::vector<jle::LoadsRecord> ended;
+  {
+    jle::Pipeline reference(model, settings, &frames);
+    for (int k = 0; k < kFirst; ++k) feed(reference, k);
+    while (reference.flush()) ended.push_back(reference.record());
+  }
+  ASSERT_EQ(ended.size(), 50u);
+  jle::Pipeline pipeline(model, settings, &frames);
+  for (int k = 0; k < kFirst; ++k) feed(pipeline, k);
+  feed(pipeline, 0);  // time jumps back
+  ASSERT_EQ(pipeline.counters().resets, 1);
+  std::size_t i = 0;
+  for (; pipeline.takeDrained(); ++i) {
+    ASSERT_LT(i, ended.size());
+    const jle::LoadsRecord& got = pipeline.record();
+    const jle::LoadsRecord& want = ended[i];
+    EXPECT_EQ(got.stamp, want.stamp) << i;
+    EXPECT_EQ(got.effort, want.effort) << i;
+    EXPECT_EQ(got.q, want.q) << i;
+    EXPECT_EQ(got.qd, want.qd) << i;
+    EXPECT_EQ(got.qdd, want.qdd) << i;
+    EXPECT_EQ(got.base_force, want.base_force) << i;
+    EXPECT_EQ(got.base_moment, want.base_moment) << i;
+    ASSERT_EQ(got.inputs.size(), 1u);
+    EXPECT_TRUE(got.inputs[0].used);
+    EXPECT_FALSE(got.inputs[0].stale);
+    EXPECT_EQ(got.inputs[0].residual.force, want.inputs[0].residual.force) << i;
+    EXPECT_EQ(got.inputs[0].residual.moment, want.inputs[0].residual.moment) << i;
+    EXPECT_EQ(got.inputs[0].frame, "tool0");
+    if (i == 0) continue;
+    // The sample's own: the previous record's differ.
+    EXPECT_GT((got.inputs[0].residual.force - ended[i - 1].inputs[0].residual.force).norm(), 1e-3)
+        << i;
+    EXPECT_GT((got.base_force - ended[i - 1].base_force).norm(), 1e-6) << i;
+  }
+  EXPECT_EQ(i, ended.size());
 }

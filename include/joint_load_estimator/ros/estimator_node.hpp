@@ -50,9 +50,8 @@ class EstimatorNode {
   struct WrenchTopic {
     ros::Subscriber subscriber;
     InputHealth health;
-    // Sensor inputs (sensor_joint): the residual of the last published sample in the
-    // reading's frame, its output ~consistency/<sensor_joint> and its extremes.
-    Wrench<double> residual;
+    // Sensor inputs (sensor_joint): the residual's output ~consistency/<sensor_joint> and
+    // its extremes.
     ros::Publisher consistency_pub;
     double max_force = 0.0, max_moment = 0.0;  // |residual| since the last diagnosis
   };
@@ -97,7 +96,7 @@ class EstimatorNode {
   // else a new one (published as a shared pointer, so that a subscriber in the same
   // process gets the message itself, not a serialised copy).
   joint_load_estimator::JointLoadsPtr freeLoadsMessage();
-  void publishPlates(const ros::Time& stamp);
+  void publishPlates(const LoadsRecord& record, const ros::Time& stamp);
   // /diagnostics on a wall-clock timer (diagnostic_period): it keeps its rate whatever
   // the inputs and the (sim) clock do.
   void onDiagnosticsTimer(const ros::WallTimerEvent& event);
@@ -108,9 +107,9 @@ class EstimatorNode {
   std::string diagnoseInputs(diagnostic_updater::DiagnosticStatusWrapper& status);
   void diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& status);
   // Predicted against measured (sensor residuals, floating-base residual).
-  void publishConsistency(const ros::Time& stamp);
-  void publishResidual(std::size_t k, const ros::Time& stamp);
-  void collectBiasSample();
+  void publishConsistency(const LoadsRecord& record, const ros::Time& stamp);
+  void publishResidual(const InputRecord& input, std::size_t k, const ros::Time& stamp);
+  void collectBiasSample(const LoadsRecord& record);
   void diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool onCalibrateBias(joint_load_estimator::CalibrateBias::Request& req,
                        joint_load_estimator::CalibrateBias::Response& res);
