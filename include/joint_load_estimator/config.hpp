@@ -1,6 +1,6 @@
 // Every setting of the estimator and of its front ends (the node, process_bag, the
 // command-line tools, the bindings), each with its default, once, and their one
-// validation. Readers (rosparam/YAML in ros/settings.hpp, a command line, Python) only
+// validation. Readers (YAML and the parameter tree in settings_reader.hpp, a command line) only
 // map names onto these structures and call validate(). ROS-free.
 //
 // The keys named in the errors are the parameter names of config/default.yaml, with

@@ -53,8 +53,9 @@ class Loads:
             raise KeyError("no loads for joint '%s' (joints: %s)" % (joint, ", ".join(self.joints)))
 
     # The arrays with one column per joint (the others, t or base_residual, are kept whole).
-    PER_JOINT = ("wrench", "effort", "effort_stddev", "position", "velocity", "acceleration",
-                 "motor_effort", "measured_effort")
+    PER_JOINT = ("wrench", "effort", "effort_stddev", "effort_per_kg", "position", "velocity",
+                 "acceleration", "motor_effort", "measured_effort", "external_effort",
+                 "external_effort_stddev", "covariance")
 
     def __getitem__(self, joint):
         i = self.index(joint)
@@ -71,6 +72,15 @@ class Loads:
 
     def __repr__(self):
         return "Loads(%d samples x %d joints, frame %s)" % (len(self), len(self.joints), self.frame)
+
+
+def _record(estimator, smoothed=False):
+    """The last published record (of the smoothed stream with smoothed=True) as Loads of
+    one sample: every output of the node's record, as process_bag returns them."""
+    return Loads(estimator._record(smoothed))
+
+
+Estimator.record = _record
 
 
 def inverse_dynamics(model, q, qd, qdd, wrenches=None, frame="child", gravity=None,
@@ -128,20 +138,24 @@ def process_bag(bag, urdf, config="", zero_phase=None, cutoff_rule="auto", summa
     ``smoothed`` is the smoothed stream's Loads (the config's smoothed/...; README "Two
     streams"), None when it is off or with zero_phase.
     """
-    arrays = _core._process_bag(bag, urdf, config, zero_phase, cutoff_rule, summary)
+    from . import _bag  # the one part that needs ROS (rosbag, tf2)
+    arrays = _bag._process_bag(bag, urdf, config, zero_phase, cutoff_rule, summary)
     smoothed = arrays.pop("smoothed")
     loads = Loads(arrays)
     loads.smoothed = Loads(smoothed) if smoothed is not None else None
     return loads
 
 
-def estimate(estimator, t, q, wrenches=()):
-    """Feeds N joint samples (t [s], N; q, N x nq) and the readings of the config's
-    wrench inputs (a list of (t_k, N_k x 6) per input, link frame, as the sensor reports
-    them) to ``estimator`` in time order; returns Loads of the published samples (``t`` =
-    the stamp each describes) and ``status`` per joint sample."""
-    r = estimator.run(t, q, list(wrenches))
-    r["joints"] = estimator.joints
-    r["links"] = estimator.links
-    r["frame"] = "child"
-    return Loads(r)
+def estimate(estimator, t, q, wrenches=(), qd=None, base_pose=None):
+    """Feeds N joint states (t [s], N; q, N x nq in coordinate_names order; qd, N x nq
+    measured velocities, optional; base_pose, N x 7 for a floating base) and the readings
+    of the config's wrench inputs (a list of (t_k, N_k x 6) per input, in the input's frame,
+    as the sensor reports them) to ``estimator`` in time order, through the node's message
+    path; returns Loads of the immediate stream's published samples (``t`` = the stamp each
+    describes; every output of the record, see Estimator.record) with ``status`` per joint
+    state, and its ``smoothed`` stream's Loads (None when smoothed/enabled is false)."""
+    r = estimator.run(t, q, list(wrenches), qd, base_pose)
+    smoothed = r.pop("smoothed")
+    loads = Loads(r)
+    loads.smoothed = Loads(smoothed) if smoothed is not None else None
+    return loads

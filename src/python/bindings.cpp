@@ -1,17 +1,17 @@
-// The Python module joint_load_estimator._core (pybind11): the model, batch inverse
-// dynamics over numpy arrays, the online estimator, the offline zero-phase smoothing and
-// a bag through the node's message path. A front end: it converts arrays and names and
-// calls the core (and jle::processBag); src/joint_load_estimator/__init__.py re-exports
-// it. docs/python.md.
+// The Python module joint_load_estimator._core (pybind11), ROS-free: the model, batch
+// inverse dynamics over numpy arrays, the online estimator (jle::Pipeline, the node's
+// message path: joint states, wrenches, plates and frames in, the whole record out) and
+// the offline zero-phase smoothing. A front end: it converts arrays and names and calls
+// the core; src/joint_load_estimator/__init__.py re-exports it (bag_bindings.cpp, the
+// module _bag, reads bags). docs/python.md.
+#include "records.hpp"
+
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/ros/bag_processing.hpp>
-#include <joint_load_estimator/ros/conversions.hpp>
-#include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/settings_reader.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
 
@@ -28,6 +28,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -42,7 +43,7 @@ namespace {
 // Arrays in: C-contiguous doubles (anything else is converted).
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-// A model and how it was made (Estimator rebuilds it with a config's model options).
+// A model and how it was made (PyEstimator rebuilds it with a config's model options).
 struct PyModel {
   jle::Model<double> model;
   std::string xml;
@@ -238,9 +239,69 @@ py::dict inverseDynamicsBatch(const PyModel& m, const Array& q, const Array& qd,
   return out;
 }
 
-// ---- the online estimator -----------------------------------------------------------
+// ---- the online estimator: jle::Pipeline, the node's message path ----------------------
 
-// The estimator with the model and settings it was made from.
+// Stamps [ns] of the estimator's times t [s]: t = 0 is this stamp (a message path takes
+// stamps, and stamp 0 means "none" on a stream that has had stamps).
+constexpr jle::Stamp kOrigin = 1000000000LL * 1000000000LL;
+
+jle::Stamp stampOf(double t) {
+  if (!std::isfinite(t) || std::abs(t) > 1e9)
+    throw std::invalid_argument("t must be a finite time [s] within 1e9 s of 0");
+  return kOrigin + static_cast<jle::Stamp>(std::llround(t * 1e9));
+}
+
+double secondsOf(jle::Stamp stamp) { return 1e-9 * static_cast<double>(stamp - kOrigin); }
+
+// Frames the URDF does not hold rigidly, as Python sets them (tf2's role in the node).
+class PyFrames : public jle::FrameSource {
+ public:
+  void set(const std::string& target, const std::string& frame, const Eigen::Isometry3d& X) {
+    poses_[{target, frame}] = X;
+  }
+  bool lookup(const std::string& target, const std::string& frame, jle::Stamp, Eigen::Isometry3d& X,
+              std::string& error) override {
+    const auto it = poses_.find({target, frame});
+    if (it == poses_.end()) {
+      error = "no transform set (Estimator.set_transform('" + target + "', '" + frame + "', pose))";
+      return false;
+    }
+    X = it->second;
+    return true;
+  }
+
+ private:
+  std::map<std::pair<std::string, std::string>, Eigen::Isometry3d> poses_;
+};
+
+Eigen::Isometry3d poseOf(const Array& p, const std::string& what) {
+  if (p.ndim() != 1 || p.shape(0) != 7)
+    throw std::invalid_argument(what + " must be 7 numbers (x y z qx qy qz qw)");
+  const double* x = p.data();
+  const Eigen::Quaterniond o(x[6], x[3], x[4], x[5]);
+  if (!(std::abs(o.norm() - 1.0) <= 0.01))
+    throw std::invalid_argument(what + ": the quaternion (qx, qy, qz, qw) has norm " +
+                                std::to_string(o.norm()) + ", not 1 (within 1 %)");
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = o.normalized().toRotationMatrix();
+  X.translation() = Eigen::Vector3d(x[0], x[1], x[2]);
+  return X;
+}
+
+std::vector<double> valuesOf(const py::object& given, std::size_t n, const std::string& what) {
+  if (given.is_none()) return {};
+  const Array a = given.cast<Array>();
+  if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != n)
+    throw std::invalid_argument(what + " must have " + std::to_string(n) + " entries");
+  return std::vector<double>(a.data(), a.data() + n);
+}
+
+Eigen::Vector3d vector3Of(const Array& a, const std::string& what) {
+  if (a.ndim() != 1 || a.shape(0) != 3) throw std::invalid_argument(what + " must be 3 numbers");
+  return Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]);
+}
+
+// The node's message path with the model and settings it was made from.
 class PyEstimator {
  public:
   PyEstimator(const PyModel& m, const std::string& config) {
@@ -258,71 +319,99 @@ class PyEstimator {
           options.keep_fixed_joints.end())
         options.keep_fixed_joints.push_back(j);
     model_ = jle::modelFromUrdfString(m.xml, options);
-    estimator_ = std::make_unique<jle::Estimator>(model_, settings_.estimator);
-    segments_ = jle::publishedSegments(estimator_->model(), settings_.estimator.joints);
+    reset();
   }
 
-  const jle::Estimator& estimator() const { return *estimator_; }
-  jle::Estimator& estimator() { return *estimator_; }
-  const std::vector<int>& segments() const { return segments_; }
-  const jle::Settings& settings() const { return settings_; }
+  // A new pipeline: every filter and counter from the start (the transforms are kept).
+  void reset() { pipeline_ = std::make_unique<jle::Pipeline>(model_, settings_, &frames_); }
+  const jle::Pipeline& pipeline() const { return *pipeline_; }
+  jle::Pipeline& pipeline() { return *pipeline_; }
 
-  std::string addJointSample(double t, const Array& q, const py::object& pose,
-                             const py::object& qd_object) {
-    if (q.ndim() != 1 || q.shape(0) != model_.nq)
-      throw std::invalid_argument("q must have " + std::to_string(model_.nq) + " entries");
-    jle::BasePose base;
-    if (!pose.is_none()) base = basePoseOf(pose.cast<Array>());
-    if (model_.floating_base && pose.is_none())
-      throw std::invalid_argument("a floating-base model needs base_pose (x y z qx qy qz qw)");
-    Array qd;
-    if (!qd_object.is_none()) {
-      qd = qd_object.cast<Array>();
-      if (qd.ndim() != 1 || qd.shape(0) != model_.nq)
-        throw std::invalid_argument("qd must have " + std::to_string(model_.nq) + " entries");
-    }
-    return jle::toString(estimator_->addJointSample(t, q.data(),
-                                                    model_.floating_base ? &base : nullptr,
-                                                    qd_object.is_none() ? nullptr : qd.data()));
+  void setTransform(const std::string& target, const std::string& frame, const Array& pose) {
+    frames_.set(target, frame, poseOf(pose, "pose"));
   }
 
-  static jle::BasePose basePoseOf(const Array& p) {
-    if (p.ndim() != 1 || p.shape(0) != 7)
-      throw std::invalid_argument("base_pose must be 7 numbers (x y z qx qy qz qw)");
-    jle::BasePose base;
-    const double* x = p.data();
-    base.position = Eigen::Vector3d(x[0], x[1], x[2]);
-    base.orientation = Eigen::Quaterniond(x[6], x[3], x[4], x[5]);
-    return base;
+  std::string addJointState(double t, const py::object& names_given, const Array& q,
+                            const py::object& qd, const py::object& effort,
+                            const py::object& base_pose) {
+    if (q.ndim() != 1) throw std::invalid_argument("q must be one-dimensional");
+    const std::size_t n = static_cast<std::size_t>(q.shape(0));
+    const std::vector<std::string> names = names_given.is_none()
+                                               ? model_.coordinate_names
+                                               : names_given.cast<std::vector<std::string>>();
+    if (names.size() != n)
+      throw std::invalid_argument("names has " + std::to_string(names.size()) + " entries and q " +
+                                  std::to_string(n));
+    if (!base_pose.is_none()) setBasePose(base_pose.cast<Array>());
+    const jle::Stamp stamp = stampOf(t);
+    return jle::toString(
+        pipeline_->onJointState(stamp, stamp, names, std::vector<double>(q.data(), q.data() + n),
+                                valuesOf(qd, n, "qd"), valuesOf(effort, n, "effort")));
+  }
+
+  std::string addWrench(int k, double t, const Array& force, const Array& moment,
+                        const std::string& frame) {
+    const jle::Settings& s = pipeline_->settings();
+    if (k < 0 || k >= static_cast<int>(s.wrenches.size()))
+      throw std::invalid_argument("no wrench input " + std::to_string(k));
+    const jle::Stamp stamp = stampOf(t);
+    const std::size_t i = static_cast<std::size_t>(k);
+    const std::string& given = !frame.empty()                 ? frame
+                               : !s.wrenches[i].frame.empty() ? s.wrenches[i].frame
+                                                              : s.estimator.wrenches[i].link;
+    return jle::toString(pipeline_->onWrench(k, stamp, stamp, given, vector3Of(force, "force"),
+                                             vector3Of(moment, "moment")));
+  }
+
+  std::string addPlate(int k, double t, const Array& force, const Array& moment,
+                       const std::string& frame) {
+    const jle::Settings& s = pipeline_->settings();
+    if (k < 0 || k >= static_cast<int>(s.force_plates.size()))
+      throw std::invalid_argument("no force plate " + std::to_string(k));
+    const jle::Stamp stamp = stampOf(t);
+    const std::string& given =
+        frame.empty() ? s.force_plates[static_cast<std::size_t>(k)].frame : frame;
+    return jle::toString(pipeline_->onPlate(k, stamp, stamp, given, vector3Of(force, "force"),
+                                            vector3Of(moment, "moment")));
+  }
+
+  py::dict record(bool smoothed) const {
+    if (smoothed && !pipeline_->hasSmoothed())
+      throw std::invalid_argument("smoothed/enabled is false: no smoothed stream");
+    const jle::LoadsRecord& r = smoothed ? pipeline_->smoothedRecord() : pipeline_->record();
+    jle_python::RecordColumns one(r);
+    one.add(r);
+    return one.result(&secondsOf);
   }
 
   // The loads of the last published sample: m x 6 wrenches (child frame), m efforts.
   py::dict loads() const {
-    const jle::Data<double>& d = estimator_->data();
-    Array wrench({static_cast<py::ssize_t>(segments_.size()), py::ssize_t(6)});
-    Array effort({static_cast<py::ssize_t>(segments_.size())});
-    double *w = wrench.mutable_data(), *e = effort.mutable_data();
-    for (int s : segments_) {
-      putWrench(jle::jointWrench(estimator_->model(), d, s, jle::WrenchFrame::kChild), w);
-      w += 6;
-      *e++ = d.effort[static_cast<std::size_t>(s)];
-    }
+    const jle::LoadsRecord& r = pipeline_->record();
+    const auto m = static_cast<py::ssize_t>(r.joint.size());
+    Array wrench({m, py::ssize_t(6)});
+    double* w = wrench.mutable_data();
+    for (std::size_t i = 0; i < r.joint.size(); ++i, w += 6)
+      for (int c = 0; c < 3; ++c) w[c] = r.force[i][c], w[3 + c] = r.moment[i][c];
     py::dict out;
-    out["t"] = estimator_->stamp();
+    out["t"] = secondsOf(r.stamp);
     out["wrench"] = wrench;
-    out["effort"] = effort;
+    out["effort"] = Array(m, r.effort.data());
     return out;
   }
 
-  py::dict run(const Array& t, const Array& q, const py::list& wrenches);
+  py::dict run(const Array& t, const Array& q, const py::list& wrenches, const py::object& qd,
+               const py::object& base_pose);
 
  private:
-  void appendLoads(std::vector<double>& stamps, std::vector<double>& w,
-                   std::vector<double>& e) const;
+  void setBasePose(const Array& pose) {
+    const jle::Settings& s = pipeline_->settings();
+    frames_.set(s.world_frame, s.base_frame, poseOf(pose, "base_pose"));
+  }
+
   jle::Settings settings_;
   jle::Model<double> model_;
-  std::unique_ptr<jle::Estimator> estimator_;
-  std::vector<int> segments_;
+  PyFrames frames_;
+  std::unique_ptr<jle::Pipeline> pipeline_;
 };
 
 // One wrench input's samples for run(): times [s] and n x 6 readings.
@@ -343,67 +432,88 @@ std::vector<WrenchSeries> wrenchSeries(const py::list& wrenches, int inputs) {
     const std::string what = "wrenches[" + std::to_string(k) + "]";
     if (s.t.ndim() != 1) throw std::invalid_argument(what + ": t must be one-dimensional");
     checkShape(s.w, static_cast<long>(s.t.shape(0)), 6, what + " readings");
+    for (py::ssize_t i = 0; i < s.t.shape(0); ++i) stampOf(s.t.data()[i]);  // checked here
     series.push_back(std::move(s));
   }
   return series;
 }
 
-void PyEstimator::appendLoads(std::vector<double>& stamps, std::vector<double>& w,
-                              std::vector<double>& e) const {
-  stamps.push_back(estimator_->stamp());
-  const jle::Data<double>& d = estimator_->data();
-  for (int s : segments_) {
-    double out[6];
-    putWrench(jle::jointWrench(estimator_->model(), d, s, jle::WrenchFrame::kChild), out);
-    w.insert(w.end(), out, out + 6);
-    e.push_back(d.effort[static_cast<std::size_t>(s)]);
-  }
+// An optional N x cols array of run(), checked; null when not given.
+const double* rowsOf(const py::object& given, long n, long cols, const std::string& what,
+                     std::vector<Array>& keep) {
+  if (given.is_none()) return nullptr;
+  keep.push_back(given.cast<Array>());
+  checkShape(keep.back(), n, cols, what);
+  return keep.back().data();
 }
 
-py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrenches) {
-  if (model_.floating_base)
-    throw std::invalid_argument(
-        "estimate(): a fixed-base model only; feed a floating base sample by sample "
-        "(add_joint_sample with base_pose)");
+py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrenches,
+                          const py::object& qd_given, const py::object& base_given) {
   if (t.ndim() != 1) throw std::invalid_argument("t must be one-dimensional");
   const long n = static_cast<long>(t.shape(0));
   checkShape(q, n, model_.nq, "q");
+  std::vector<Array> keep;
+  const double* qd = rowsOf(qd_given, n, model_.nq, "qd", keep);
+  const double* base = rowsOf(base_given, n, 7, "base_pose", keep);
+  if (model_.floating_base && !base)
+    throw std::invalid_argument("a floating-base model needs base_pose (N x 7)");
+  for (long i = 0; i < n; ++i) stampOf(t.data()[i]);
   std::vector<WrenchSeries> series =
-      wrenchSeries(wrenches, static_cast<int>(settings_.estimator.wrenches.size()));
-  const std::size_t m = segments_.size();
-  std::vector<double> stamps, w, e;
+      wrenchSeries(wrenches, static_cast<int>(pipeline_->settings().wrenches.size()));
+  std::vector<Eigen::Isometry3d> poses;
+  for (long i = 0; base && i < n; ++i) {
+    Array row(py::ssize_t(7), base + 7 * i);
+    poses.push_back(poseOf(row, "base_pose[" + std::to_string(i) + "]"));
+  }
+  jle_python::RecordColumns immediate(pipeline_->record());
+  std::unique_ptr<jle_python::RecordColumns> smoothed;
+  if (pipeline_->hasSmoothed())
+    smoothed = std::make_unique<jle_python::RecordColumns>(pipeline_->smoothedRecord());
   std::vector<std::string> status(static_cast<std::size_t>(n));
   {
     py::gil_scoped_release release;
+    jle::Pipeline& p = *pipeline_;
+    const jle::Settings& s = p.settings();
+    const std::vector<double> none;
+    std::vector<double> position(static_cast<std::size_t>(model_.nq)), velocity;
+    if (qd) velocity.resize(position.size());
+    const auto drain = [&] {
+      while (p.takeDrained()) immediate.add(p.record());
+      if (!smoothed) return;
+      if (p.smoothedPublished()) smoothed->add(p.smoothedRecord());
+      while (p.takeDrainedSmoothed()) smoothed->add(p.smoothedRecord());
+    };
     for (long i = 0; i < n; ++i) {
       const double ti = t.data()[i];
       for (std::size_t k = 0; k < series.size(); ++k)  // every reading up to ti first
-        for (WrenchSeries& s = series[k];
-             s.next < static_cast<std::size_t>(s.t.shape(0)) && s.t.data()[s.next] <= ti;
-             ++s.next) {
-          const double* x = s.w.data() + 6 * s.next;
-          estimator_->addWrench(static_cast<int>(k), s.t.data()[s.next],
-                                Eigen::Vector3d(x[0], x[1], x[2]),
-                                Eigen::Vector3d(x[3], x[4], x[5]));
+        for (WrenchSeries& w = series[k];
+             w.next < static_cast<std::size_t>(w.t.shape(0)) && w.t.data()[w.next] <= ti;
+             ++w.next) {
+          const double* x = w.w.data() + 6 * w.next;
+          const jle::Stamp stamp = stampOf(w.t.data()[w.next]);
+          const std::string& frame =
+              s.wrenches[k].frame.empty() ? s.estimator.wrenches[k].link : s.wrenches[k].frame;
+          p.onWrench(static_cast<int>(k), stamp, stamp, frame, Eigen::Vector3d(x[0], x[1], x[2]),
+                     Eigen::Vector3d(x[3], x[4], x[5]));
+          drain();
         }
-      const jle::SampleStatus st = estimator_->addJointSample(ti, q.data() + model_.nq * i);
-      status[static_cast<std::size_t>(i)] = jle::toString(st);
-      if (st == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
-      // A smoother's other samples due at this one (after a longer interval, a gap).
-      for (jle::SampleStatus due = st; estimator_->takeDue(due);)
-        if (due == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
+      std::copy(q.data() + model_.nq * i, q.data() + model_.nq * (i + 1), position.begin());
+      if (qd) std::copy(qd + model_.nq * i, qd + model_.nq * (i + 1), velocity.begin());
+      if (base) frames_.set(s.world_frame, s.base_frame, poses[static_cast<std::size_t>(i)]);
+      const jle::Stamp stamp = stampOf(ti);
+      const jle::Outcome o =
+          p.onJointState(stamp, stamp, model_.coordinate_names, position, velocity, none);
+      status[static_cast<std::size_t>(i)] = jle::toString(o);
+      if (o == jle::Outcome::kPublished) immediate.add(p.record());
+      drain();
     }
-    // A smoother's (differentiator/lag) last samples: smoothed with the data there is.
-    jle::SampleStatus st = jle::SampleStatus::kPublished;
-    while (estimator_->flush(st))
-      if (st == jle::SampleStatus::kPublished) appendLoads(stamps, w, e);
+    // A smoother's last samples: smoothed with the data there is.
+    while (p.flush()) immediate.add(p.record());
+    while (smoothed && p.flushSmoothed()) smoothed->add(p.smoothedRecord());
   }
-  const auto rows = static_cast<py::ssize_t>(stamps.size()), cols = static_cast<py::ssize_t>(m);
-  py::dict out;
-  out["t"] = Array(rows, stamps.data());
-  out["wrench"] = Array({rows, cols, py::ssize_t(6)}, w.data());
-  out["effort"] = Array({rows, cols}, e.data());
+  py::dict out = immediate.result(&secondsOf);
   out["status"] = status;
+  out["smoothed"] = smoothed ? py::object(smoothed->result(&secondsOf)) : py::none();
   return out;
 }
 
@@ -475,110 +585,6 @@ Array lowPassZeroPhase(const Array& t_in, const Array& x_in, double cutoff, int 
   return arrayOf(y);
 }
 
-// ---- a bag through the node's message path --------------------------------------------
-
-// The records of one stream, kept as columns.
-class RecordColumns {
- public:
-  void add(const jle::LoadsRecord& r) {
-    stamps_.push_back(r.stamp);
-    for (std::size_t i = 0; i < r.joint.size(); ++i) {
-      for (int c = 0; c < 3; ++c) wrench_.push_back(r.force[i][c]);
-      for (int c = 0; c < 3; ++c) wrench_.push_back(r.moment[i][c]);
-    }
-    append(effort_, r.effort);
-    append(stddev_, r.effort_stddev);
-    append(position_, r.position);
-    append(velocity_, r.velocity);
-    append(acceleration_, r.acceleration);
-    append(motor_, r.motor_effort);
-    append(measured_, r.measured_effort);
-  }
-  py::dict result(const std::vector<std::string>& joints,
-                  const std::vector<std::string>& links) const;
-
- private:
-  static void append(std::vector<double>& to, const std::vector<double>& from) {
-    to.insert(to.end(), from.begin(), from.end());
-  }
-  std::vector<jle::Stamp> stamps_;
-  std::vector<double> wrench_, effort_, stddev_, position_, velocity_, acceleration_, motor_,
-      measured_;
-};
-
-py::dict RecordColumns::result(const std::vector<std::string>& joints,
-                               const std::vector<std::string>& links) const {
-  const auto n = static_cast<py::ssize_t>(stamps_.size());
-  const auto m = static_cast<py::ssize_t>(joints.size());
-  const auto columns = [&](const std::vector<double>& v) {
-    return Array({n, v.empty() ? py::ssize_t(0) : m}, v.data());
-  };
-  std::vector<double> t;
-  for (jle::Stamp s : stamps_) t.push_back(jle::toRosTime(s).toSec());  // as process_bag writes
-  py::dict out;
-  out["joints"] = joints;
-  out["links"] = links;
-  out["frame"] = "child";
-  out["t"] = Array(n, t.data());
-  out["stamp_ns"] = py::array_t<std::int64_t>(n, stamps_.data());
-  out["wrench"] = Array({n, m, py::ssize_t(6)}, wrench_.data());
-  out["effort"] = columns(effort_);
-  out["effort_stddev"] = columns(stddev_);
-  out["position"] = columns(position_);
-  out["velocity"] = columns(velocity_);
-  out["acceleration"] = columns(acceleration_);
-  out["motor_effort"] = columns(motor_);
-  out["measured_effort"] = columns(measured_);
-  return out;
-}
-
-// Every published record of both streams.
-class RecordSink : public jle::LoadsSink {
- public:
-  void open(const jle::Pipeline& pipeline) override {
-    const jle::LoadsRecord& r = pipeline.record();
-    joints_ = r.joint;
-    links_ = r.link;
-    has_smoothed_ = pipeline.hasSmoothed();
-  }
-  void write(const jle::LoadsRecord& r, long) override { immediate_.add(r); }
-  void writeSmoothed(const jle::LoadsRecord& r, long) override { smoothed_.add(r); }
-  // The immediate stream's columns, and its smoothed stream's under "smoothed" (None when
-  // smoothed/enabled is false).
-  py::dict result() const {
-    py::dict out = immediate_.result(joints_, links_);
-    out["smoothed"] = has_smoothed_ ? py::object(smoothed_.result(joints_, links_)) : py::none();
-    return out;
-  }
-
- private:
-  std::vector<std::string> joints_, links_;
-  bool has_smoothed_ = false;
-  RecordColumns immediate_, smoothed_;
-};
-
-py::dict processBag(const std::string& bag, const std::string& urdf, const std::string& config,
-                    const py::object& zero_phase, const std::string& cutoff_rule, bool summary) {
-  jle::BagOptions options;
-  options.bag = bag;
-  options.urdf = urdf;
-  options.config = config;
-  options.summary = summary;
-  if (!zero_phase.is_none()) {
-    options.smooth = true;
-    const bool automatic = py::isinstance<py::str>(zero_phase);
-    if (automatic && zero_phase.cast<std::string>() != "auto")
-      throw std::invalid_argument("zero_phase must be a cutoff [Hz], 'auto' or None");
-    options.smoothing = zeroPhaseConfig(automatic ? py::none() : zero_phase, cutoff_rule, 4, 0);
-  }
-  RecordSink sink;
-  {
-    py::gil_scoped_release release;
-    jle::processBag(options, sink);
-  }
-  return sink.result();
-}
-
 // ---- the module -----------------------------------------------------------------------
 
 void defineModel(py::module_& m) {
@@ -618,59 +624,118 @@ void defineModel(py::module_& m) {
       .def_property_readonly("warnings", [](const PyModel& p) { return p.model.warnings; });
 }
 
-void defineEstimator(py::module_& m) {
-  py::class_<PyEstimator>(m, "Estimator",
-                          "The node's online estimator (filters, wrench inputs, loads).")
-      .def(py::init<const PyModel&, const std::string&>(), py::arg("model"),
-           py::arg("config") = std::string(),
-           "config: the node's parameters as a YAML file (config/default.yaml); empty: the "
-           "node's defaults.")
-      .def("add_joint_sample", &PyEstimator::addJointSample, py::arg("t"), py::arg("q"),
-           py::arg("base_pose") = py::none(), py::arg("qd") = py::none(),
-           "qd: the measured joint velocities (NaN: none at this sample), used as the "
-           "configuration's measured_velocity says.")
+py::dict counters(const jle::Pipeline& p) {
+  const jle::PipelineCounters& c = p.counters();
+  py::dict out;
+  const char* kinds[] = {"joint_state", "wrench", "plate"};
+  for (int k = 0; k < static_cast<int>(jle::InputKind::kCount); ++k) {
+    py::dict per;
+    for (int o = 0; o < static_cast<int>(jle::Outcome::kCount); ++o)
+      per[jle::toString(static_cast<jle::Outcome>(o))] = c.outcomes[k][o];
+    out[kinds[k]] = per;
+  }
+  out["unknown_joints"] = c.unknown_joints;
+  out["resets"] = c.resets;
+  out["nonfinite_efforts"] = c.nonfinite_efforts;
+  out["nonfinite_velocities"] = c.nonfinite_velocities;
+  return out;
+}
+
+void defineEstimatorInputs(py::class_<PyEstimator>& c) {
+  c.def("add_joint_state", &PyEstimator::addJointState, py::arg("t"), py::kw_only(),
+        py::arg("names") = py::none(), py::arg("q"), py::arg("qd") = py::none(),
+        py::arg("effort") = py::none(), py::arg("base_pose") = py::none(),
+        "A JointState: names (default: coordinate_names), positions, and optionally measured "
+        "velocities and efforts (NaN: none for that joint), and a floating base's pose (x y z "
+        "qx qy qz qw in world_frame). Returns what became of it: 'published' (record() holds "
+        "its loads), 'used', or the reason it was not used ('invalid', 'stamp order', ...; "
+        "problem says why).")
       .def(
-          "add_wrench",
-          [](PyEstimator& e, int k, double t, const std::vector<double>& f,
-             const std::vector<double>& mom) {
-            if (k < 0 || k >= static_cast<int>(e.settings().estimator.wrenches.size()))
-              throw std::invalid_argument("no wrench input " + std::to_string(k));
-            if (f.size() != 3 || mom.size() != 3)
-              throw std::invalid_argument("force and moment must be 3 numbers each");
-            return e.estimator().addWrench(k, t, Eigen::Vector3d(f[0], f[1], f[2]),
-                                           Eigen::Vector3d(mom[0], mom[1], mom[2]));
+          "add_joint_sample",
+          [](PyEstimator& e, double t, const Array& q, const py::object& base_pose,
+             const py::object& qd) {
+            return e.addJointState(t, py::none(), q, qd, py::none(), base_pose);
           },
-          py::arg("k"), py::arg("t"), py::arg("force"), py::arg("moment"))
-      .def("reset", [](PyEstimator& e) { e.estimator().reset(); })
+          py::arg("t"), py::arg("q"), py::arg("base_pose") = py::none(), py::arg("qd") = py::none(),
+          "add_joint_state with q in coordinate_names order.")
+      .def("add_wrench", &PyEstimator::addWrench, py::arg("k"), py::arg("t"), py::arg("force"),
+           py::arg("moment"), py::arg("frame") = std::string(),
+           "A reading of wrench input k of the config: force [N], moment [N m] about the origin "
+           "of `frame` (default: the input's configured frame, else its link). Returns its "
+           "outcome ('used', or why not).")
+      .def("add_plate", &PyEstimator::addPlate, py::arg("k"), py::arg("t"), py::arg("force"),
+           py::arg("moment"), py::arg("frame") = std::string(),
+           "A sample of force plate k of the config: what the foot applies to the plate, plate "
+           "frame (default: the configured frame), moment about its origin.")
+      .def("set_transform", &PyEstimator::setTransform, py::arg("target"), py::arg("frame"),
+           py::arg("pose"),
+           "The pose (x y z qx qy qz qw) of `frame` in `target`, for frames the URDF does not "
+           "hold rigidly (tf2's role in the node: a plate's frame in the world, a sensor's "
+           "frame); kept until set again.")
+      .def("reset", &PyEstimator::reset, "Every filter and counter from the start.");
+}
+
+void defineEstimatorOutputs(py::class_<PyEstimator>& c) {
+  c.def("_record", &PyEstimator::record, py::arg("smoothed") = false,
+        "The last published record as Loads arrays of one sample (every output: loads, "
+        "efforts, coordinates, sensor residuals, plates, base residual, external efforts).")
+      .def("loads", &PyEstimator::loads)
+      .def(
+          "take_drained", [](PyEstimator& e) { return e.pipeline().takeDrained(); },
+          "After every input: true while another record is due (a smoother's), each then in "
+          "record().")
+      .def("take_drained_smoothed",
+           [](PyEstimator& e) { return e.pipeline().takeDrainedSmoothed(); })
+      .def(
+          "smoothed_published",
+          [](const PyEstimator& e) { return e.pipeline().smoothedPublished(); },
+          "Whether the last input put a smoothed record in record(smoothed=True).")
       .def(
           "flush",
           [](PyEstimator& e) -> py::object {
-            jle::SampleStatus st = jle::SampleStatus::kPublished;
-            if (!e.estimator().flush(st)) return py::none();
-            return py::str(jle::toString(st));
+            if (!e.pipeline().flush()) return py::none();
+            return py::str("published");
           },
           "The end of a stream: with a smoother (differentiator/lag > 0) the next sample "
-          "still to come, smoothed with the data there is: its status as add_joint_sample "
-          "gives it ('published': loads() and stamp hold it), None when none is left.")
-      .def("loads", &PyEstimator::loads)
-      .def("run", &PyEstimator::run, py::arg("t"), py::arg("q"), py::arg("wrenches") = py::list())
-      .def_property_readonly("joints",
-                             [](const PyEstimator& e) {
-                               return namesOf(e.estimator().model().joint_name, e.segments());
-                             })
+          "still to come, smoothed with the data there is ('published': record() holds it), "
+          "None when none is left.")
+      .def(
+          "flush_smoothed", [](PyEstimator& e) { return e.pipeline().flushSmoothed(); },
+          "As flush, for the smoothed stream: true while a record was put in "
+          "record(smoothed=True).")
+      .def("run", &PyEstimator::run, py::arg("t"), py::arg("q"), py::arg("wrenches") = py::list(),
+           py::arg("qd") = py::none(), py::arg("base_pose") = py::none());
+}
+
+void defineEstimator(py::module_& m) {
+  py::class_<PyEstimator> c(m, "Estimator",
+                            "The node's message path (jle::Pipeline): its filters, checks, "
+                            "both streams and every output.");
+  c.def(py::init<const PyModel&, const std::string&>(), py::arg("model"),
+        py::arg("config") = std::string(),
+        "config: the node's parameters as a YAML file (config/default.yaml); empty: the node's "
+        "defaults.");
+  defineEstimatorInputs(c);
+  defineEstimatorOutputs(c);
+  c.def_property_readonly("joints",
+                          [](const PyEstimator& e) { return e.pipeline().record().joint; })
       .def_property_readonly("links",
-                             [](const PyEstimator& e) {
-                               return namesOf(e.estimator().model().link_name, e.segments());
-                             })
+                             [](const PyEstimator& e) { return e.pipeline().record().link; })
       .def_property_readonly(
           "coordinate_names",
-          [](const PyEstimator& e) { return e.estimator().model().coordinate_names; })
+          [](const PyEstimator& e) { return e.pipeline().model().coordinate_names; })
       .def_property_readonly("delay_samples",
-                             [](const PyEstimator& e) { return e.estimator().delaySamples(); })
-      .def_property_readonly("stamp", [](const PyEstimator& e) { return e.estimator().stamp(); })
-      .def_property_readonly("q", [](const PyEstimator& e) { return e.estimator().q(); })
-      .def_property_readonly("qd", [](const PyEstimator& e) { return e.estimator().qd(); })
-      .def_property_readonly("qdd", [](const PyEstimator& e) { return e.estimator().qdd(); });
+                             [](const PyEstimator& e) { return e.pipeline().delaySamples(); })
+      .def_property_readonly("has_smoothed",
+                             [](const PyEstimator& e) { return e.pipeline().hasSmoothed(); })
+      .def_property_readonly(
+          "stamp", [](const PyEstimator& e) { return secondsOf(e.pipeline().record().stamp); })
+      .def_property_readonly("q", [](const PyEstimator& e) { return e.pipeline().record().q; })
+      .def_property_readonly("qd", [](const PyEstimator& e) { return e.pipeline().record().qd; })
+      .def_property_readonly("qdd", [](const PyEstimator& e) { return e.pipeline().record().qdd; })
+      .def_property_readonly("problem", [](const PyEstimator& e) { return e.pipeline().problem(); })
+      .def_property_readonly("counters",
+                             [](const PyEstimator& e) { return counters(e.pipeline()); });
 }
 
 }  // namespace
@@ -685,8 +750,6 @@ PYBIND11_MODULE(_core, m) {
         py::arg("rule"), py::arg("order"), py::arg("padding"));
   m.def("_low_pass_zero_phase", &lowPassZeroPhase, py::arg("t"), py::arg("x"), py::arg("cutoff"),
         py::arg("order"), py::arg("padding"));
-  m.def("_process_bag", &processBag, py::arg("bag"), py::arg("urdf"), py::arg("config"),
-        py::arg("zero_phase"), py::arg("cutoff_rule"), py::arg("summary"));
   m.attr("default_gravity") = std::vector<double>{jle::EstimatorConfig().gravity_world[0],
                                                   jle::EstimatorConfig().gravity_world[1],
                                                   jle::EstimatorConfig().gravity_world[2]};

@@ -5,7 +5,7 @@
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
-#include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/settings_reader.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
 
@@ -479,7 +479,7 @@ void BagProcessor::printDrops() const {
 void processBag(const BagOptions& options, LoadsSink& sink) {
   jle::Settings settings;
   try {
-    settings = jle::parseSettings(options.config.empty() ? XmlRpc::XmlRpcValue()
+    settings = jle::parseSettings(options.config.empty() ? jle::ParamValue()
                                                          : jle::loadYaml(options.config));
   } catch (const jle::SettingsError& e) {
     throw std::runtime_error(options.config + ": " + e.what());

@@ -8,6 +8,7 @@ import csv
 import os
 import re
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -330,6 +331,93 @@ def test_estimator_is_process_bag(tmp_path, example_bag, lag):
     assert len(flushed) == pending and (lag == 0 or pending > 10), flushed
     assert estimator.flush() is None
     assert_same(np.array(published), loads.effort, "sample by sample")
+
+
+def pose_of(transform):
+    t, r = transform.translation, transform.rotation
+    return np.array([t.x, t.y, t.z, r.x, r.y, r.z, r.w])
+
+
+def test_estimator_runs_the_gait_demo_with_plates(tmp_path):
+    """The gait demo's configuration (floating base, two force plates, body_mass,
+    decimation, a centred Savitzky-Golay filter) through Estimator, fed a walking bag's
+    joint states (by name), plate samples and tf poses message by message, gives the
+    records process_bag's code gives for the same bag: loads, efforts per kg, centres of
+    pressure, plate contact and the base residual, both streams."""
+    import rosbag
+    bag = str(tmp_path / "gait.bag")
+    subprocess.run([tool("make_gait_bag"), "--urdf", BODY, "--output", bag, "--strides", "1"],
+                   check=True, capture_output=True)
+    config = os.path.join(REPO, "config", "gait_demo.yaml")
+    expected = jle.process_bag(bag, BODY, config)
+    estimator = jle.Estimator(jle.Model(BODY), config)
+    plates = {"/force_plate_1/wrench": 0, "/force_plate_2/wrench": 1}
+    t0 = None
+    records, smoothed = [], []
+
+    def take():
+        while estimator.take_drained():
+            records.append(estimator.record())
+        if estimator.smoothed_published():
+            smoothed.append(estimator.record(smoothed=True))
+        while estimator.take_drained_smoothed():
+            smoothed.append(estimator.record(smoothed=True))
+
+    with rosbag.Bag(bag) as b:
+        for topic, msg, _ in b.read_messages():
+            if topic in ("/tf", "/tf_static"):
+                for tf in msg.transforms:
+                    estimator.set_transform(tf.header.frame_id, tf.child_frame_id,
+                                            pose_of(tf.transform))
+                continue
+            if topic not in plates and topic != "/joint_states":
+                continue
+            stamp = msg.header.stamp.to_nsec()
+            t0 = stamp if t0 is None else t0
+            t = (stamp - t0) * 1e-9
+            if topic == "/joint_states":
+                outcome = estimator.add_joint_state(t, names=list(msg.name),
+                                                    q=np.array(msg.position))
+                if outcome == "published":
+                    records.append(estimator.record())
+            else:
+                w = msg.wrench
+                outcome = estimator.add_plate(plates[topic], t, [w.force.x, w.force.y, w.force.z],
+                                              [w.torque.x, w.torque.y, w.torque.z],
+                                              msg.header.frame_id)
+                assert outcome == "used", (outcome, estimator.problem)
+            take()
+    while estimator.flush():
+        records.append(estimator.record())
+    while estimator.flush_smoothed():
+        smoothed.append(estimator.record(smoothed=True))
+    assert len(records) == len(expected.t) >= 100  # 1 s at 100 Hz (decimation 2)
+    assert len(smoothed) == len(expected.smoothed.t) >= 100
+    joined = lambda key, rows: np.concatenate([getattr(r, key) for r in rows])
+    for key in ("wrench", "effort", "effort_per_kg", "cop", "normal_force", "base_residual", "q",
+                "qdd"):
+        assert_same(joined(key, records), getattr(expected, key), key)
+    assert (joined("plate_contact", records) == expected.plate_contact).all()
+    assert expected.plate_contact.any() and (~expected.plate_contact).any()
+    assert_same(joined("effort", smoothed), expected.smoothed.effort, "smoothed effort")
+    # The plates matter: a moment of 1 N m/kg or more at the ankles in stance.
+    assert np.abs(expected.effort_per_kg).max() > 1.0
+
+
+def test_core_module_loads_without_ros():
+    """joint_load_estimator (the model, inverse dynamics, the estimator, the zero-phase
+    smoother) loads no ROS library: only process_bag's module (_bag) reads bags."""
+    code = ("import joint_load_estimator as j; m = j.Model(%r); e = j.Estimator(m); "
+            "print(open('/proc/self/maps').read())" % PANDA)
+    maps = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                          text=True).stdout
+    paths = [line.split()[-1] for line in maps.splitlines() if len(line.split()) >= 6]
+    loaded = {os.path.basename(p) for p in paths if p.endswith(".so") or ".so." in p}
+    ros = sorted(name for name in loaded
+                 if re.match(r"lib(roscpp|rosbag|rosconsole|tf2|xmlrpcpp|cpp_common|rostime)",
+                             name))
+    assert any(name.startswith("_core") for name in loaded), sorted(loaded)
+    assert not ros, ros
 
 
 def test_estimator_defaults_are_the_nodes(tmp_path):

@@ -1,5 +1,5 @@
 """The layers: the front ends (the node and nodelet in src/ros, the offline tools in
-src/tools) reach the computation only through jle::Pipeline and read only its record;
+src/tools, the Python modules in src/python) reach the computation only through jle::Pipeline and read only its record;
 none of them names the estimator behind it (jle::Estimator, estimator.hpp,
 Pipeline::estimator(), which is not public). Run by test/CMakeLists.txt under pytest."""
 
@@ -7,9 +7,9 @@ import os
 import re
 
 REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
-FRONT_ENDS = ["src/ros", "src/tools", "include/joint_load_estimator/ros"]
+FRONT_ENDS = ["src/ros", "src/tools", "src/python", "include/joint_load_estimator/ros"]
 BEHIND_THE_PIPELINE = re.compile(
-    r"(?<![A-Za-z_/])Estimator(?![A-Za-z_.])|estimator\.hpp|\.estimator\(\)|->estimator\(\)")
+    r"(?<![A-Za-z_/\"])Estimator(?![A-Za-z_.\"])|estimator\.hpp|\.estimator\(\)|->estimator\(\)")
 
 
 def sources(folder):
@@ -36,5 +36,5 @@ def test_the_pattern_finds_what_it_must():
                  "pipeline_->estimator().data()", "Estimator estimator(model, config);"]:
         assert BEHIND_THE_PIPELINE.search(line), line
     for line in ["BiasEstimator b;", "EstimatorNode node;", "jle::EstimatorConfig c;",
-                 "smoothedEstimatorConfig(s)"]:
+                 "smoothedEstimatorConfig(s)", 'py::class_<PyEstimator> c(m, "Estimator",']:
         assert not BEHIND_THE_PIPELINE.search(line), line

@@ -32,7 +32,7 @@
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/settings_reader.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <diagnostic_msgs/DiagnosticArray.h>

@@ -2,7 +2,7 @@
 // naming the key) and in process_bag (the plate pose from the config; effort_per_kg),
 // against the hand-worked numbers of test/rostest/test_plates.cpp.
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/ros/settings.hpp>
+#include <joint_load_estimator/settings_reader.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <rosbag/bag.h>
@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 const std::string kFoot = std::string(JLE_ROSTEST_DIR) + "/standing_foot.urdf";
 
-XmlRpc::XmlRpcValue yaml(const std::string& text, const fs::path& dir) {
+jle::ParamValue yaml(const std::string& text, const fs::path& dir) {
   const fs::path p = dir / "settings.yaml";
   std::ofstream(p) << text;
   return jle::loadYaml(p.string());

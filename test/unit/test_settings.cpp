@@ -1,8 +1,8 @@
-// The parameter reader (ros/settings.hpp) maps every key onto its field of jle::Settings
-// and refuses what validate() refuses, naming the key: per key family an ok and a ko
-// YAML (test/config/ok_*.yaml, ko_*.yaml), as ros_controllers' joint_state_controller
-// tests do. And the documentation cannot drift: config/default.yaml and the defaults
-// stated by README.md's parameter table parse to Settings{}.
+// The parameter reader (settings_reader.hpp; ros/settings.hpp for the parameter server) maps every
+// key onto its field of jle::Settings and refuses what validate() refuses, naming the key: per key
+// family an ok and a ko YAML (test/config/ok_*.yaml, ko_*.yaml), as ros_controllers'
+// joint_state_controller tests do. And the documentation cannot drift: config/default.yaml and the
+// defaults stated by README.md's parameter table parse to Settings{}.
 #include <joint_load_estimator/ros/settings.hpp>
 
 #include <gtest/gtest.h>
@@ -459,22 +459,48 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
 TEST(SettingsDocs, DefaultYamlIsSettingsDefaults) {
   expectSame(parseFile(JLE_DEFAULT_YAML), Settings{});
   // And parsing nothing is Settings{}: the reader writes no default of its own.
+  expectSame(jle::parseSettings(jle::ParamValue()), Settings{});
   expectSame(jle::parseSettings(XmlRpc::XmlRpcValue()), Settings{});
+}
+
+// The parameter server's values (XmlRpc) read as the same file's YAML: every type, nested
+// maps and lists.
+TEST(SettingsReader, ParameterServerValuesAreReadAsTheirYaml) {
+  XmlRpc::XmlRpcValue params;
+  params["decimation"] = 3;
+  params["gravity"][0] = 0.0;
+  params["gravity"][1] = 0;
+  params["gravity"][2] = -9.5;
+  params["joints"][0] = std::string("a");
+  params["savings"]["prune"] = false;
+  params["differentiator"]["type"] = std::string("kalman");
+  params["wrenches"][0]["topic"] = std::string("ft");
+  params["wrenches"][0]["link"] = std::string("tool0");
+  params["wrenches"][0]["sign"] = -1.0;
+  expectSame(
+      jle::parseSettings(params),
+      jle::parseSettings(jle::parseYaml(
+          "decimation: 3\ngravity: [0.0, 0, -9.5]\njoints: [a]\nsavings: {prune: false}\n"
+          "differentiator: {type: kalman}\nwrenches: [{topic: ft, link: tool0, sign: -1.0}]")));
+  EXPECT_EQ(jle::parseSettings(params).estimator.decimation, 3);
+  EXPECT_EQ(jle::parseSettings(params).estimator.wrenches.at(0).sign, -1.0);
+  EXPECT_THROW(jle::parseYaml("decimation: [1"), jle::SettingsError);
 }
 
 // Every key of the ok files (which together hold every key the reader knows) is in
 // config/default.yaml: top-level keys at the top, a map's keys in that map.
 TEST(SettingsDocs, DefaultYamlListsEveryKey) {
-  XmlRpc::XmlRpcValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
+  const jle::ParamValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
   for (const char* family : {"top_level", "differentiator", "savings", "uncertainty", "stamps",
                              "external_effort", "smoothed"}) {
-    XmlRpc::XmlRpcValue ok = jle::loadYaml(kConfig + "/ok_" + family + ".yaml");
-    for (auto& kv : ok) {
-      ASSERT_TRUE(defaults.hasMember(kv.first)) << kv.first << " is not in config/default.yaml";
-      if (kv.second.getType() != XmlRpc::XmlRpcValue::TypeStruct) continue;
-      for (auto& sub : kv.second)
-        EXPECT_TRUE(defaults[kv.first].hasMember(sub.first))
-            << kv.first << "/" << sub.first << " is not in config/default.yaml";
+    const jle::ParamValue ok = jle::loadYaml(kConfig + "/ok_" + family + ".yaml");
+    for (std::size_t i = 0; i < ok.size(); ++i) {
+      const std::string& key = ok.key(i);
+      ASSERT_TRUE(defaults.has(key)) << key << " is not in config/default.yaml";
+      if (ok[i].type() != jle::ParamValue::Type::kMap) continue;
+      for (std::size_t j = 0; j < ok[i].size(); ++j)
+        EXPECT_TRUE(defaults.at(key).has(ok[i].key(j)))
+            << key << "/" << ok[i].key(j) << " is not in config/default.yaml";
     }
   }
 }
@@ -502,9 +528,11 @@ TEST(SettingsDocs, ReadmeTableStatesTheDefaults) {
     ++checked;
   }
   EXPECT_GE(checked, 35);  // the rows of one key (38 when written)
-  for (auto& kv : jle::loadYaml(JLE_DEFAULT_YAML)) {
-    if (kv.second.getType() == XmlRpc::XmlRpcValue::TypeStruct) continue;  // rows per key
-    EXPECT_NE(rows.find("`" + kv.first + "`"), std::string::npos) << kv.first << ": no README row";
+  const jle::ParamValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
+  for (std::size_t i = 0; i < defaults.size(); ++i) {
+    if (defaults[i].type() == jle::ParamValue::Type::kMap) continue;  // rows per key
+    EXPECT_NE(rows.find("`" + defaults.key(i) + "`"), std::string::npos)
+        << defaults.key(i) << ": no README row";
   }
 }
 
