@@ -85,7 +85,9 @@ mirrored), so that each effort is the net moment on the distal segment in that s
                                          (as --pelvis-width); each within a factor of
                                          2 of the table's value, not with the option
                      a segment or value not given keeps the table's (the tables'
-                     masses scale with --mass; the model's mass is then the sum)
+                     masses scale with --mass; the model's mass is then the sum); a
+                     mass without inertia or gyration keeps the table's radii of
+                     gyration (of the segment's length, given or the table's)
   --thigh-length M   hip to knee joint centre (default 0.245 x height)
   --shank-length M   knee to ankle joint centre (default 0.246 x height)
   --foot-length M    heel to toe (default 0.152 x height)
@@ -430,10 +432,13 @@ Matrix3d segmentInertia(double m, double l, const SegmentTable& t, const Vector3
   return transverse * (Matrix3d::Identity() - uu) + longitudinal * uu;
 }
 
-// A segment's table values replaced by what --segments gives. A sagittal-only inertia
-// (iyy) gets ixx = izz = iyy / 2: the least that meets the triangle inequality; a planar
-// body turning about y never multiplies them.
+// A segment's table values replaced by what --segments gives. A mass without an inertia
+// keeps the table's radii of gyration (the table's inertia, m k^2 with k from the segment
+// length given or the table's, scales with the mass). A sagittal-only inertia (iyy) gets
+// ixx = izz = iyy / 2: the least that meets the triangle inequality; a planar body
+// turning about y never multiplies them.
 void applyOverride(const SegmentOverride& s, double& mass, Vector3d& com, Matrix3d& inertia) {
+  if (s.mass && !s.inertia && !s.gyration) inertia *= *s.mass / mass;
   if (s.mass) mass = *s.mass;
   if (s.com) com = *s.com;
   if (s.inertia) inertia = *s.inertia;

@@ -623,6 +623,38 @@ TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
   }
 }
 
+// A segment given its mass only keeps the table's radii of gyration (Winter Table 4.1's
+// k = 0.323 l across the thigh, de Leva's 14.9 / 32.9 of it along), not the table's
+// inertia in kg m^2: 9 kg on the 75 kg, 1.75 m body's 0.42875 m thigh gives
+// 9 (0.323 x 0.42875)^2 = 0.1726 kg m^2 across (the table's 7.5 kg inertia, 0.1438, is
+// 17% low). A length given beside it scales the radii too: a 4 kg shank of 0.40 m has
+// 4 (0.302 x 0.40)^2 = 0.05837 kg m^2 across.
+TEST_F(BodyTool, MassWithoutInertiaKeepsTheTablesRadiusOfGyration) {
+  write("segments.yaml", "thigh: {mass: 9.0}\nshank: {mass: 4.0, length: 0.40}\n");
+  const jle::Model<double> model =
+      generate({"--mass", "75", "--height", "1.75", "--segments", path("segments.yaml")});
+  const auto inertia = [&](const char* link) {
+    return model.inertia_com[model.frames[model.frameIndex(link)].segment];
+  };
+  const double thigh = 0.245 * 1.75, shank = 0.40;  // [m]
+  const double thigh_across = 9.0 * std::pow(0.323 * thigh, 2);
+  const double thigh_along = 9.0 * std::pow(0.323 * 14.9 / 32.9 * thigh, 2);
+  const double shank_across = 4.0 * std::pow(0.302 * shank, 2);
+  const double shank_along = 4.0 * std::pow(0.302 * 10.3 / 25.5 * shank, 2);
+  EXPECT_NEAR(thigh_across, 0.172606, 1e-6);  // the figure of the issue, by hand
+  for (const char* side : {"r", "l"}) {
+    const Matrix3d t = inertia((std::string("femur_") + side).c_str());
+    const Matrix3d s = inertia((std::string("tibia_") + side).c_str());
+    // 1e-15: the tool's products in another order, a few ulps of 0.17 kg m^2.
+    EXPECT_NEAR(t(0, 0), thigh_across, 1e-15) << side;
+    EXPECT_NEAR(t(1, 1), thigh_across, 1e-15) << side;
+    EXPECT_NEAR(t(2, 2), thigh_along, 1e-15) << side;
+    EXPECT_NEAR(s(0, 0), shank_across, 1e-15) << side;
+    EXPECT_NEAR(s(1, 1), shank_across, 1e-15) << side;
+    EXPECT_NEAR(s(2, 2), shank_along, 1e-15) << side;
+  }
+}
+
 TEST_F(BodyTool, SegmentsAreCheckedNamingTheKey) {
   const auto refused = [&](const std::string& yaml, std::vector<std::string> extra, int status,
                            const std::string& part) {
