@@ -655,6 +655,37 @@ TEST_F(BodyTool, MassWithoutInertiaKeepsTheTablesRadiusOfGyration) {
   }
 }
 
+// A URDF that joint_loads would refuse is never written: the tool runs the package's
+// model check on what it would write and stops with exit status 1 naming the segment,
+// its link and the violation. With --sagittal, {iyy: 0.15, ixy: 0.01} leaves ixx = izz
+// = 0, and [[0, 0.01], [0.01, 0.15]] has the principal moment (0.15 - sqrt(0.15^2 + 4 x
+// 0.01^2)) / 2 = -6.6e-4 < 0; a 3-D shank {0.1, 0.1, 0.3} breaks the triangle
+// inequality (0.1 + 0.1 < 0.3) and so does a foot of radii [0.1, 0.1, 0.3] m.
+TEST_F(BodyTool, RefusesSegmentsTheModelCheckRefuses) {
+  const auto refused = [&](const std::string& yaml, std::vector<std::string> args,
+                           const std::vector<std::string>& parts) {
+    write("bad.yaml", yaml);
+    args.insert(args.end(), {"--mass", "75", "--height", "1.75", "--segments", path("bad.yaml"),
+                             "--output", path("out/x.urdf")});
+    const Result r = run(args);
+    EXPECT_EQ(r.status, 1) << yaml << r.err;
+    for (const std::string& part : parts) EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("out/x.urdf"))) << yaml;
+    EXPECT_TRUE(r.out.empty()) << yaml;
+  };
+  refused("thigh: {inertia: {iyy: 0.15, ixy: 0.01}}\n", {"--sagittal"},
+          {"thigh", "link 'femur_r'", "not positive semi-definite"});
+  refused("shank: {inertia: {ixx: 0.1, iyy: 0.1, izz: 0.3}}\n", {},
+          {"shank", "link 'tibia_r'", "triangle inequality"});
+  refused("foot: {gyration: [0.1, 0.1, 0.3]}\n", {}, {"foot", "link 'foot_r'", "triangle"});
+  // Standard output too: nothing is printed when the model is refused.
+  write("bad.yaml", "hat: {inertia: {ixx: 1, iyy: 1, izz: 3}}\n");
+  const Result r = run({"--mass", "75", "--height", "1.75", "--segments", path("bad.yaml")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("hat (link 'pelvis'"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 TEST_F(BodyTool, SegmentsAreCheckedNamingTheKey) {
   const auto refused = [&](const std::string& yaml, std::vector<std::string> extra, int status,
                            const std::string& part) {
