@@ -131,7 +131,8 @@ struct LoadsRecord {
   std::string contact_joint, contact_link;
 };
 
-/// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
+/// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints,
+/// accept_nonphysical_inertia).
 ModelOptions modelOptions(const Settings& settings);
 
 /// Segments whose loads are published: `joints` (URDF names of moving joints, or of

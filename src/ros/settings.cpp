@@ -316,6 +316,7 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("tf_wait", n.tf_wait);
   s.read("time_jump_threshold", n.time_jump_threshold);
   s.read("keep_fixed_joints", n.keep_fixed_joints);
+  s.read("accept_nonphysical_inertia", n.accept_nonphysical_inertia);
   s.read("diagnostic_period", n.diagnostic_period);
   s.read("inline_callbacks", n.inline_callbacks);
   s.read("decimation", n.estimator.decimation);

@@ -34,7 +34,8 @@ using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the pa
 const char* const kUsage =
     R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS]
                    [--gravity GX,GY,GZ] [--frame child|parent|world]
-                   [--floating-base] [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
+                   [--floating-base] [--accept-nonphysical-inertia]
+                   [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
                    [--contact-threshold N] [--per-kg [--body-mass KG]]
                    [--kinematics] [--friction [--velocity-scale V]]
                    [--planar off|auto|on] [--format csv|sto]
@@ -88,6 +89,12 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
   --frame F        the frame of the output joint wrenches: child (the joint's child
                    link, default), parent (the joint's URDF parent link) or world
   --floating-base  the URDF's root link floats: its pose is read from base.* columns
+  --accept-nonphysical-inertia
+                   accept link inertias no rigid body has (an identified parameter
+                   set: not positive semi-definite, triangle inequality broken) with a
+                   warning per link: the efforts are the identified model's, the
+                   joints' full 3-D force and moment are not physical (README
+                   "Model"). Default: such a model is refused
   --plate NAME=LINK,X,Y,Z[,YAW_DEG]
                    a force plate (repeatable): its frame (z up, the contact surface
                    through its origin) at X,Y,Z [m] in the world (finite), turned by
@@ -162,6 +169,7 @@ struct Options {
   Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};
   jle::WrenchFrame frame = jle::WrenchFrame::kChild;
   bool floating_base = false;
+  bool accept_nonphysical_inertia = jle::ModelOptions().accept_nonphysical_inertia;
   std::vector<jle::ForcePlateConfig> plates;
   double contact_threshold = 20.0;
   bool per_kg = false;
@@ -305,7 +313,8 @@ Options parseOptions(int argc, char** argv) {
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
                     "--body-mass", "--format", "--cutoff", "--cutoff-rule", "--filter-order",
                     "--write-kinematics", "--velocity-scale", "--planar"},
-                   {"--floating-base", "--per-kg", "--kinematics", "--friction"});
+                   {"--floating-base", "--per-kg", "--kinematics", "--friction",
+                    "--accept-nonphysical-inertia"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   options.input = requiredValue(v, "--input", "STATES.csv");
@@ -313,6 +322,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--gravity")) options.gravity_world = parseGravity(v["--gravity"]);
   if (v.count("--frame")) options.frame = parseFrame(v["--frame"]);
   options.floating_base = v.count("--floating-base") > 0;
+  if (v.count("--accept-nonphysical-inertia")) options.accept_nonphysical_inertia = true;
   if (v.count("--contact-threshold"))
     options.contact_threshold =
         parseNumber("--contact-threshold", v["--contact-threshold"], Sign::kNonNegative);
@@ -657,7 +667,10 @@ class Processor {
 jle::Model<double> loadModel(const Options& options) {
   jle::ModelOptions model_options;
   model_options.floating_base = options.floating_base;
+  model_options.accept_nonphysical_inertia = options.accept_nonphysical_inertia;
   jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
+  for (const std::string& w : model.warnings)
+    std::fprintf(stderr, "joint_loads: warning: robot model: %s\n", w.c_str());
   for (const jle::ForcePlateConfig& plate : options.plates) {
     bool known = false;
     for (const jle::Frame<double>& f : model.frames) known = known || f.name == plate.link;
