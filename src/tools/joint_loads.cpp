@@ -127,7 +127,9 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    revolute joint). The choice and its reason are printed on standard
                    error. Not with --plate, --frame parent|world, --kinematics,
                    --friction (the 6x6 path's outputs)
-  --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
+  --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md;
+                   world vectors in OpenSim's ground axes, y up: the CSV's (x, y, z)
+                   is written (x, z, -y); --gravity must point along -z)
   --cutoff HZ|auto positions only (no JOINT.qdd column; JOINT.qd for every joint or
                    none: measured velocities only guide the cutoff): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
@@ -243,15 +245,22 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
 }
 
 // The --plate frames are z up in the world: gravity along +z, or off the z axis, would
-// put the plates on a wall or a ceiling without saying so.
-void checkPlatesUp(const Options& options) {
+// put the plates on a wall or a ceiling without saying so. A .sto turns the world's z-up
+// vectors into OpenSim's y-up ground (sto.hpp): the same holds.
+void checkWorldUp(const Options& options) {
   const Eigen::Vector3d& g = options.gravity_world;
   const double tolerance = 1e-12 * g.norm();
-  if (options.plates.empty() ||
+  if ((options.plates.empty() && !options.sto) ||
       (std::abs(g.x()) <= tolerance && std::abs(g.y()) <= tolerance && g.z() <= 0.0))
     return;
-  throw UsageError("--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) + "," +
-                   std::to_string(g.z()) + " with --plate " + options.plates.front().name +
+  const std::string gravity = "--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) +
+                              "," + std::to_string(g.z());
+  if (options.plates.empty())
+    throw UsageError(gravity +
+                     " with --format sto: a .sto gives world vectors in OpenSim's y-up ground, "
+                     "turned from a z-up world, so --gravity must point along -z (0,0,-G); "
+                     "express the data in a z-up world");
+  throw UsageError(gravity + " with --plate " + options.plates.front().name +
                    ": --plate frames are z up in the world, so --gravity must point along -z "
                    "(0,0,-G); express the data in a z-up world");
 }
@@ -327,7 +336,6 @@ Options parseOptions(int argc, char** argv) {
     options.contact_threshold =
         parseNumber("--contact-threshold", v["--contact-threshold"], Sign::kNonNegative);
   options.plates = platesOf(plates, options.contact_threshold);
-  checkPlatesUp(options);
   options.per_kg = v.count("--per-kg") > 0;
   if (v.count("--body-mass")) {
     if (!options.per_kg) throw UsageError("--body-mass is only used with --per-kg");
@@ -336,6 +344,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--format") && v["--format"] != "csv" && v["--format"] != "sto")
     throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
   options.sto = v.count("--format") && v["--format"] == "sto";
+  checkWorldUp(options);
   parseSmoothing(v, options);
   parseOutputOptions(v, options);
   return options;
@@ -348,7 +357,7 @@ class Output {
          const std::vector<std::string>& names) {
     if (options.sto) {
       sto_ = std::make_unique<jle::StoWriter>(options.output);
-      sto_->writeHeader(jle::stoColumnNames(model, names, options.frame));
+      sto_->writeHeader(jle::stoLayout(model, names, options.frame));
     } else {
       csv_ = std::make_unique<jle::CsvWriter>(options.output);
       csv_->writeHeader(names);

@@ -74,7 +74,8 @@ bag is played to it, without the timing of a live system.
   --sto PATH           also (or only) write them as an OpenSim storage file: the
                        same numbers, tab-separated, under OpenSim's column names
                        (time, JOINT_moment or JOINT_force, and
-                       JOINT_on_CHILD_in_CHILD_fx ... _mz; docs/joint_loads.md)
+                       JOINT_on_CHILD_in_CHILD_fx ... _mz in the child link's
+                       axes; docs/joint_loads.md)
                        Every output is written beside PATH and renamed onto it on
                        success only. With none, the loads are computed and counted.
   --topic-prefix NS    namespace of the output topic (default /joint_load_estimator)
@@ -246,7 +247,7 @@ void Outputs::open(const jle::Pipeline& pipeline) {
   }
   if (!options.sto.empty()) {
     sto_ = std::make_unique<jle::StoWriter>(options.sto);
-    sto_->writeHeader(jle::stoColumnNames(pipeline.model(), names, jle::WrenchFrame::kChild));
+    sto_->writeHeader(jle::stoLayout(pipeline.model(), names, jle::WrenchFrame::kChild));
   }
   openSmoothed(pipeline);
 }

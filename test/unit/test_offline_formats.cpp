@@ -342,8 +342,15 @@ TEST_F(OfflineFormatsTest, PerKgEffortsDivideByTheBodyMass) {
 
 // ------------------------------------------------------------------- OpenSim .sto
 
-void expectStoMatchesCsv(const Sto& sto, const Table& csv,
-                         const std::map<std::string, std::string>& names) {
+// A .sto column and the CSV column it holds, times `sign`: OpenSim's ground axes are x
+// forward, y up, z right, the model's world x forward, y left, z up, so a world
+// vector's (x, y, z) is written (x, z, -y).
+struct StoColumn {
+  std::string csv, sto;
+  double sign = 1.0;
+};
+
+void expectStoMatchesCsv(const Sto& sto, const Table& csv, const std::vector<StoColumn>& names) {
   // OpenSim's Storage header.
   ASSERT_GE(sto.header_lines.size(), 5u);
   EXPECT_EQ(sto.header_lines[0], "Inverse Dynamics Generalized Forces");
@@ -353,12 +360,14 @@ void expectStoMatchesCsv(const Sto& sto, const Table& csv,
   EXPECT_EQ(sto.header_lines[4], "inDegrees=no");
   ASSERT_EQ(sto.table.header.size(), csv.header.size());
   ASSERT_EQ(sto.table.rows.size(), csv.rows.size());
-  for (const auto& [csv_name, sto_name] : names) {
+  for (const auto& [csv_name, sto_name, sign] : names) {
     const int c = csv.column(csv_name), s = sto.table.column(sto_name);
     ASSERT_GE(c, 0) << csv_name;
     ASSERT_GE(s, 0) << sto_name;
-    for (std::size_t row = 0; row < csv.rows.size(); ++row)
-      EXPECT_EQ(sto.table.rows[row][s], csv.rows[row][c]) << sto_name << " row " << row;
+    for (std::size_t row = 0; row < csv.rows.size(); ++row)  // exact: %.17g reads back
+      EXPECT_EQ(std::strtod(sto.table.rows[row][s].c_str(), nullptr),
+                sign * std::strtod(csv.rows[row][c].c_str(), nullptr))
+          << sto_name << " row " << row;
   }
 }
 
@@ -375,20 +384,71 @@ TEST_F(OfflineFormatsTest, JointLoadsWritesOpenSimStorage) {
                            : std::string(frame) == "parent" ? "leg_l"
                                                             : "ground";
     const Sto s = parseSto(readFile(path("o.sto")));
+    // The link frames' components as they are; the world's (ground) turned to y up.
+    const bool ground = in == "ground";
+    const std::string ankle = "ankle_l_on_foot_l_in_" + in + "_";
     expectStoMatchesCsv(s, parseCsv(csv.out),
                         {{"t", "time"},
                          {"base.fx", "pelvis_tx_force"},
-                         {"base.fz", "pelvis_tz_force"},
-                         {"base.my", "pelvis_my_moment"},
+                         {"base.fz", "pelvis_ty_force"},
+                         {"base.fy", "pelvis_tz_force", -1.0},
+                         {"base.my", "pelvis_mz_moment", -1.0},
+                         {"base.mz", "pelvis_my_moment"},
                          {"ankle_l.effort", "ankle_l_moment"},
                          {"ankle_l.effort_per_kg", "ankle_l_moment_per_kg"},
-                         {"ankle_l.fz", "ankle_l_on_foot_l_in_" + in + "_fz"},
-                         {"ankle_l.my", "ankle_l_on_foot_l_in_" + in + "_my"},
+                         {"ankle_l.fx", ankle + "fx"},
+                         {"ankle_l.fz", ankle + (ground ? "fy" : "fz")},
+                         {"ankle_l.my", ankle + (ground ? "mz" : "my"), ground ? -1.0 : 1.0},
                          {"plate@left.contact", "left_contact"},
                          {"plate@left.cop_x", "left_ground_force_px"},
-                         {"plate@right.cop_z", "right_ground_force_pz"}});
+                         {"plate@left.cop_y", "left_ground_force_pz", -1.0},
+                         {"plate@right.cop_z", "right_ground_force_py"}});
     EXPECT_EQ(s.table.header[0], "time");
   }
+}
+
+// OpenSim's ground is y up: a vertical force, a centre of pressure's height, land in the
+// _ty / _fy / _py columns. Hand values: the free body's first state of
+// FreeBodyResidualIsNewtonEuler, F = (1.2, 5, 2 (3 + g)), M = (0, -0.2 (3 + g), 0.65) in
+// the z-up world, is written tx = 1.2, ty = 2 (3 + g), tz = -5 and mx = 0, my = 0.65,
+// mz = 0.2 (3 + g); standing on plates raised to z = 0.25 m, the COPs (x_c, +-0.1,
+// 0.25) are written (x_c, 0.25, -+0.1), and the left ankle's vertical force -(W/2 - g)
+// (world frame) is its _fy.
+TEST_F(OfflineFormatsTest, StoWritesWorldVectorsInOpenSimsGroundAxes) {
+  write("body.csv", std::string(kBaseHeader) + "\n0,0,0,1,0,0,0,1,0,0,0,0,0,2,1,2,3,0,0,5\n");
+  Result r = jointLoads({"--urdf", kFreeBody, "--input", path("body.csv"), "--floating-base",
+                         "--format", "sto", "--output", path("body.sto")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table body = parseSto(readFile(path("body.sto"))).table;
+  ASSERT_EQ(body.rows.size(), 1u);
+  // 1e-12: a few roundings of numbers of order 30.
+  EXPECT_NEAR(body.number(0, "body_tx_force"), 1.2, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_ty_force"), 2.0 * (3.0 + kG), 1e-12);
+  EXPECT_NEAR(body.number(0, "body_tz_force"), -5.0, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_mx_moment"), 0.0, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_my_moment"), 0.65, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_mz_moment"), 0.2 * (3.0 + kG), 1e-12);
+
+  write("in.csv", standCsv());
+  r = jointLoads({"--urdf", kStand, "--input", path("in.csv"), "--floating-base", "--plate",
+                  "left=foot_l,0,0.1,0.25", "--plate", "right=foot_r,0,-0.1,0.25,90", "--frame",
+                  "world", "--format", "sto", "--output", path("stand.sto")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table stand = parseSto(readFile(path("stand.sto"))).table;
+  EXPECT_NEAR(stand.number(0, "left_ground_force_px"), kXc, 1e-14);
+  EXPECT_NEAR(stand.number(0, "left_ground_force_py"), 0.25, 1e-14);
+  EXPECT_NEAR(stand.number(0, "left_ground_force_pz"), -0.1, 1e-14);
+  EXPECT_NEAR(stand.number(0, "right_ground_force_py"), 0.25, 1e-14);
+  EXPECT_NEAR(stand.number(0, "right_ground_force_pz"), 0.1, 1e-14);
+  EXPECT_NEAR(stand.number(0, "ankle_l_on_foot_l_in_ground_fy"), -(kWeight / 2 - kG), 1e-11);
+  EXPECT_NEAR(stand.number(0, "ankle_l_on_foot_l_in_ground_fx"), 0.0, 1e-11);
+  EXPECT_NEAR(stand.number(0, "ankle_l_on_foot_l_in_ground_fz"), 0.0, 1e-11);
+
+  // A world that is not z up has no such turn: refused.
+  r = jointLoads({"--urdf", kFreeBody, "--input", path("body.csv"), "--floating-base", "--gravity",
+                  "0,-9.8,0", "--format", "sto"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--format sto"), std::string::npos) << r.err;
 }
 
 TEST_F(OfflineFormatsTest, ProcessBagWritesOpenSimStorage) {
