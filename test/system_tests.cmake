@@ -26,7 +26,8 @@ endif()
 
 # --- The Python bindings (pytest, python3-pytest) ----------------------------------
 # joint_load_estimator (src/python) against joint_loads and process_bag on the same inputs
-# (to 1e-12) and a closed form; run in the workspace's environment (devel/env.sh puts the
+# (to 1e-12) and a closed form; the gait demo's peak table (tools/gait_peaks.py, with
+# make_gait_bag) against the docs; run in the workspace's environment (devel/env.sh puts the
 # devel Python path first), its JUnit file where catkin_test_results reads it.
 set(JLE_PYTEST_RESULT ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-bindings.xml)
 catkin_run_tests_target(pytest bindings pytest-bindings.xml
@@ -34,7 +35,7 @@ catkin_run_tests_target(pytest bindings pytest-bindings.xml
 JLE_PROCESS_BAG=$<TARGET_FILE:process_bag> JLE_MAKE_EXAMPLE_BAG=$<TARGET_FILE:make_example_bag> \
 /usr/bin/python3 -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/test/python \
 --junitxml=${JLE_PYTEST_RESULT}"
-  DEPENDENCIES joint_load_estimator_python joint_loads process_bag make_example_bag)
+  DEPENDENCIES joint_load_estimator_python joint_loads process_bag make_example_bag make_gait_bag)
 
 # --- Node tests (rostest) -----------------------------------------------------------
 jle_add_node_test(test_node_loads loads.test rostest/test_loads.cpp)
