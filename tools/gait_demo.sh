@@ -112,6 +112,9 @@ echo
 head -3 "$summary"
 echo
 # Peak joint moments per kg: max |effort| (column 3 of the table) / body mass.
+echo "  peak |moment|: of either sign. Sign convention: positive = flexion, adduction, internal"
+echo "  rotation, dorsiflexion, as the moment on the distal segment (Winter plots the opposite"
+echo "  sign for hip, knee and ankle); signed peaks and their instants: tools/gait_peaks.py"
 awk -v m="$body_mass" 'NR > 3 && NF >= 5 {
     printf "  %-18s peak |moment| %7.1f N m = %5.2f N m/kg\n", $1, $3, $3 / m }' "$summary"
 # The residual: what the plates do not explain (filter error only, for this trial).

@@ -10,6 +10,7 @@
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/force_plate.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
 
 #include <Eigen/Core>
 
@@ -338,6 +339,9 @@ struct Settings {
   /// the sensor inputs (estimator.wrenches[k].sensor_joint) are kept too, without being
   /// listed here (modelOptions()).
   std::vector<std::string> keep_fixed_joints;
+  /// Accept a robot model whose link inertias no rigid body has (identified parameter
+  /// sets), with a warning per link; default: refused (ModelOptions holds the default).
+  bool accept_nonphysical_inertia = ModelOptions().accept_nonphysical_inertia;
   /// Floating base: a residual force above this fraction (> 0) of the total weight is a
   /// diagnostic warning.
   double base_residual_threshold = 0.1;

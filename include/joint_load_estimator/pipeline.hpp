@@ -164,7 +164,8 @@ struct LoadsRecord {
   bool planar = false;  ///< computed by the planar 3x3 path (savings.planar)
 };
 
-/// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints).
+/// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints,
+/// accept_nonphysical_inertia).
 ModelOptions modelOptions(const Settings& settings);
 
 /// Segments whose loads are published: `joints` (URDF names of moving joints, or of

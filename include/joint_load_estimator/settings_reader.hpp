@@ -60,7 +60,7 @@ class ParamValue {
   int int_ = 0;
   double double_ = 0.0;
   std::string string_;
-  std::vector<std::string> keys_;  // a map's, in order
+  std::vector<std::string> keys_;   // a map's, in order
   std::vector<ParamValue> values_;  // a list's elements, or a map's values
 };
 

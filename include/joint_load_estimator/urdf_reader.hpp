@@ -28,6 +28,14 @@ struct ModelOptions {
   /// than this fraction of the largest is accepted and reported in Model::warnings;
   /// a larger violation is refused.
   double triangle_tolerance = 0.05;
+  /// Accept a link inertia that no rigid body has (not positive semi-definite, or
+  /// principal moments breaking the triangle inequality beyond triangle_tolerance), as
+  /// dynamic identification gives them in moments the joint torques do not depend on.
+  /// Each such link is reported in Model::warnings, naming the violation and what it
+  /// can and cannot affect (the efforts about the joint axes are the identified model's;
+  /// the joints' full 3-D force and moment are not physical). false: refused. The one
+  /// default of the setting (Settings::accept_nonphysical_inertia, the tools' flags).
+  bool accept_nonphysical_inertia = false;
 };
 
 /// Parses a URDF document. Throws ModelError with the culprit's name on any defect:

@@ -100,6 +100,7 @@ ModelOptions modelOptions(const Settings& settings) {
   ModelOptions options;
   options.floating_base = settings.floating_base;
   options.keep_fixed_joints = settings.keep_fixed_joints;
+  options.accept_nonphysical_inertia = settings.accept_nonphysical_inertia;
   for (const WrenchInputConfig& input : settings.estimator.wrenches)
     if (!input.sensor_joint.empty() &&
         std::find(options.keep_fixed_joints.begin(), options.keep_fixed_joints.end(),

@@ -56,9 +56,7 @@ class Section {
   void read(const std::string& key, double& out) {
     if (has(key)) out = toNumber(get(key), name(key));
   }
-  void read(const std::string& key, int& out) {
-    readScalar(key, out, Type::kInt, "an integer");
-  }
+  void read(const std::string& key, int& out) { readScalar(key, out, Type::kInt, "an integer"); }
   void read(const std::string& key, bool& out) {
     readScalar(key, out, Type::kBool, "true or false");
   }
@@ -308,6 +306,7 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("tf_wait", n.tf_wait);
   s.read("time_jump_threshold", n.time_jump_threshold);
   s.read("keep_fixed_joints", n.keep_fixed_joints);
+  s.read("accept_nonphysical_inertia", n.accept_nonphysical_inertia);
   s.read("diagnostic_period", n.diagnostic_period);
   s.read("inline_callbacks", n.inline_callbacks);
   s.read("decimation", n.estimator.decimation);

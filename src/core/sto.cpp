@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <map>
 #include <stdexcept>
 
 namespace jle {
@@ -60,6 +61,27 @@ std::string jointName(const Model<double>& model, const std::string& name, const
   return joint + "_on_" + model.link_name[segment] + "_in_" + in + "_" + suffix;
 }
 
+// The world vector a CSV column is a component of (base.f, base.m, plate@P.cop, and with
+// the world frame J.f, J.m) and its axis; axis -1: none.
+struct VectorPart {
+  std::string vector;
+  int axis = -1;
+};
+
+VectorPart worldVectorPart(const std::string& name, WrenchFrame frame) {
+  const std::size_t dot = name.rfind('.');
+  if (dot == std::string::npos) return {};
+  const std::string head = name.substr(0, dot), suffix = name.substr(dot + 1);
+  if (head.compare(0, 6, "plate@") == 0) {
+    for (int axis = 0; axis < 3; ++axis)
+      if (suffix == kPlateOutputs[static_cast<std::size_t>(axis) + 1]) return {head + ".cop", axis};
+    return {};
+  }
+  const int i = componentIndex(suffix);
+  if (i < 0 || (head != "base" && frame != WrenchFrame::kWorld)) return {};
+  return {head + (i < 3 ? ".f" : ".m"), i % 3};
+}
+
 std::string stoName(const Model<double>& model, const std::string& name, WrenchFrame frame) {
   if (name == "t") return "time";
   const std::size_t dot = name.rfind('.');
@@ -82,7 +104,17 @@ StoWriter::~StoWriter() {
   if (body_) std::fclose(body_);
 }
 
+void StoWriter::writeHeader(const StoLayout& layout) {
+  writeHeader(layout.labels);
+  for (const std::array<std::size_t, 3>& v : layout.world_vectors)
+    for (std::size_t c : v)
+      if (c >= columns_) throw std::invalid_argument("a world vector's column is out of range");
+  world_vectors_ = layout.world_vectors;
+  turned_.resize(columns_);
+}
+
 void StoWriter::writeHeader(const std::vector<std::string>& labels) {
+  world_vectors_.clear();
   if (labels.empty() || labels[0] != "time")
     throw std::invalid_argument("the first column of a .sto file is 'time'");
   labels_.clear();
@@ -100,6 +132,14 @@ void StoWriter::writeRow(const double* values, std::size_t count) {
     throw std::invalid_argument("a .sto row of " + std::to_string(count) + " numbers, " +
                                 std::to_string(columns_) + " columns");
   line_.clear();
+  if (!world_vectors_.empty()) {  // in OpenSim's ground axes
+    std::copy(values, values + count, turned_.begin());
+    for (const std::array<std::size_t, 3>& v : world_vectors_) {
+      const std::array<double, 3> g = toOpenSimGround(values[v[0]], values[v[1]], values[v[2]]);
+      for (std::size_t k = 0; k < 3; ++k) turned_[v[k]] = g[k];
+    }
+    values = turned_.data();
+  }
   appendNumberRow(line_, values, count, '\t');
   if (std::fwrite(line_.data(), 1, line_.size(), body_) != line_.size())
     throw CsvError(where_ + ": cannot write the temporary file: " + errnoText());
@@ -134,6 +174,29 @@ std::vector<std::string> stoColumnNames(const Model<double>& model,
   out.reserve(csv_names.size());
   for (const std::string& name : csv_names) out.push_back(stoName(model, name, frame));
   return out;
+}
+
+StoLayout stoLayout(const Model<double>& model, const std::vector<std::string>& csv_names,
+                    WrenchFrame frame) {
+  StoLayout layout;
+  layout.labels = stoColumnNames(model, csv_names, frame);
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::map<std::string, std::array<std::size_t, 3>> vectors;
+  for (std::size_t c = 0; c < csv_names.size(); ++c) {
+    const VectorPart part = worldVectorPart(csv_names[c], frame);
+    if (part.axis < 0) continue;
+    auto it = vectors.emplace(part.vector, std::array<std::size_t, 3>{kNone, kNone, kNone}).first;
+    it->second[static_cast<std::size_t>(part.axis)] = c;
+  }
+  for (const auto& [name, columns] : vectors) {
+    for (std::size_t c : columns)
+      if (c == kNone)
+        throw std::invalid_argument("the world vector " + name +
+                                    " needs its x, y and z columns in a .sto (turned to "
+                                    "OpenSim's ground axes)");
+    layout.world_vectors.push_back(columns);
+  }
+  return layout;
 }
 
 }  // namespace jle

@@ -176,14 +176,30 @@ JointDesc parseJoint(const tinyxml2::XMLElement* e) {
   return joint;
 }
 
+// What a non-physical inertia accepted with ModelOptions::accept_nonphysical_inertia
+// can and cannot affect, said after each violation.
+std::string nonphysicalNote(const std::string& link) {
+  return "; accepted (accept_nonphysical_inertia): no rigid body has this inertia, as "
+         "identified parameter sets give it; the efforts (the torques or forces along the "
+         "axes) of the joints carrying link '" +
+         link +
+         "' are the identified model's, but those joints' full 3-D force and moment are not "
+         "physical";
+}
+
 // A link's inertia must be that of some mass distribution: symmetric positive
 // semi-definite, and its principal moments must satisfy the triangle inequality.
 // Violations of the triangle inequality up to `triangle_tolerance` (relative to the
 // largest principal moment) are accepted with a warning: published models have them
-// (Talos' gripper motors by 2.5%), and the method solves them all the same.
-void checkInertia(const LinkDesc& link, double triangle_tolerance,
+// (Talos' gripper motors by 2.5%), and the method solves them all the same. With
+// `options.accept_nonphysical_inertia` any violation is a warning (identified models).
+void checkInertia(const LinkDesc& link, const ModelOptions& options,
                   std::vector<std::string>& warnings) {
   const std::string what = "link '" + link.name + "'";
+  const auto refuse = [&](const std::string& violation) {
+    if (!options.accept_nonphysical_inertia) fail(violation);
+    warnings.push_back(violation + nonphysicalNote(link.name));
+  };
   if (link.mass < 0.0) fail(what + ": negative mass " + std::to_string(link.mass));
   Eigen::SelfAdjointEigenSolver<Matrix3> eig(link.inertia, Eigen::EigenvaluesOnly);
   const Vector3 l = eig.eigenvalues();  // ascending
@@ -193,14 +209,16 @@ void checkInertia(const LinkDesc& link, double triangle_tolerance,
     std::ostringstream os;
     os << what << ": inertia is not positive semi-definite (principal moments " << l[0] << ", "
        << l[1] << ", " << l[2] << ")";
-    fail(os.str());
+    refuse(os.str());
   }
   if (l[0] + l[1] < l[2] - tol) {
     std::ostringstream os;
     os << what << ": inertia violates the triangle inequality (principal moments " << l[0] << " + "
        << l[1] << " < " << l[2] << ", by " << 100.0 * (l[2] - l[0] - l[1]) / l[2] << "%)";
-    if (l[0] + l[1] < l[2] * (1.0 - triangle_tolerance)) fail(os.str());
-    warnings.push_back(os.str());
+    if (l[0] + l[1] < l[2] * (1.0 - options.triangle_tolerance))
+      refuse(os.str());
+    else
+      warnings.push_back(os.str());
   }
 }
 
@@ -247,7 +265,7 @@ struct Builder {
     frame.p_segment_frame = X_segment_link.p;
     model.frames.push_back(frame);
     if (!l.has_inertial) return;
-    checkInertia(l, options.triangle_tolerance, model.warnings);
+    checkInertia(l, options, model.warnings);
     const Pose X = X_segment_link * l.inertial_origin;
     parts[segment].push_back({l.mass, X.p, X.R * l.inertia * X.R.transpose()});
   }

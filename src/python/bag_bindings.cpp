@@ -23,7 +23,8 @@ class RecordSink : public jle::LoadsSink {
  public:
   void open(const jle::Pipeline& pipeline) override {
     immediate_ = std::make_unique<RecordColumns>(pipeline.record());
-    if (pipeline.hasSmoothed()) smoothed_ = std::make_unique<RecordColumns>(pipeline.smoothedRecord());
+    if (pipeline.hasSmoothed())
+      smoothed_ = std::make_unique<RecordColumns>(pipeline.smoothedRecord());
   }
   void write(const jle::LoadsRecord& r, long) override { immediate_->add(r); }
   void writeSmoothed(const jle::LoadsRecord& r, long) override { smoothed_->add(r); }

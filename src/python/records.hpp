@@ -113,14 +113,14 @@ class RecordColumns {
  private:
   static constexpr std::size_t kPerJoint = 10;
   static constexpr const char* kPerJointNames[kPerJoint] = {
-      "effort",       "effort_stddev", "effort_per_kg",   "measured_effort",
-      "position",     "velocity",      "acceleration",    "motor_effort",
-      "external_effort", "external_effort_stddev"};
+      "effort",   "effort_stddev", "effort_per_kg", "measured_effort", "position",
+      "velocity", "acceleration",  "motor_effort",  "external_effort", "external_effort_stddev"};
   static const std::vector<double>* fieldOf(const jle::LoadsRecord& r, std::size_t j) {
-    const std::vector<double>* fields[kPerJoint] = {
-        &r.effort,       &r.effort_stddev, &r.effort_per_kg, &r.measured_effort,
-        &r.position,     &r.velocity,      &r.acceleration,  &r.motor_effort,
-        &r.external_effort, &r.external_effort_stddev};
+    const std::vector<double>* fields[kPerJoint] = {&r.effort,          &r.effort_stddev,
+                                                    &r.effort_per_kg,   &r.measured_effort,
+                                                    &r.position,        &r.velocity,
+                                                    &r.acceleration,    &r.motor_effort,
+                                                    &r.external_effort, &r.external_effort_stddev};
     return fields[j];
   }
   void putInputs(py::dict& out, py::ssize_t n) const {

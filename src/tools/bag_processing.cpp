@@ -484,6 +484,7 @@ void processBag(const BagOptions& options, LoadsSink& sink) {
   } catch (const jle::SettingsError& e) {
     throw std::runtime_error(options.config + ": " + e.what());
   }
+  if (options.accept_nonphysical_inertia) settings.accept_nonphysical_inertia = true;
   if (options.smooth) {
     // The positions are smoothed already: central differences differentiate them (exact
     // for the parabola through three samples, any spacing) and pass the forces as they are.

@@ -37,7 +37,14 @@ dynamic parameters (docs/dh_to_urdf.md). TABLE.yaml:
   name: NAME                        the robot's name (default dh_robot)
   base_link: NAME                   the root link, DH frame 0 (default base_link)
   tip_link: NAME                    a massless link fixed at the last DH frame n
-                                    (default flange)
+                                    (default flange), or at the flange entry's
+                                    transform from it
+  flange:                           a fixed transform from DH frame n to tip_link
+                                    (default none), either a constant row of the
+                                    table's convention:
+    {a: A, alpha: ALPHA, d: D, theta: THETA}   (each default 0; the Panda's: {d: 0.107})
+                                    or a URDF origin in DH frame n:
+    {xyz: [X, Y, Z], rpy: [R, P, Y]}           [m]; R = Rz(Y) Ry(P) Rx(R) (default 0)
   angle_unit: rad | deg             of alpha, theta, lower, upper (default rad)
   inertia_about: com | origin       the inertias are about the link's centre of mass,
                                     or about its DH frame's origin (default com)
@@ -117,6 +124,9 @@ struct Table {
   bool modified = false;
   std::string name = "dh_robot", base_link = "base_link", tip_link = "flange";
   std::vector<Row> rows;
+  // The flange entry: tip_link in DH frame n (identity without it).
+  Matrix3d R_n_tip = Matrix3d::Identity();
+  Vector3d p_n_tip = Vector3d::Zero();
 };
 
 class TableReader {
@@ -131,9 +141,9 @@ class TableReader {
       throw std::runtime_error(path_ + ": " + e.what());
     }
     if (!root.IsMap()) fail("", "the table is not a YAML map");
-    checkKeys(
-        root, "",
-        {"convention", "name", "base_link", "tip_link", "angle_unit", "inertia_about", "links"});
+    checkKeys(root, "",
+              {"convention", "name", "base_link", "tip_link", "angle_unit", "inertia_about",
+               "links", "flange"});
     Table t;
     const std::string convention = text(root, "", "convention", "");
     if (convention != "standard" && convention != "modified")
@@ -153,6 +163,7 @@ class TableReader {
     for (std::size_t i = 0; i < links.size(); ++i)
       t.rows.push_back(row(links[i], static_cast<int>(i), about == "origin"));
     checkNames(t);
+    if (root["flange"]) flange(root["flange"], t);
     return t;
   }
 
@@ -209,7 +220,20 @@ class TableReader {
     return x;
   }
 
+  Vector3d triple(const YAML::Node& node, const std::string& where, const char* key) const {
+    const YAML::Node v = node[key];
+    if (!v) return Vector3d::Zero();
+    if (!v.IsSequence() || v.size() != 3)
+      fail(where, std::string("'") + key + "' must be [X, Y, Z]");
+    Vector3d out;
+    for (std::size_t k = 0; k < 3; ++k)
+      out[static_cast<int>(k)] =
+          value(v[k], where, std::string("'") + key + "'[" + std::to_string(k) + "]");
+    return out;
+  }
+
   Row row(const YAML::Node& node, int i, bool about_origin) const;
+  void flange(const YAML::Node& node, Table& t) const;
   void inertia(const YAML::Node& node, const std::string& where, Row& r) const;
   void limits(const YAML::Node& node, const std::string& where, Row& r) const;
   void checkNames(const Table& t) const;
@@ -261,6 +285,37 @@ Row TableReader::row(const YAML::Node& node, int i, bool about_origin) const {
                  "link without mass as massless (no inertia), KDL keeps the inertia\n",
                  where.c_str());
   return r;
+}
+
+// The flange entry: a constant DH row of the table's convention, or a URDF origin.
+void TableReader::flange(const YAML::Node& node, Table& t) const {
+  const std::string where = "flange";
+  if (!node.IsMap()) fail(where, "must be a map {a, alpha, d, theta} or {xyz, rpy}");
+  checkKeys(node, where, {"a", "alpha", "d", "theta", "xyz", "rpy"});
+  const bool dh = node["a"] || node["alpha"] || node["d"] || node["theta"];
+  if (dh && (node["xyz"] || node["rpy"]))
+    fail(where, "give a DH row {a, alpha, d, theta} or an origin {xyz, rpy}, not both");
+  using Eigen::AngleAxisd;
+  if (dh) {
+    const double a = number(node, where, "a", 0.0), d = number(node, where, "d", 0.0);
+    const double alpha = angle_ * number(node, where, "alpha", 0.0);
+    const double theta = angle_ * number(node, where, "theta", 0.0);
+    const Matrix3d Rx = AngleAxisd(alpha, Vector3d::UnitX()).toRotationMatrix();
+    const Matrix3d Rz = AngleAxisd(theta, Vector3d::UnitZ()).toRotationMatrix();
+    if (t.modified) {  // Rx(alpha) Tx(a) Rz(theta) Tz(d)
+      t.R_n_tip = Rx * Rz;
+      t.p_n_tip = Vector3d(a, 0.0, 0.0) + Rx * Vector3d(0.0, 0.0, d);
+    } else {  // Rz(theta) Tz(d) Tx(a) Rx(alpha)
+      t.R_n_tip = Rz * Rx;
+      t.p_n_tip = Vector3d(0.0, 0.0, d) + Rz * Vector3d(a, 0.0, 0.0);
+    }
+    return;
+  }
+  const Vector3d rpy = angle_ * triple(node, where, "rpy");
+  t.p_n_tip = triple(node, where, "xyz");
+  t.R_n_tip = (AngleAxisd(rpy.z(), Vector3d::UnitZ()) * AngleAxisd(rpy.y(), Vector3d::UnitY()) *
+               AngleAxisd(rpy.x(), Vector3d::UnitX()))
+                  .toRotationMatrix();
 }
 
 void TableReader::inertia(const YAML::Node& node, const std::string& where, Row& r) const {
@@ -408,6 +463,25 @@ class Writer {
   }
 };
 
+// A URDF <origin> of any rotation R = Rz(yaw) Ry(pitch) Rx(roll) and translation p.
+std::string originText(const Matrix3d& R, const Vector3d& p) {
+  const double pitch = std::atan2(-R(2, 0), std::hypot(R(0, 0), R(1, 0)));
+  double roll = std::atan2(R(2, 1), R(2, 2)), yaw = std::atan2(R(1, 0), R(0, 0));
+  if (std::hypot(R(0, 0), R(1, 0)) < 1e-12) {  // pitch +-90 deg: only roll -+ yaw is defined
+    roll = 0.0;
+    yaw = std::atan2(-R(0, 1), R(1, 1));
+  }
+  return "<origin xyz=\"" + vec(p) + "\" rpy=\"" + num(roll) + " " + num(pitch) + " " + num(yaw) +
+         "\"/>";
+}
+
+// The tip link's origin in the last link: DH frame n, then the flange entry.
+std::string tipOrigin(const Table& t) {
+  const Placement n = frameInLink(t, t.rows.back());
+  if (t.R_n_tip == Matrix3d::Identity() && t.p_n_tip.isZero(0.0)) return n.text();
+  return originText(n.rotation() * t.R_n_tip, n.xyz + n.rotation() * t.p_n_tip);
+}
+
 std::string makeUrdf(const Table& t, const std::string& input) {
   Writer w;
   w.line("<?xml version=\"1.0\"?>");
@@ -421,11 +495,11 @@ std::string makeUrdf(const Table& t, const std::string& input) {
     w.link(t.rows[i].link, t, &t.rows[i]);
     parent = t.rows[i].link;
   }
-  // The tip: DH frame n.
+  // The tip: DH frame n, or the flange entry's transform from it.
   w.line("  <joint name=\"" + t.tip_link + "_joint\" type=\"fixed\">");
   w.line("    <parent link=\"" + parent + "\"/>");
   w.line("    <child link=\"" + t.tip_link + "\"/>");
-  w.line("    " + frameInLink(t, t.rows.back()).text());
+  w.line("    " + tipOrigin(t));
   w.line("  </joint>");
   w.line("  <link name=\"" + t.tip_link + "\"/>");
   w.line("</robot>");

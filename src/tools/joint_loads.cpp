@@ -34,7 +34,8 @@ using namespace jle::cli;  // command_line.hpp: UsageError, optionValues, the pa
 const char* const kUsage =
     R"(usage: joint_loads --urdf ROBOT.urdf --input STATES.csv [--output LOADS]
                    [--gravity GX,GY,GZ] [--frame child|parent|world]
-                   [--floating-base] [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
+                   [--floating-base] [--accept-nonphysical-inertia]
+                   [--plate NAME=LINK,X,Y,Z[,YAW_DEG]]...
                    [--contact-threshold N] [--per-kg [--body-mass KG]]
                    [--kinematics] [--friction [--velocity-scale V]]
                    [--planar off|auto|on] [--format csv|sto]
@@ -55,7 +56,9 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                                                mimic joints may be left out (ignored
                                                if present: a mimic follows its leader);
                                                or JOINT.q alone for every joint
-                                               (positions only: see --cutoff)
+                                               (positions only: see --cutoff; a
+                                               floating base's pose is then smoothed
+                                               and differentiated alike)
                      wrench@LINK.fx,.fy,.fz,.mx,.my,.mz
                                                optional: a wrench applied TO the robot
                                                at the origin of URDF link LINK, in
@@ -88,6 +91,12 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
   --frame F        the frame of the output joint wrenches: child (the joint's child
                    link, default), parent (the joint's URDF parent link) or world
   --floating-base  the URDF's root link floats: its pose is read from base.* columns
+  --accept-nonphysical-inertia
+                   accept link inertias no rigid body has (an identified parameter
+                   set: not positive semi-definite, triangle inequality broken) with a
+                   warning per link: the efforts are the identified model's, the
+                   joints' full 3-D force and moment are not physical (README
+                   "Model"). Default: such a model is refused
   --plate NAME=LINK,X,Y,Z[,YAW_DEG]
                    a force plate (repeatable): its frame (z up, the contact surface
                    through its origin) at X,Y,Z [m] in the world (finite), turned by
@@ -120,7 +129,9 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    revolute joint). The choice and its reason are printed on standard
                    error. Not with --plate, --frame parent|world, --kinematics,
                    --friction (the 6x6 path's outputs)
-  --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md)
+  --format F       csv (default) or sto (OpenSim storage file, docs/joint_loads.md;
+                   world vectors in OpenSim's ground axes, y up: the CSV's (x, y, z)
+                   is written (x, z, -y); --gravity must point along -z)
   --cutoff HZ|auto positions only (no JOINT.qdd column; JOINT.qd for every joint or
                    none: measured velocities only guide the cutoff): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
@@ -162,6 +173,7 @@ struct Options {
   Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};
   jle::WrenchFrame frame = jle::WrenchFrame::kChild;
   bool floating_base = false;
+  bool accept_nonphysical_inertia = jle::ModelOptions().accept_nonphysical_inertia;
   std::vector<jle::ForcePlateConfig> plates;
   double contact_threshold = 20.0;
   bool per_kg = false;
@@ -235,15 +247,22 @@ std::vector<jle::ForcePlateConfig> platesOf(const std::vector<std::string>& valu
 }
 
 // The --plate frames are z up in the world: gravity along +z, or off the z axis, would
-// put the plates on a wall or a ceiling without saying so.
-void checkPlatesUp(const Options& options) {
+// put the plates on a wall or a ceiling without saying so. A .sto turns the world's z-up
+// vectors into OpenSim's y-up ground (sto.hpp): the same holds.
+void checkWorldUp(const Options& options) {
   const Eigen::Vector3d& g = options.gravity_world;
   const double tolerance = 1e-12 * g.norm();
-  if (options.plates.empty() ||
+  if ((options.plates.empty() && !options.sto) ||
       (std::abs(g.x()) <= tolerance && std::abs(g.y()) <= tolerance && g.z() <= 0.0))
     return;
-  throw UsageError("--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) + "," +
-                   std::to_string(g.z()) + " with --plate " + options.plates.front().name +
+  const std::string gravity = "--gravity " + std::to_string(g.x()) + "," + std::to_string(g.y()) +
+                              "," + std::to_string(g.z());
+  if (options.plates.empty())
+    throw UsageError(gravity +
+                     " with --format sto: a .sto gives world vectors in OpenSim's y-up ground, "
+                     "turned from a z-up world, so --gravity must point along -z (0,0,-G); "
+                     "express the data in a z-up world");
+  throw UsageError(gravity + " with --plate " + options.plates.front().name +
                    ": --plate frames are z up in the world, so --gravity must point along -z "
                    "(0,0,-G); express the data in a z-up world");
 }
@@ -305,7 +324,8 @@ Options parseOptions(int argc, char** argv) {
                    {"--urdf", "--input", "--output", "--gravity", "--frame", "--contact-threshold",
                     "--body-mass", "--format", "--cutoff", "--cutoff-rule", "--filter-order",
                     "--write-kinematics", "--velocity-scale", "--planar"},
-                   {"--floating-base", "--per-kg", "--kinematics", "--friction"});
+                   {"--floating-base", "--per-kg", "--kinematics", "--friction",
+                    "--accept-nonphysical-inertia"});
   Options options;
   options.urdf = requiredValue(v, "--urdf", "ROBOT.urdf");
   options.input = requiredValue(v, "--input", "STATES.csv");
@@ -313,11 +333,11 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--gravity")) options.gravity_world = parseGravity(v["--gravity"]);
   if (v.count("--frame")) options.frame = parseFrame(v["--frame"]);
   options.floating_base = v.count("--floating-base") > 0;
+  if (v.count("--accept-nonphysical-inertia")) options.accept_nonphysical_inertia = true;
   if (v.count("--contact-threshold"))
     options.contact_threshold =
         parseNumber("--contact-threshold", v["--contact-threshold"], Sign::kNonNegative);
   options.plates = platesOf(plates, options.contact_threshold);
-  checkPlatesUp(options);
   options.per_kg = v.count("--per-kg") > 0;
   if (v.count("--body-mass")) {
     if (!options.per_kg) throw UsageError("--body-mass is only used with --per-kg");
@@ -326,6 +346,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--format") && v["--format"] != "csv" && v["--format"] != "sto")
     throw UsageError("--format: '" + v["--format"] + "' is not csv or sto");
   options.sto = v.count("--format") && v["--format"] == "sto";
+  checkWorldUp(options);
   parseSmoothing(v, options);
   parseOutputOptions(v, options);
   return options;
@@ -338,7 +359,7 @@ class Output {
          const std::vector<std::string>& names) {
     if (options.sto) {
       sto_ = std::make_unique<jle::StoWriter>(options.output);
-      sto_->writeHeader(jle::stoColumnNames(model, names, options.frame));
+      sto_->writeHeader(jle::stoLayout(model, names, options.frame));
     } else {
       csv_ = std::make_unique<jle::CsvWriter>(options.output);
       csv_->writeHeader(names);
@@ -380,19 +401,30 @@ std::string shortest(double x) {
   return buffer;
 }
 
-// The base pose of the current record, checked: a quaternion of norm 1 within 1 %.
-void readBasePose(const jle::CsvReader& reader, const jle::StateColumns& columns, Row& row) {
+// The base pose's quaternion in the current record's `cells`: of norm 1 within 1 %.
+void checkBaseQuaternion(const jle::CsvReader& reader, const jle::StateColumns& columns,
+                         const std::vector<double>& x) {
+  const auto& c = columns.base_pose;
+  const double norm = Eigen::Quaterniond(x[c[6]], x[c[3]], x[c[4]], x[c[5]]).norm();
+  if (!(std::abs(norm - 1.0) <= 0.01))
+    reader.failAt(c[6], "the quaternion (base.qx, .qy, .qz, .qw) has norm " + std::to_string(norm) +
+                            ", not 1 (within 1 %)");
+}
+
+// The base pose of a row's cells, its quaternion normalised.
+void setBasePose(const jle::StateColumns& columns, Row& row) {
   const auto& c = columns.base_pose;
   const std::vector<double>& x = row.cells;
   row.pose.t = x[columns.t];
   row.pose.p_world_base = Eigen::Vector3d(x[c[0]], x[c[1]], x[c[2]]);
-  Eigen::Quaterniond q(x[c[6]], x[c[3]], x[c[4]], x[c[5]]);
-  const double norm = q.norm();
-  if (!(std::abs(norm - 1.0) <= 0.01))
-    reader.failAt(c[6], "the quaternion (base.qx, .qy, .qz, .qw) has norm " + std::to_string(norm) +
-                            ", not 1 (within 1 %)");
-  q.coeffs() /= norm;
-  row.pose.R_world_base = q.toRotationMatrix();
+  row.pose.R_world_base =
+      Eigen::Quaterniond(x[c[6]], x[c[3]], x[c[4]], x[c[5]]).normalized().toRotationMatrix();
+}
+
+// The base pose of the current record, checked.
+void readBasePose(const jle::CsvReader& reader, const jle::StateColumns& columns, Row& row) {
+  checkBaseQuaternion(reader, columns, row.cells);
+  setBasePose(columns, row);
 }
 
 // The loads of each input row. A floating base whose twist or acceleration the CSV does
@@ -447,6 +479,7 @@ class Processor {
     Row& row = slot(n);
     std::copy(cells.begin(), cells.end(), row.cells.begin());
     row.line = line;
+    if (model_.floating_base) setBasePose(columns_, row);
   }
 
   // Emits what row n, just read, completes.
@@ -657,7 +690,10 @@ class Processor {
 jle::Model<double> loadModel(const Options& options) {
   jle::ModelOptions model_options;
   model_options.floating_base = options.floating_base;
+  model_options.accept_nonphysical_inertia = options.accept_nonphysical_inertia;
   jle::Model<double> model = jle::modelFromUrdfFile(options.urdf, model_options);
+  for (const std::string& w : model.warnings)
+    std::fprintf(stderr, "joint_loads: warning: robot model: %s\n", w.c_str());
   for (const jle::ForcePlateConfig& plate : options.plates) {
     bool known = false;
     for (const jle::Frame<double>& f : model.frames) known = known || f.name == plate.link;
@@ -682,6 +718,7 @@ Record readRecord(jle::CsvReader& reader, const jle::StateColumns& columns,
   while (reader.next()) {
     std::vector<double> cells(static_cast<std::size_t>(reader.columns()));
     reader.numbers(cells.data());
+    if (columns.base_pose[0] >= 0) checkBaseQuaternion(reader, columns, cells);
     const double t = cells[columns.t];
     if (!r.t.empty() && !(t > r.t.back()))
       reader.failAt(columns.t, "time does not increase (the previous row's is " +
@@ -720,6 +757,54 @@ std::vector<int> forceColumns(const jle::StateColumns& columns) {
   return forces;
 }
 
+// A floating base's pose smoothed with the joints' cutoff (the quaternion's sign made
+// continuous first: q and -q are one turn), its twist and acceleration (world frame)
+// from the smoothed pose's rates, appended to every row and `columns` pointed at them.
+// With u = q / |q|: omega = 2 vec(q' q*) / |q|^2, alpha = 2 (vec(q'' q*) - (q . q')
+// omega) / |q|^2 (the filter leaves |q| a little off 1).
+void smoothBase(const Options& options, jle::StateColumns& columns, Record& r, double cutoff) {
+  const auto& c = columns.base_pose;
+  for (std::size_t i = 1; i < r.cells.size(); ++i) {
+    double dot = 0.0;
+    for (int k = 3; k < 7; ++k) dot += r.cells[i][c[k]] * r.cells[i - 1][c[k]];
+    if (dot < 0.0)
+      for (int k = 3; k < 7; ++k) r.cells[i][c[k]] = -r.cells[i][c[k]];
+  }
+  jle::ZeroPhaseConfig z = options.smoothing;
+  z.rule = jle::CutoffRule::kFixed;
+  z.cutoff = cutoff;
+  const std::vector<int> pose(c.begin(), c.end());
+  const jle::ZeroPhaseResult k = jle::smoothZeroPhase(r.t, gather(r, pose), z);
+  const std::size_t width = r.cells.front().size();
+  for (std::size_t j = 0; j < 6; ++j) {
+    columns.base_twist[j] = static_cast<int>(width + j);
+    columns.base_acceleration[j] = static_cast<int>(width + 6 + j);
+  }
+  const auto quaternion = [](const Eigen::MatrixXd& m, Eigen::Index i) {
+    return Eigen::Quaterniond(m(i, 6), m(i, 3), m(i, 4), m(i, 5));
+  };
+  for (std::size_t i = 0; i < r.cells.size(); ++i) {
+    const Eigen::Index row = static_cast<Eigen::Index>(i);
+    const Eigen::Quaterniond q = quaternion(k.value, row), qd = quaternion(k.rate, row),
+                             qdd = quaternion(k.accel, row);
+    const double n2 = q.squaredNorm();
+    const Eigen::Vector3d w = 2.0 * (qd * q.conjugate()).vec() / n2;
+    const Eigen::Vector3d alpha =
+        2.0 * ((qdd * q.conjugate()).vec() - q.coeffs().dot(qd.coeffs()) * w) / n2;
+    std::vector<double>& cells = r.cells[i];
+    cells.resize(width + 12);
+    for (int j = 0; j < 3; ++j) {
+      cells[c[j]] = k.value(row, j);
+      cells[width + j] = k.rate(row, j);
+      cells[width + 3 + j] = w[j];
+      cells[width + 6 + j] = k.accel(row, j);
+      cells[width + 9 + j] = alpha[j];
+    }
+    const Eigen::Quaterniond unit = q.normalized();
+    for (int j = 0; j < 4; ++j) cells[c[3 + j]] = unit.coeffs()[j];  // x, y, z, w
+  }
+}
+
 // q and the forces smoothed alike (the JOINT.qd columns, if any, as the cutoff rule's
 // evidence), q's rate and acceleration appended to every row and `columns` pointed at
 // them. Returns how the cutoff was chosen.
@@ -743,6 +828,7 @@ jle::CutoffChoice smoothPositions(const Options& options, jle::StateColumns& col
     if (!forces.empty())
       scatter(jle::lowPassZeroPhase(r.t, gather(r, forces), k.cutoff, z.order, z.padding), forces,
               r);
+    if (columns.base_pose[0] >= 0) smoothBase(options, columns, r, k.cutoff);
     return k.choice;
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(options.input + ": smoothing the positions (--cutoff): " + e.what());
@@ -756,10 +842,19 @@ void writeKinematics(const Options& options, const jle::Model<double>& model,
   std::vector<int> order{columns.t};
   for (int k = 0; k < model.nq; ++k)
     order.insert(order.end(), {columns.q[k], columns.qd[k], columns.qdd[k]});
-  for (const jle::StateColumns::WrenchColumns& w : columns.wrenches) links.push_back(w.link);
-  const std::vector<int> forces = forceColumns(columns);
-  order.insert(order.end(), forces.begin(), forces.end());
+  for (const jle::StateColumns::WrenchColumns& w : columns.wrenches) {
+    links.push_back(w.link);
+    order.insert(order.end(), w.column.begin(), w.column.end());
+  }
+  if (model.floating_base) {  // the smoothed pose, its twist and acceleration
+    order.insert(order.end(), columns.base_pose.begin(), columns.base_pose.end());
+    order.insert(order.end(), columns.base_twist.begin(), columns.base_twist.end());
+    order.insert(order.end(), columns.base_acceleration.begin(), columns.base_acceleration.end());
+  }
+  for (const std::array<int, 6>& plate : columns.plates)
+    order.insert(order.end(), plate.begin(), plate.end());
   jle::ExtraStateInputs extra;
+  extra.floating_base = model.floating_base;
   for (const jle::ForcePlateConfig& plate : options.plates) extra.plates.push_back(plate.name);
   jle::CsvWriter out(options.write_kinematics);
   out.writeHeader(jle::stateColumnNames(model, links, extra));
@@ -775,6 +870,12 @@ void writeKinematics(const Options& options, const jle::Model<double>& model,
 // loads of every row as for a CSV with JOINT.qd, JOINT.qdd.
 void runPositionsOnly(const Options& options, const jle::Model<double>& model,
                       jle::CsvReader& reader, jle::StateColumns columns) {
+  if (columns.hasBaseTwist() || columns.hasBaseAcceleration())
+    throw std::runtime_error(options.input +
+                             ": positions only (no JOINT.qd, JOINT.qdd): the floating base's "
+                             "twist and acceleration are computed from its smoothed pose like "
+                             "the joints' rates; leave out base.vx ... base.alz, or give "
+                             "JOINT.qd and JOINT.qdd of every joint");
   Record record = readRecord(reader, columns, options.input);
   const jle::CutoffChoice choice = smoothPositions(options, columns, record);
   std::fprintf(stderr,
@@ -800,8 +901,9 @@ void run(const Options& options) {
   jle::CsvReader reader(options.input);
   jle::ExtraStateInputs extra;
   extra.floating_base = model.floating_base;
-  // Positions only with a fixed base (a floating base's pose is not smoothed).
-  extra.positions_only = !model.floating_base;
+  // Positions only: JOINT.q alone (a floating base's pose smoothed and differentiated
+  // with the joints).
+  extra.positions_only = true;
   for (const jle::ForcePlateConfig& plate : options.plates) extra.plates.push_back(plate.name);
   const jle::StateColumns columns = jle::bindStateColumns(model, reader, extra);
   if (columns.positions_only) return runPositionsOnly(options, model, reader, columns);

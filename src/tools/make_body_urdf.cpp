@@ -3,6 +3,7 @@
 // the classic anthropometric tables. Every table value, its source and every assumption
 // is documented here and in docs/body_model.md.
 #include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
 
 #include <yaml-cpp/yaml.h>
 
@@ -85,7 +86,9 @@ mirrored), so that each effort is the net moment on the distal segment in that s
                                          (as --pelvis-width); each within a factor of
                                          2 of the table's value, not with the option
                      a segment or value not given keeps the table's (the tables'
-                     masses scale with --mass; the model's mass is then the sum)
+                     masses scale with --mass; the model's mass is then the sum); a
+                     mass without inertia or gyration keeps the table's radii of
+                     gyration (of the segment's length, given or the table's)
   --thigh-length M   hip to knee joint centre (default 0.245 x height)
   --shank-length M   knee to ankle joint centre (default 0.246 x height)
   --foot-length M    heel to toe (default 0.152 x height)
@@ -98,8 +101,14 @@ mirrored), so that each effort is the net moment on the distal segment in that s
                      and renamed onto it on success only
   --help             this text
 
-Exit status: 0 success; 1 a data error (the output cannot be written); 2 a usage
-error (unknown, missing or repeated option, a value out of range).
+The URDF goes through the package's model check (what joint_loads and the node run)
+before it is written: an inertia it refuses (not positive semi-definite, or principal
+moments breaking the triangle inequality, e.g. --sagittal with {iyy, ixy}, whose ixx
+and izz are then 0) stops the tool naming the segment, its link and the violation.
+
+Exit status: 0 success; 1 a data error (a --segments file, a model the model check
+refuses, the output cannot be written); 2 a usage error (unknown, missing or repeated
+option, a value out of range).
 )";
 
 constexpr double kPi = 3.14159265358979323846;
@@ -430,10 +439,13 @@ Matrix3d segmentInertia(double m, double l, const SegmentTable& t, const Vector3
   return transverse * (Matrix3d::Identity() - uu) + longitudinal * uu;
 }
 
-// A segment's table values replaced by what --segments gives. A sagittal-only inertia
-// (iyy) gets ixx = izz = iyy / 2: the least that meets the triangle inequality; a planar
-// body turning about y never multiplies them.
+// A segment's table values replaced by what --segments gives. A mass without an inertia
+// keeps the table's radii of gyration (the table's inertia, m k^2 with k from the segment
+// length given or the table's, scales with the mass). A sagittal-only inertia (iyy) gets
+// ixx = izz = iyy / 2: the least that meets the triangle inequality; a planar body
+// turning about y never multiplies them.
 void applyOverride(const SegmentOverride& s, double& mass, Vector3d& com, Matrix3d& inertia) {
+  if (s.mass && !s.inertia && !s.gyration) inertia *= *s.mass / mass;
   if (s.mass) mass = *s.mass;
   if (s.com) com = *s.com;
   if (s.inertia) inertia = *s.inertia;
@@ -701,7 +713,42 @@ void writeOutput(const std::string& path, const std::string& text) {
   }
 }
 
-void run(const Options& o) { writeOutput(o.output, makeUrdf(o)); }
+// The segment (--segments' key) whose parameters a link of the model carries; "" none.
+std::string segmentOfLink(const std::string& link) {
+  static const char* const kLinkSegment[][2] = {
+      {"femur_", "thigh"}, {"tibia_", "shank"}, {"foot_", "foot"}, {"pelvis", "hat"}};
+  for (const auto& [prefix, segment] : kLinkSegment)
+    if (link.rfind(prefix, 0) == 0) return segment;
+  return "";
+}
+
+// The model as joint_loads and the node read it (the package's model check with its
+// default options): one they would refuse is not written, and the message names the
+// segment, its link and the violation. Their warnings are said here too.
+void checkModel(const std::string& urdf, const Options& o) {
+  try {
+    for (const std::string& w : jle::modelFromUrdfString(urdf).warnings)
+      std::fprintf(stderr, "make_body_urdf: warning: %s\n", w.c_str());
+  } catch (const jle::ModelError& e) {
+    const std::string what = e.what(), refused = "; joint_loads and the node refuse such a model";
+    const std::string head = "link '";  // the reader's messages name the link first
+    const std::size_t close =
+        what.rfind(head, 0) == 0 ? what.find("': ", head.size()) : std::string::npos;
+    if (close == std::string::npos) throw std::runtime_error(what + refused);
+    const std::string link = what.substr(head.size(), close - head.size());
+    const std::string segment = segmentOfLink(link);
+    std::string where = "link '" + link + "'";
+    if (!segment.empty())
+      where = segment + " (" + where + (o.segments.empty() ? "" : ", " + o.segments) + ")";
+    throw std::runtime_error(where + ": " + what.substr(close + 3) + refused);
+  }
+}
+
+void run(const Options& o) {
+  const std::string urdf = makeUrdf(o);
+  checkModel(urdf, o);
+  writeOutput(o.output, urdf);
+}
 
 }  // namespace
 

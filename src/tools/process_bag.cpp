@@ -33,6 +33,7 @@ using jle::cli::optionValues;
 const char* const kUsage =
     R"(usage: process_bag --bag IN.bag --urdf ROBOT.urdf [--config CONFIG.yaml]
                    [--output OUT.bag | --csv OUT.csv [--kinematics]] [--sto OUT.sto]
+                   [--accept-nonphysical-inertia]
                    [--smoothed-csv OUT.csv]
                    [--topic-prefix /joint_load_estimator]
                    [--zero-phase HZ|auto [--cutoff-rule RULE]]
@@ -73,10 +74,15 @@ bag is played to it, without the timing of a live system.
   --sto PATH           also (or only) write them as an OpenSim storage file: the
                        same numbers, tab-separated, under OpenSim's column names
                        (time, JOINT_moment or JOINT_force, and
-                       JOINT_on_CHILD_in_CHILD_fx ... _mz; docs/joint_loads.md)
+                       JOINT_on_CHILD_in_CHILD_fx ... _mz in the child link's
+                       axes; docs/joint_loads.md)
                        Every output is written beside PATH and renamed onto it on
                        success only. With none, the loads are computed and counted.
   --topic-prefix NS    namespace of the output topic (default /joint_load_estimator)
+  --accept-nonphysical-inertia
+                       as the setting accept_nonphysical_inertia: true (README
+                       "Model"): link inertias no rigid body has (an identified
+                       parameter set) are accepted with a warning per link
   --zero-phase HZ|auto smooth offline first (docs/zero_phase.md): the whole bag's
                        joint positions, and with the same filter every wrench and
                        plate message, by a Butterworth low-pass (order 4 per pass)
@@ -112,7 +118,8 @@ struct Options {
   std::string prefix = "/joint_load_estimator";
   bool smooth = false;  // --zero-phase
   jle::ZeroPhaseConfig smoothing;
-  bool kinematics = false;  // JOINT.q, .qd, .qdd in the CSV
+  bool kinematics = false;                  // JOINT.q, .qd, .qdd in the CSV
+  bool accept_nonphysical_inertia = false;  // the flag: the setting set to true
 };
 
 // --zero-phase, --cutoff-rule.
@@ -135,7 +142,7 @@ Options parseOptions(int argc, char** argv) {
       optionValues(argc, argv,
                    {"--bag", "--urdf", "--config", "--output", "--csv", "--sto", "--topic-prefix",
                     "--zero-phase", "--cutoff-rule", "--smoothed-csv"},
-                   {"--kinematics"});
+                   {"--kinematics", "--accept-nonphysical-inertia"});
   Options o;
   if (!v.count("--bag")) throw UsageError("--bag IN.bag is required");
   if (!v.count("--urdf")) throw UsageError("--urdf ROBOT.urdf is required");
@@ -149,6 +156,7 @@ Options parseOptions(int argc, char** argv) {
   if (v.count("--sto")) o.sto = v["--sto"];
   if (v.count("--smoothed-csv")) o.smoothed_csv = v["--smoothed-csv"];
   o.kinematics = v.count("--kinematics") > 0;
+  o.accept_nonphysical_inertia = v.count("--accept-nonphysical-inertia") > 0;
   if (o.kinematics && o.csv.empty() && o.smoothed_csv.empty())
     throw UsageError("--kinematics is only used with --csv or --smoothed-csv");
   if (v.count("--topic-prefix")) o.prefix = v["--topic-prefix"];
@@ -239,7 +247,7 @@ void Outputs::open(const jle::Pipeline& pipeline) {
   }
   if (!options.sto.empty()) {
     sto_ = std::make_unique<jle::StoWriter>(options.sto);
-    sto_->writeHeader(jle::stoColumnNames(pipeline.model(), names, jle::WrenchFrame::kChild));
+    sto_->writeHeader(jle::stoLayout(pipeline.model(), names, jle::WrenchFrame::kChild));
   }
   openSmoothed(pipeline);
 }
@@ -368,6 +376,7 @@ void run(const Options& options) {
   bag.config = options.config;
   bag.smooth = options.smooth;
   bag.smoothing = options.smoothing;
+  bag.accept_nonphysical_inertia = options.accept_nonphysical_inertia;
   Outputs outputs(options);
   jle::processBag(bag, outputs);
 }

@@ -623,6 +623,69 @@ TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
   }
 }
 
+// A segment given its mass only keeps the table's radii of gyration (Winter Table 4.1's
+// k = 0.323 l across the thigh, de Leva's 14.9 / 32.9 of it along), not the table's
+// inertia in kg m^2: 9 kg on the 75 kg, 1.75 m body's 0.42875 m thigh gives
+// 9 (0.323 x 0.42875)^2 = 0.1726 kg m^2 across (the table's 7.5 kg inertia, 0.1438, is
+// 17% low). A length given beside it scales the radii too: a 4 kg shank of 0.40 m has
+// 4 (0.302 x 0.40)^2 = 0.05837 kg m^2 across.
+TEST_F(BodyTool, MassWithoutInertiaKeepsTheTablesRadiusOfGyration) {
+  write("segments.yaml", "thigh: {mass: 9.0}\nshank: {mass: 4.0, length: 0.40}\n");
+  const jle::Model<double> model =
+      generate({"--mass", "75", "--height", "1.75", "--segments", path("segments.yaml")});
+  const auto inertia = [&](const char* link) {
+    return model.inertia_com[model.frames[model.frameIndex(link)].segment];
+  };
+  const double thigh = 0.245 * 1.75, shank = 0.40;  // [m]
+  const double thigh_across = 9.0 * std::pow(0.323 * thigh, 2);
+  const double thigh_along = 9.0 * std::pow(0.323 * 14.9 / 32.9 * thigh, 2);
+  const double shank_across = 4.0 * std::pow(0.302 * shank, 2);
+  const double shank_along = 4.0 * std::pow(0.302 * 10.3 / 25.5 * shank, 2);
+  EXPECT_NEAR(thigh_across, 0.172606, 1e-6);  // the figure of the issue, by hand
+  for (const char* side : {"r", "l"}) {
+    const Matrix3d t = inertia((std::string("femur_") + side).c_str());
+    const Matrix3d s = inertia((std::string("tibia_") + side).c_str());
+    // 1e-15: the tool's products in another order, a few ulps of 0.17 kg m^2.
+    EXPECT_NEAR(t(0, 0), thigh_across, 1e-15) << side;
+    EXPECT_NEAR(t(1, 1), thigh_across, 1e-15) << side;
+    EXPECT_NEAR(t(2, 2), thigh_along, 1e-15) << side;
+    EXPECT_NEAR(s(0, 0), shank_across, 1e-15) << side;
+    EXPECT_NEAR(s(1, 1), shank_across, 1e-15) << side;
+    EXPECT_NEAR(s(2, 2), shank_along, 1e-15) << side;
+  }
+}
+
+// A URDF that joint_loads would refuse is never written: the tool runs the package's
+// model check on what it would write and stops with exit status 1 naming the segment,
+// its link and the violation. With --sagittal, {iyy: 0.15, ixy: 0.01} leaves ixx = izz
+// = 0, and [[0, 0.01], [0.01, 0.15]] has the principal moment (0.15 - sqrt(0.15^2 + 4 x
+// 0.01^2)) / 2 = -6.6e-4 < 0; a 3-D shank {0.1, 0.1, 0.3} breaks the triangle
+// inequality (0.1 + 0.1 < 0.3) and so does a foot of radii [0.1, 0.1, 0.3] m.
+TEST_F(BodyTool, RefusesSegmentsTheModelCheckRefuses) {
+  const auto refused = [&](const std::string& yaml, std::vector<std::string> args,
+                           const std::vector<std::string>& parts) {
+    write("bad.yaml", yaml);
+    args.insert(args.end(), {"--mass", "75", "--height", "1.75", "--segments", path("bad.yaml"),
+                             "--output", path("out/x.urdf")});
+    const Result r = run(args);
+    EXPECT_EQ(r.status, 1) << yaml << r.err;
+    for (const std::string& part : parts) EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("out/x.urdf"))) << yaml;
+    EXPECT_TRUE(r.out.empty()) << yaml;
+  };
+  refused("thigh: {inertia: {iyy: 0.15, ixy: 0.01}}\n", {"--sagittal"},
+          {"thigh", "link 'femur_r'", "not positive semi-definite"});
+  refused("shank: {inertia: {ixx: 0.1, iyy: 0.1, izz: 0.3}}\n", {},
+          {"shank", "link 'tibia_r'", "triangle inequality"});
+  refused("foot: {gyration: [0.1, 0.1, 0.3]}\n", {}, {"foot", "link 'foot_r'", "triangle"});
+  // Standard output too: nothing is printed when the model is refused.
+  write("bad.yaml", "hat: {inertia: {ixx: 1, iyy: 1, izz: 3}}\n");
+  const Result r = run({"--mass", "75", "--height", "1.75", "--segments", path("bad.yaml")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("hat (link 'pelvis'"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 TEST_F(BodyTool, SegmentsAreCheckedNamingTheKey) {
   const auto refused = [&](const std::string& yaml, std::vector<std::string> extra, int status,
                            const std::string& part) {

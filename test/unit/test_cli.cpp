@@ -185,6 +185,40 @@ TEST_F(CliTest, PandaChainRoundTripMatchesTheLibrary) {
   EXPECT_EQ(piped.out, readFile(outPath()));
 }
 
+// identified_pendulum.urdf (test/data/urdf/SOURCE.md): its links' inertias no rigid body
+// has ('arm' not positive semi-definite, 'hand' breaking the triangle inequality).
+// Refused by default (exit 1, link and violation named); with
+// --accept-nonphysical-inertia the loads are written, a warning names each link and
+// violation, and the effort about the axis is the closed form 1.81 qdd - 2 g cos q
+// (ixx and izz do not enter).
+TEST_F(CliTest, IdentifiedInertiaNeedsTheFlag) {
+  const std::string urdf = kData + "/urdf/identified_pendulum.urdf";
+  write("states.csv",
+        "t,shoulder.q,shoulder.qd,shoulder.qdd\n0,0,0,0\n0.01,0.7,1.3,-0.4\n0.02,-2.1,-0.5,3\n");
+  const Result refused =
+      jointLoads({"--urdf", urdf, "--input", path("states.csv"), "--output", outPath()});
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("link 'arm': inertia is not positive semi-definite"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(outPath()));
+  const Result r = jointLoads({"--urdf", urdf, "--input", path("states.csv"), "--output", outPath(),
+                               "--accept-nonphysical-inertia"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part :
+       {"joint_loads: warning: robot model: link 'arm': inertia is not positive semi-definite",
+        "link 'arm': inertia violates the triangle inequality",
+        "link 'hand': inertia violates the triangle inequality",
+        "full 3-D force and moment are not physical"})
+    EXPECT_NE(r.err.find(part), std::string::npos) << part << "\n" << r.err;
+  const Table loads = parseTable(readFile(outPath()));
+  ASSERT_EQ(loads.rows.size(), 3u);
+  const double q[] = {0.0, 0.7, -2.1}, qdd[] = {0.0, -0.4, 3.0}, g = 9.80665;
+  for (std::size_t i = 0; i < 3; ++i)  // 1e-12: a few products of O(1) numbers
+    EXPECT_NEAR(loads.number(i, "shoulder.effort"), 1.81 * qdd[i] - 2.0 * g * std::cos(q[i]), 1e-12)
+        << i;
+}
+
 TEST_F(CliTest, PandaWithMimicFingerRoundTripMatchesTheLibrary) {
   // The wrench acts on a finger: a prismatic segment, its link frame rotated in the hand.
   const std::string in = trajectory(

@@ -49,6 +49,7 @@ constexpr double kEffortTol = 1e-12;
 constexpr double kPoseTol = 1e-13;  // [m] and rotation entries
 // KDL reads the URDF through its own parser and sums in another order.
 constexpr double kKdlTol = 1e-10;
+constexpr double kPi = 3.14159265358979323846;
 
 struct DhRow {
   bool prismatic = false;
@@ -401,6 +402,96 @@ TEST_F(DhToUrdf, InertiaAboutTheOriginIsMovedToTheCom) {
     EXPECT_LE((a.inertia_com[s] - b.inertia_com[s]).cwiseAbs().maxCoeff(), 1e-14) << s;
 }
 
+// ------------------------------------------------------------------------ the flange
+
+// The flange pose and the efforts of `urdf` at random states against the DH product
+// followed by `T_n_flange` (the fixed transform from DH frame n), and the Newton-Euler
+// reference (the flange is massless: the efforts are the table's).
+void expectFlange(const DhTable& table, const Matrix4d& T_n_flange, const std::string& urdf,
+                  std::mt19937& gen) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t n = table.rows.size();
+  const jle::Model<double> model = jle::modelFromUrdfString(urdf);
+  for (int sample = 0; sample < 20; ++sample) {
+    Eigen::VectorXd q(n), qd(n), qdd(n);
+    for (std::size_t i = 0; i < n; ++i)
+      q[i] = (table.rows[i].prismatic ? 0.5 : 3.0) * u(gen), qd[i] = 2.0 * u(gen),
+      qdd[i] = 5.0 * u(gen);
+    const PackageResult ours = packageRun(model, q, qd, qdd);
+    const Matrix4d fk = forwardKinematics(table, q) * T_n_flange;
+    EXPECT_LE((ours.flange - fk).cwiseAbs().maxCoeff(), kPoseTol) << "sample " << sample;
+    const Eigen::VectorXd reference = referenceEfforts(table, q, qd, qdd);
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_NEAR(ours.effort[i], reference[i], kEffortTol) << "sample " << sample << " j" << i + 1;
+  }
+}
+
+// The Panda's modified DH table (Franka Emika, "Robot and interface specifications":
+// a, d, alpha per joint, then the flange d = 0.107 m) with unit masses at the frame
+// origins. At q = 0 the flange is at (0.088, 0, 0.333 + 0.316 + 0.384 - 0.107) =
+// (0.088, 0, 0.926) m with its z axis down (the alphas sum to pi), Franka's figure.
+TEST_F(DhToUrdf, FlangeOffsetAfterTheLastJointOfThePanda) {
+  constexpr double h = kPi / 2.0;
+  DhTable panda;
+  panda.modified = true;
+  const double a[] = {0, 0, 0, 0.0825, -0.0825, 0, 0.088};
+  const double d[] = {0.333, 0, 0.316, 0, 0.384, 0, 0};
+  const double alpha[] = {0, -h, h, h, -h, h, h};
+  for (int i = 0; i < 7; ++i) {
+    DhRow r;
+    r.a = a[i], r.d = d[i], r.alpha = alpha[i], r.mass = 1.0;
+    r.inertia = 0.01 * Matrix3d::Identity();
+    panda.rows.push_back(r);
+  }
+  std::string yaml = yamlOf(panda);
+  yaml.insert(yaml.find("links:"), "flange: {d: 0.107}\n");
+  const std::string urdf = convert(yaml);
+  const jle::Model<double> model = jle::modelFromUrdfString(urdf);
+  const PackageResult zero = packageRun(model, Eigen::VectorXd::Zero(7), Eigen::VectorXd::Zero(7),
+                                        Eigen::VectorXd::Zero(7));
+  EXPECT_LE((zero.flange.block<3, 1>(0, 3) - Vector3d(0.088, 0.0, 0.926)).norm(), 1e-15);
+  EXPECT_LE((zero.flange.block<3, 3>(0, 0) - Vector3d(1, -1, -1).asDiagonal().toDenseMatrix())
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-15);
+  std::mt19937 gen(17);
+  expectFlange(panda, transZ(0.107), urdf, gen);
+}
+
+// Every form of the entry on random tables: the table's own convention's row (a, alpha,
+// d, theta; standard Rz Tz Tx Rx, modified Rx Tx Rz Tz) or a URDF origin (xyz, then
+// rpy: Rz(yaw) Ry(pitch) Rx(roll)), in the table's angle unit.
+TEST_F(DhToUrdf, FlangeEntryInEveryFormMatchesTheDhProduct) {
+  std::mt19937 gen(23);
+  for (const bool modified : {false, true}) {
+    const DhTable table = randomTable(modified, 6, gen);
+    const std::string yaml = yamlOf(table);
+    const auto with = [&](const std::string& entry) {
+      std::string y = yaml;
+      y.insert(y.find("links:"), "flange: " + entry + "\n");
+      return convert(y);
+    };
+    const Matrix4d row = modified ? rotX(0.3) * transX(0.05) * rotZ(-0.7) * transZ(0.1)
+                                  : rotZ(-0.7) * transZ(0.1) * transX(0.05) * rotX(0.3);
+    expectFlange(table, row, with("{a: 0.05, alpha: 0.3, d: 0.1, theta: -0.7}"), gen);
+    Matrix4d origin = Matrix4d::Identity();
+    origin.block<3, 3>(0, 0) =
+        (Eigen::AngleAxisd(0.6, Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.5, Vector3d::UnitY()) *
+         Eigen::AngleAxisd(0.4, Vector3d::UnitX()))
+            .toRotationMatrix();
+    origin.block<3, 1>(0, 3) = Vector3d(0.1, -0.2, 0.3);
+    expectFlange(table, origin, with("{xyz: [0.1, -0.2, 0.3], rpy: [0.4, -0.5, 0.6]}"), gen);
+  }
+  // Degrees, the table's angle unit, for the flange's angles too: the same table written
+  // in degrees, and Franka's hand mount (-45 deg about z, 0.107 m along it).
+  const DhTable table = randomTable(true, 3, gen);
+  DhTable in_degrees = table;
+  for (DhRow& r : in_degrees.rows) r.alpha *= 180.0 / kPi, r.theta *= 180.0 / kPi;
+  std::string yaml = yamlOf(in_degrees);
+  yaml.insert(yaml.find("links:"), "angle_unit: deg\nflange: {theta: -45, d: 0.107}\n");
+  expectFlange(table, rotZ(-kPi / 4.0) * transZ(0.107), convert(yaml), gen);
+}
+
 TEST_F(DhToUrdf, BadTablesAreRefusedNamingTheRow) {
   const std::string head = "convention: modified\nlinks:\n";
   const auto refused = [&](const std::string& yaml, const std::vector<std::string>& parts) {
@@ -420,6 +511,12 @@ TEST_F(DhToUrdf, BadTablesAreRefusedNamingTheRow) {
           {"links[0] (a)", "positive semi-definite"});
   refused(head + "  - joint: a\n    colour: red\n", {"unknown key 'colour'"});
   refused(head, {"'links'"});
+  refused("convention: modified\nflange: {d: 0.1, xyz: [0, 0, 0.1]}\nlinks:\n  - joint: a\n",
+          {"flange", "not both"});
+  refused("convention: modified\nflange: {colour: red}\nlinks:\n  - joint: a\n",
+          {"flange", "unknown key 'colour'"});
+  refused("convention: modified\nflange: {xyz: [0, 0]}\nlinks:\n  - joint: a\n",
+          {"flange", "'xyz'"});
   const Result usage = run({"--output", path("out/x.urdf")});
   EXPECT_EQ(usage.status, 2);
   const Result help = run({"--help"});

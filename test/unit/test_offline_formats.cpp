@@ -212,6 +212,92 @@ TEST_F(OfflineFormatsTest, PoseOnlyBaseMotionIsEstimatedWithinTheMethodsOrder) {
   RecordProperty("worst_moment_error_over_bound", std::to_string(worst_moment));
 }
 
+// Positions only with a floating base: the joints' JOINT.q and the base's pose, whose
+// twist and acceleration are computed from the smoothed pose like the joints' rates. The
+// two-leg body (two_leg_stand.urdf) with every joint at 0 is one rigid body: its residual
+// is the Newton-Euler of its five parts written here (part i: mass m_i, centre of mass
+// c_i and inertia J_i in the pelvis frame), F = sum m_i (a_i - g), M = sum R J_i R^T alpha
+// + w x R J_i R^T w + R c_i x m_i (a_i - g), a_i = a + alpha x R c_i + w x (w x R c_i);
+// and the left ankle holds its foot: F = m_f (a_f - g) (world frame). The motion: p =
+// (0.3 sin pi t, 0.2 sin 0.8 pi t, 0.9 + 0.1 cos pi t), a turn 0.3 sin pi t about the
+// fixed axis u, the quaternion's sign flipped on every other row; 4 s at 1 kHz, compared
+// over the middle 2 s: the zero-phase filter's end transients (its own, as for the
+// joints: docs/zero_phase.md) are still 0.4 N at 0.4 s from the ends, far below 1e-3
+// after 1 s (they decay as exp(-19 t) at 8 Hz).
+TEST_F(OfflineFormatsTest, PositionsOnlyFloatingBaseDifferentiatesThePose) {
+  const double w = M_PI;
+  const Eigen::Vector3d u = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  struct Part {
+    double m;
+    Eigen::Vector3d c;
+    Eigen::Vector3d J;  // principal, along the pelvis axes
+  };
+  const Part parts[] = {{10, {0.02, 0, 0}, {0.1, 0.08, 0.1}},
+                        {5, {0, 0.1, -0.4}, {0.27, 0.27, 0.01}},
+                        {5, {0, -0.1, -0.4}, {0.27, 0.27, 0.01}},
+                        {1, {0.05, 0.1, -0.85}, {0.002, 0.004, 0.004}},
+                        {1, {0.05, -0.1, -0.85}, {0.002, 0.004, 0.004}}};
+  const int n = 4001;
+  std::string csv = std::string("t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw,") +
+                    "hip_l.q,ankle_l.q,hip_r.q,ankle_r.q\n";
+  for (int i = 0; i < n; ++i) {
+    const double t = 0.001 * i;
+    Eigen::Quaterniond q(Eigen::AngleAxisd(0.3 * std::sin(w * t), u));
+    if (i % 2) q.coeffs() = -q.coeffs();
+    csv += num(t) + "," + num(0.3 * std::sin(w * t)) + "," + num(0.2 * std::sin(0.8 * w * t)) +
+           "," + num(0.9 + 0.1 * std::cos(w * t)) + "," + num(q.x()) + "," + num(q.y()) + "," +
+           num(q.z()) + "," + num(q.w()) + ",0,0,0,0\n";
+  }
+  write("in.csv", csv);
+  const Result r = jointLoads({"--urdf", kStand, "--input", path("in.csv"), "--floating-base",
+                               "--frame", "world", "--cutoff", "8"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table out = parseCsv(r.out);
+  ASSERT_EQ(out.rows.size(), static_cast<std::size_t>(n));
+  const Eigen::Vector3d g(0, 0, -kG);
+  double worst = 0.0;
+  for (int i = 1000; i <= 3000; i += 50) {
+    const double t = 0.001 * i, s = std::sin(w * t), c = std::cos(w * t);
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3 * s, u).toRotationMatrix();
+    const Eigen::Vector3d om = u * (0.3 * w * c), al = u * (-0.3 * w * w * s);
+    const Eigen::Vector3d a(-0.3 * w * w * s, -0.2 * 0.64 * w * w * std::sin(0.8 * w * t),
+                            -0.1 * w * w * c);
+    Eigen::Vector3d F = Eigen::Vector3d::Zero(), M = Eigen::Vector3d::Zero();
+    Eigen::Vector3d F_foot = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 5; ++k) {
+      const Eigen::Vector3d ci = R * parts[k].c;
+      const Eigen::Matrix3d Ji = R * parts[k].J.asDiagonal() * R.transpose();
+      const Eigen::Vector3d Fi = parts[k].m * (a + al.cross(ci) + om.cross(om.cross(ci)) - g);
+      F += Fi;
+      M += Ji * al + om.cross(Ji * om) + ci.cross(Fi);
+      if (k == 3) F_foot = Fi;
+    }
+    const Eigen::Vector3d F_out(out.number(i, "base.fx"), out.number(i, "base.fy"),
+                                out.number(i, "base.fz"));
+    const Eigen::Vector3d M_out(out.number(i, "base.mx"), out.number(i, "base.my"),
+                                out.number(i, "base.mz"));
+    const Eigen::Vector3d A_out(out.number(i, "ankle_l.fx"), out.number(i, "ankle_l.fy"),
+                                out.number(i, "ankle_l.fz"));
+    // 1e-4 N, N m: a residual of a body at rest would be off by 22 x 0.3 pi^2 = 65 N; the
+    // smoothing (8 Hz against a 0.5 Hz motion) and differentiation leave 3.7e-6.
+    EXPECT_LE((F_out - F).norm(), 1e-4) << "row " << i;
+    EXPECT_LE((M_out - M).norm(), 1e-4) << "row " << i;
+    EXPECT_LE((A_out - F_foot).norm(), 1e-4) << "row " << i;
+    worst = std::max({worst, (F_out - F).norm(), (M_out - M).norm(), (A_out - F_foot).norm()});
+  }
+  RecordProperty("worst_error", std::to_string(worst));
+  std::printf("positions-only floating base: worst error %.3g\n", worst);
+  // A twist or acceleration beside positions only is refused, saying why.
+  write("twist.csv",
+        "t,base.x,base.y,base.z,base.qx,base.qy,base.qz,base.qw,base.vx,base.vy,"
+        "base.vz,base.wx,base.wy,base.wz,hip_l.q,ankle_l.q,hip_r.q,ankle_r.q\n"
+        "0,0,0,1,0,0,0,1,0,0,0,0,0,0,0,0,0,0\n");
+  const Result twist =
+      jointLoads({"--urdf", kStand, "--input", path("twist.csv"), "--floating-base"});
+  EXPECT_EQ(twist.status, 1);
+  EXPECT_NE(twist.err.find("computed from its smoothed pose"), std::string::npos) << twist.err;
+}
+
 // ------------------------------------------------------- standing on two force plates
 
 // The two-leg fixture standing still, every angle zero, pelvis origin 0.9 m up: total
@@ -342,8 +428,15 @@ TEST_F(OfflineFormatsTest, PerKgEffortsDivideByTheBodyMass) {
 
 // ------------------------------------------------------------------- OpenSim .sto
 
-void expectStoMatchesCsv(const Sto& sto, const Table& csv,
-                         const std::map<std::string, std::string>& names) {
+// A .sto column and the CSV column it holds, times `sign`: OpenSim's ground axes are x
+// forward, y up, z right, the model's world x forward, y left, z up, so a world
+// vector's (x, y, z) is written (x, z, -y).
+struct StoColumn {
+  std::string csv, sto;
+  double sign = 1.0;
+};
+
+void expectStoMatchesCsv(const Sto& sto, const Table& csv, const std::vector<StoColumn>& names) {
   // OpenSim's Storage header.
   ASSERT_GE(sto.header_lines.size(), 5u);
   EXPECT_EQ(sto.header_lines[0], "Inverse Dynamics Generalized Forces");
@@ -353,12 +446,14 @@ void expectStoMatchesCsv(const Sto& sto, const Table& csv,
   EXPECT_EQ(sto.header_lines[4], "inDegrees=no");
   ASSERT_EQ(sto.table.header.size(), csv.header.size());
   ASSERT_EQ(sto.table.rows.size(), csv.rows.size());
-  for (const auto& [csv_name, sto_name] : names) {
+  for (const auto& [csv_name, sto_name, sign] : names) {
     const int c = csv.column(csv_name), s = sto.table.column(sto_name);
     ASSERT_GE(c, 0) << csv_name;
     ASSERT_GE(s, 0) << sto_name;
-    for (std::size_t row = 0; row < csv.rows.size(); ++row)
-      EXPECT_EQ(sto.table.rows[row][s], csv.rows[row][c]) << sto_name << " row " << row;
+    for (std::size_t row = 0; row < csv.rows.size(); ++row)  // exact: %.17g reads back
+      EXPECT_EQ(std::strtod(sto.table.rows[row][s].c_str(), nullptr),
+                sign * std::strtod(csv.rows[row][c].c_str(), nullptr))
+          << sto_name << " row " << row;
   }
 }
 
@@ -375,20 +470,71 @@ TEST_F(OfflineFormatsTest, JointLoadsWritesOpenSimStorage) {
                            : std::string(frame) == "parent" ? "leg_l"
                                                             : "ground";
     const Sto s = parseSto(readFile(path("o.sto")));
+    // The link frames' components as they are; the world's (ground) turned to y up.
+    const bool ground = in == "ground";
+    const std::string ankle = "ankle_l_on_foot_l_in_" + in + "_";
     expectStoMatchesCsv(s, parseCsv(csv.out),
                         {{"t", "time"},
                          {"base.fx", "pelvis_tx_force"},
-                         {"base.fz", "pelvis_tz_force"},
-                         {"base.my", "pelvis_my_moment"},
+                         {"base.fz", "pelvis_ty_force"},
+                         {"base.fy", "pelvis_tz_force", -1.0},
+                         {"base.my", "pelvis_mz_moment", -1.0},
+                         {"base.mz", "pelvis_my_moment"},
                          {"ankle_l.effort", "ankle_l_moment"},
                          {"ankle_l.effort_per_kg", "ankle_l_moment_per_kg"},
-                         {"ankle_l.fz", "ankle_l_on_foot_l_in_" + in + "_fz"},
-                         {"ankle_l.my", "ankle_l_on_foot_l_in_" + in + "_my"},
+                         {"ankle_l.fx", ankle + "fx"},
+                         {"ankle_l.fz", ankle + (ground ? "fy" : "fz")},
+                         {"ankle_l.my", ankle + (ground ? "mz" : "my"), ground ? -1.0 : 1.0},
                          {"plate@left.contact", "left_contact"},
                          {"plate@left.cop_x", "left_ground_force_px"},
-                         {"plate@right.cop_z", "right_ground_force_pz"}});
+                         {"plate@left.cop_y", "left_ground_force_pz", -1.0},
+                         {"plate@right.cop_z", "right_ground_force_py"}});
     EXPECT_EQ(s.table.header[0], "time");
   }
+}
+
+// OpenSim's ground is y up: a vertical force, a centre of pressure's height, land in the
+// _ty / _fy / _py columns. Hand values: the free body's first state of
+// FreeBodyResidualIsNewtonEuler, F = (1.2, 5, 2 (3 + g)), M = (0, -0.2 (3 + g), 0.65) in
+// the z-up world, is written tx = 1.2, ty = 2 (3 + g), tz = -5 and mx = 0, my = 0.65,
+// mz = 0.2 (3 + g); standing on plates raised to z = 0.25 m, the COPs (x_c, +-0.1,
+// 0.25) are written (x_c, 0.25, -+0.1), and the left ankle's vertical force -(W/2 - g)
+// (world frame) is its _fy.
+TEST_F(OfflineFormatsTest, StoWritesWorldVectorsInOpenSimsGroundAxes) {
+  write("body.csv", std::string(kBaseHeader) + "\n0,0,0,1,0,0,0,1,0,0,0,0,0,2,1,2,3,0,0,5\n");
+  Result r = jointLoads({"--urdf", kFreeBody, "--input", path("body.csv"), "--floating-base",
+                         "--format", "sto", "--output", path("body.sto")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table body = parseSto(readFile(path("body.sto"))).table;
+  ASSERT_EQ(body.rows.size(), 1u);
+  // 1e-12: a few roundings of numbers of order 30.
+  EXPECT_NEAR(body.number(0, "body_tx_force"), 1.2, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_ty_force"), 2.0 * (3.0 + kG), 1e-12);
+  EXPECT_NEAR(body.number(0, "body_tz_force"), -5.0, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_mx_moment"), 0.0, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_my_moment"), 0.65, 1e-12);
+  EXPECT_NEAR(body.number(0, "body_mz_moment"), 0.2 * (3.0 + kG), 1e-12);
+
+  write("in.csv", standCsv());
+  r = jointLoads({"--urdf", kStand, "--input", path("in.csv"), "--floating-base", "--plate",
+                  "left=foot_l,0,0.1,0.25", "--plate", "right=foot_r,0,-0.1,0.25,90", "--frame",
+                  "world", "--format", "sto", "--output", path("stand.sto")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table stand = parseSto(readFile(path("stand.sto"))).table;
+  EXPECT_NEAR(stand.number(0, "left_ground_force_px"), kXc, 1e-14);
+  EXPECT_NEAR(stand.number(0, "left_ground_force_py"), 0.25, 1e-14);
+  EXPECT_NEAR(stand.number(0, "left_ground_force_pz"), -0.1, 1e-14);
+  EXPECT_NEAR(stand.number(0, "right_ground_force_py"), 0.25, 1e-14);
+  EXPECT_NEAR(stand.number(0, "right_ground_force_pz"), 0.1, 1e-14);
+  EXPECT_NEAR(stand.number(0, "ankle_l_on_foot_l_in_ground_fy"), -(kWeight / 2 - kG), 1e-11);
+  EXPECT_NEAR(stand.number(0, "ankle_l_on_foot_l_in_ground_fx"), 0.0, 1e-11);
+  EXPECT_NEAR(stand.number(0, "ankle_l_on_foot_l_in_ground_fz"), 0.0, 1e-11);
+
+  // A world that is not z up has no such turn: refused.
+  r = jointLoads({"--urdf", kFreeBody, "--input", path("body.csv"), "--floating-base", "--gravity",
+                  "0,-9.8,0", "--format", "sto"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--format sto"), std::string::npos) << r.err;
 }
 
 TEST_F(OfflineFormatsTest, ProcessBagWritesOpenSimStorage) {

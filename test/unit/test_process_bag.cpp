@@ -589,6 +589,40 @@ TEST_F(ProcessBagTest, StaticTransformsWrittenLateHoldFromTheStart) {
       EXPECT_NEAR(b.rows[i][c], a.rows[i][c], 1e-9) << a.header[c] << ", row " << i;
 }
 
+// The Panda with panda_link7's inertia turned into one no rigid body has (ixx negated,
+// as an identified parameter set may give it): refused by default naming the link and
+// the violation; accepted with --accept-nonphysical-inertia or the setting
+// accept_nonphysical_inertia: true, with a warning naming them.
+TEST_F(ProcessBagTest, IdentifiedInertiaNeedsTheFlagOrTheSetting) {
+  writeBag(path("in.bag"), makeMessages());
+  writeFile(path("config.yaml"), kConfig);
+  std::string urdf = readFile(kPanda);
+  const std::string link7 = "<inertia ixx=\"0.012516\"";
+  ASSERT_NE(urdf.find(link7), std::string::npos);
+  urdf.replace(urdf.find(link7), link7.size(), "<inertia ixx=\"-0.012516\"");
+  writeFile(path("identified.urdf"), urdf);
+  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " +
+                           quote(path("identified.urdf")) + " --bag " + quote(path("in.bag")) +
+                           " --csv " + quote(path("o.csv")) + " --config ";
+  const std::string violation = "link 'panda_link7': inertia is not positive semi-definite";
+  Result r = run(tool + quote(path("config.yaml")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find(violation), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.csv")));
+  r = run(tool + quote(path("config.yaml")) + " --accept-nonphysical-inertia");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("process_bag: warning: robot model: " + violation), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("not physical"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(path("o.csv")));
+  fs::remove(path("o.csv"));
+  writeFile(path("accept.yaml"), std::string(kConfig) + "accept_nonphysical_inertia: true\n");
+  r = run(tool + quote(path("accept.yaml")));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(violation), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(path("o.csv")));
+}
+
 TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
   const Messages m = makeMessages();
   writeBag(path("in.bag"), m);

@@ -193,6 +193,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(stamps.regularize);
   EXPECT_SAME(stamps.jump_confirm);
   EXPECT_SAME(keep_fixed_joints);
+  EXPECT_SAME(accept_nonphysical_inertia);
   EXPECT_SAME(base_residual_threshold);
   EXPECT_SAME(still_velocity);
   EXPECT_SAME(bias_file);
@@ -249,6 +250,7 @@ TEST(SettingsReader, TopLevelKeys) {
   e.estimator.decimation = 3;
   e.time_jump_threshold = 0.5;
   e.keep_fixed_joints = {"wrist_3_link-tool0_fixed_joint"};
+  e.accept_nonphysical_inertia = true;
   e.estimator.precision = jle::Precision::kFloat;
   e.estimator.measured_velocity = jle::MeasuredVelocity::kNever;
   e.floating_base = true;

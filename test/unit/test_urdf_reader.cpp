@@ -1,6 +1,7 @@
 // The URDF reader against urdfdom (ROS's own parser, an independent implementation):
 // every link's pose at q = 0, mass and inertia must agree on the public models.
 #include <joint_load_estimator/dynamics.hpp>
+#include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -140,6 +142,55 @@ TEST(UrdfReader, TalosLoadsWithItsSlightlyUnphysicalInertiaReported) {
   } catch (const jle::ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("gripper_left_motor_single_link"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("talos_reduced.urdf"), std::string::npos);
+  }
+}
+
+// identified_pendulum.urdf, an identified parameter set's inertias: link 'arm' (principal moments
+// -0.05, 0.02, 0.3) is not positive semi-definite and breaks the triangle inequality, link 'hand'
+// (0.01, 0.01, 0.1) breaks it by 80%. Refused by default; accepted with
+// accept_nonphysical_inertia, each violation a warning naming the link and what it
+// affects; the effort about the joint axis y is then the identified model's closed
+// form, where neither ixx nor izz enters: tau = (Iyy_arm + Iyy_hand + 2 x 0.5^2 + 1 x
+// 1^2) qdd - (2 x 0.5 + 1 x 1) g cos q = 1.81 qdd - 2 g cos q.
+const std::string kIdentifiedPendulum = kData + "/urdf/identified_pendulum.urdf";
+
+TEST(UrdfReader, IdentifiedInertiaIsRefusedByDefaultAndAcceptedWithTheOption) {
+  try {
+    jle::modelFromUrdfFile(kIdentifiedPendulum);
+    FAIL() << "a non-physical inertia was accepted by default";
+  } catch (const jle::ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("link 'arm': inertia is not positive semi-definite"),
+              std::string::npos)
+        << e.what();
+  }
+  jle::ModelOptions options;
+  options.accept_nonphysical_inertia = true;
+  const jle::Model<double> model = jle::modelFromUrdfFile(kIdentifiedPendulum, options);
+  const auto warned = [&](const std::string& link, const std::string& violation) {
+    for (const std::string& w : model.warnings)
+      if (w.find("link '" + link + "': inertia " + violation) != std::string::npos &&
+          w.find("are the identified model's") != std::string::npos &&
+          w.find("full 3-D force and moment are not physical") != std::string::npos)
+        return true;
+    return false;
+  };
+  EXPECT_TRUE(warned("arm", "is not positive semi-definite"));
+  EXPECT_TRUE(warned("arm", "violates the triangle inequality"));
+  EXPECT_TRUE(warned("hand", "violates the triangle inequality"));
+  EXPECT_EQ(model.warnings.size(), 3u);
+  constexpr double g = 9.80665;
+  for (const double q : {0.0, 0.7, -2.1}) {
+    jle::Data<double> data(model);
+    jle::VectorX<double> vq(1), vqd(1), vqdd(1);
+    vq << q;
+    vqd << 1.3;
+    vqdd << -0.4;
+    jle::forwardKinematics(model, data, vq, vqd, vqdd, Eigen::Vector3d(0.0, 0.0, -g));
+    jle::inverseDynamics(model, data);
+    // 1e-12: a few products of O(1) numbers.
+    EXPECT_NEAR(data.effort[model.segmentOfJoint("shoulder")], 1.81 * -0.4 - 2.0 * g * std::cos(q),
+                1e-12)
+        << q;
   }
 }
 

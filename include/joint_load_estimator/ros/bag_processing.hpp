@@ -22,6 +22,9 @@ struct BagOptions {
   /// differentiator is then central differences of the smoothed positions.
   bool smooth = false;
   ZeroPhaseConfig smoothing;
+  /// process_bag --accept-nonphysical-inertia: the setting accept_nonphysical_inertia
+  /// set to true whatever the config says (false: the config's).
+  bool accept_nonphysical_inertia = false;
   /// Progress (on a terminal) and the summary lines on standard error; warnings are
   /// said in any case.
   bool summary = true;
