@@ -297,7 +297,9 @@ struct StampSettings {
 };
 
 /// The smoothed stream's filter by default: the constant-jerk Kalman smoother, process
-/// noise 1e3, lag 0.2 s. Chosen on the accuracy study's scenes (docs/accuracy.md, "The
+/// noise 1e3 raised from the data where the positions' spectrum shows motion above its
+/// bandwidth (auto_bandwidth: the running leg, the impacts, the gait; docs/accuracy.md),
+/// lag 0.2 s. The process noise was chosen on the accuracy study's scenes (docs/accuracy.md, "The
 /// defaults against the best of the study"): with the joint states' velocities 1.05x the
 /// best offline row on geometric mean over 24 scenes (1e2: 1.24x, 1e4: 1.09x, the adaptive
 /// smoother 1.08x); positions only 1.70x (1e2: 1.63x), and 4.3x where the positions carry
@@ -308,6 +310,7 @@ inline DifferentiatorConfig defaultSmoother() {
   c.kalman_model = KalmanModel::kConstantJerk;
   c.process_noise = 1e3;
   c.lag = 0.2;
+  c.auto_bandwidth = true;
   return c;
 }
 

@@ -68,6 +68,16 @@ struct DifferentiatorConfig {
   /// the model's state) follow an estimated sample: a lag shorter than n intervals is n.
   /// Adaptive: the same smoother, its process noise the selected filter's at each sample.
   double lag = 0.0;
+  /// Kalman with a lag: the smoother's bandwidth raised from the data (true): where the
+  /// joint positions' spectrum so far meets its noise floor (SpectralCutoff::Rule::
+  /// kNoiseFloor, as the offline zero-phase rule: coloured noise is not taken for motion;
+  /// 2 s blocks, from the second one on), at least kLagFloor / lag, at most max_bandwidth,
+  /// as the process noise r^2 h (2 pi f)^(2n) (r measurement_noise, h the recent interval:
+  /// the smoother's gain is 1/2 at f, as the zero-phase Butterworth of order n's at its
+  /// cutoff) where that is above process_noise; never below it (lowered, it cost the
+  /// accuracy study's Panda scenes up to 1.2x: a 2 s block's spectrum is a thin basis and
+  /// the lag short). false: process_noise throughout.
+  bool auto_bandwidth = false;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
   /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
   /// noise [unit] if known (0: estimated online from the innovations), and the time
@@ -99,8 +109,9 @@ inline bool sameDifferentiator(const DifferentiatorConfig& a, const Differentiat
   return a.type == b.type && a.window == b.window && a.order == b.order && a.delay == b.delay &&
          a.kalman_model == b.kalman_model && processNoise(a) == processNoise(b) &&
          a.measurement_noise == b.measurement_noise && a.lag == b.lag &&
-         a.min_bandwidth == b.min_bandwidth && a.max_bandwidth == b.max_bandwidth &&
-         a.noise == b.noise && a.memory == b.memory && a.max_gap == b.max_gap;
+         a.auto_bandwidth == b.auto_bandwidth && a.min_bandwidth == b.min_bandwidth &&
+         a.max_bandwidth == b.max_bandwidth && a.noise == b.noise && a.memory == b.memory &&
+         a.max_gap == b.max_gap;
 }
 
 /// Checks a configuration once (the bank on construction, validate(EstimatorConfig) in
@@ -128,6 +139,11 @@ inline void validate(const DifferentiatorConfig& c) {
       fail("measurement_noise", "must be finite and > 0");
     if (!(c.lag >= 0.0) || !(c.lag <= kMaxLag))
       fail("lag", "must be 0..10 [s] (0: the causal filter)");
+    if (c.auto_bandwidth && (!(c.min_bandwidth > 0.0) || !std::isfinite(c.min_bandwidth)))
+      fail("min_bandwidth", "must be finite and > 0 [Hz]");
+    if (c.auto_bandwidth &&
+        (!(c.max_bandwidth >= c.min_bandwidth) || !std::isfinite(c.max_bandwidth)))
+      fail("max_bandwidth", "must be finite and >= min_bandwidth [Hz]");
   } else {
     if (c.lag != 0.0) fail("lag", "applies to types kalman and adaptive only (it must be 0)");
     if (c.order < 2 || c.order > 5)
@@ -179,6 +195,7 @@ class DifferentiatorBank {
       innovation_.setZero(channels_);
       if (config_.type == DifferentiatorType::kAdaptive) buildModels();
       if (config_.type == DifferentiatorType::kAdaptive && config_.lag > 0.0) buildSmoother();
+      if (autoBandwidth()) chooseBandwidthFrom(channels_);
       if (smoothing()) allocateRing(1);
     } else {
       n_ = config_.order + 1;
@@ -318,6 +335,7 @@ class DifferentiatorBank {
   /// standard deviation [unit] of channel c it assumes (estimated or given; 0 before the
   /// first estimate).
   double bandwidth() const {
+    if (autoBandwidth()) return auto_bandwidth_;
     if (delegating() && spectral_.bandwidth() > 0.0) return spectral_.bandwidth();
     return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
   }
@@ -327,6 +345,11 @@ class DifferentiatorBank {
   /// Adaptive with a lag: only the first `channels` channels (e.g. the joint positions,
   /// not the wrenches filtered alike) choose the smoother's bandwidth. All by default.
   void chooseBandwidthFrom(int channels) {
+    if (autoBandwidth()) {
+      spectral_ = SpectralCutoff(std::min(channels, channels_), config_.min_bandwidth,
+                                 config_.max_bandwidth, SpectralCutoff::Rule::kNoiseFloor);
+      return;
+    }
     if (!delegating()) return;
     const double floor = kLagFloor / config_.lag;
     spectral_ = SpectralCutoff(floor <= kHighestFloor ? std::min(channels, channels_) : 0,
@@ -444,6 +467,24 @@ class DifferentiatorBank {
     stamp_ = s.stamp_;
     newest_used_ = s.newest_used_;
     return true;
+  }
+
+  bool autoBandwidth() const {
+    return config_.type == DifferentiatorType::kKalman && config_.auto_bandwidth &&
+           config_.lag > 0.0;
+  }
+
+  // auto_bandwidth: SpectralCutoff's choice, at least kLagFloor / lag, as the process
+  // noise where it is above process_noise's (dt: the last interval, where the recent
+  // median is not known yet).
+  void chooseNoise(double dt) {
+    if (!(spectral_.cutoff() > 0.0)) return;
+    auto_bandwidth_ = std::max(spectral_.cutoff(), kLagFloor / config_.lag);
+    const double h = spacing_ > 0.0 ? spacing_ : dt;
+    const double r = config_.measurement_noise;
+    const double q = r * r * h * std::pow(2.0 * M_PI * auto_bandwidth_, 2 * n_);
+    below_default_ = q < default_q_;
+    setProcessNoise(std::max(q, default_q_));
   }
 
   // A new process noise from the next sample on (F and Q recomputed, the gain unsettled).
@@ -693,6 +734,8 @@ class DifferentiatorBank {
       kalmanChannels<4>(x, predicted);
     stamp_ = t;
     if (count_ < n) ++count_;
+    if (autoBandwidth() && count_ >= n && spectral_.add(t, x, state_.data() + 1, n))
+      chooseNoise(dt);
     if (smoothing()) return smoothStep(t, dt);
     return count_ >= n;
   }
@@ -1021,6 +1064,9 @@ class DifferentiatorBank {
   double recent_[kRecent] = {};
   int recent_count_ = 0;
   double spacing_ = 0.0;
+  double auto_bandwidth_ = 0.0;               // [Hz] auto_bandwidth: the spectrum's (0: none yet)
+  double default_q_ = processNoise(config_);  // auto_bandwidth: the least process noise
+  bool below_default_ = false;  // auto_bandwidth: the spectrum's bandwidth below process_noise's
   SmallMatrix backward_gain_;
   // Per remembered sample (column: slot index % ring_size_): the filtered state
   // (n x channels, channel-major), the prediction before its measurement, the backward

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <vector>
 
 namespace jle {
@@ -82,8 +83,11 @@ class SpectralCutoff {
   static constexpr double kBlockSeconds = 2.0;
   static constexpr double kMemorySeconds = 30.0;
   static constexpr double kMaxRate = 1000.0;  ///< [Hz] above it, samples are averaged
-  static constexpr int kMaxFill = 10;         ///< missing samples filled in a block at most
-  static constexpr int kMaxBlock = 4096;      ///< samples of a block at most (2 s at 2 kHz)
+  /// [Hz] Rule::kNoiseFloor's: the floor and the crossing lie far below it, and the
+  /// transforms cost half of kMaxRate's (the smoothed stream's default runs it).
+  static constexpr double kMaxRateNoiseFloor = 500.0;
+  static constexpr int kMaxFill = 10;     ///< missing samples filled in a block at most
+  static constexpr int kMaxBlock = 4096;  ///< samples of a block at most (2 s at 2 kHz)
   static constexpr double kGridRatio = 1.05;
   static constexpr int kGridSize = 128;  ///< candidates at most (1.05^128: 500x)
   static constexpr double kTolerance = 0.02;
@@ -92,11 +96,28 @@ class SpectralCutoff {
   /// Candidates scored per step of the spread work.
   static constexpr int kScoresPerStep = 16;
 
+  /// How the cutoff is chosen from the spectrum.
+  enum class Rule : std::uint8_t {
+    kGcv,  ///< the GCV score above
+    /// Where the spectrum meets its noise floor, as zero_phase.hpp's CutoffRule::kSpectrum
+    /// on the record's bands: the bins' levels (the variance of white noise that would
+    /// give them) averaged in bands of ratio kBandRatio; their upper envelope from above
+    /// followed up in frequency; the first band from which it falls by less than
+    /// kFlatSlope (log-log) over the next octave, kFloorBelowPeak under its highest level,
+    /// starts the floor (the median level of that octave), and the cutoff is where the
+    /// envelope, coming down, crosses twice the floor. Coloured noise, flat to a corner,
+    /// is not taken for motion (GCV takes it for motion). No floor: the highest cutoff.
+    kNoiseFloor,
+  };
+  static constexpr double kBandRatio = 1.1;
+  static constexpr double kFlatSlope = -1.5;
+  static constexpr double kFloorBelowPeak = 1e-3;
+
   SpectralCutoff() = default;
   /// channels: how many of the first channels of each sample choose (e.g. the joint
   /// positions, not the wrenches); lowest, highest: the cutoffs searched [Hz].
-  SpectralCutoff(int channels, double lowest, double highest)
-      : channels_(channels), lowest_(lowest), highest_(highest) {
+  SpectralCutoff(int channels, double lowest, double highest, Rule rule = Rule::kGcv)
+      : channels_(channels), lowest_(lowest), highest_(highest), rule_(rule) {
     if (channels_ <= 0) return;
     // Every buffer at the largest block (the grid is at most kMaxRate): none grows later.
     fft_ = Fft(kMaxBlock);
@@ -170,12 +191,17 @@ class SpectralCutoff {
   int pendingSteps() const {
     if (step_ < 0) return 0;
     const int scored = step_ <= channels_ ? 0 : scored_;
-    const int scoring = std::max(1, (count_ - scored + kScoresPerStep - 1) / kScoresPerStep);
+    const int scoring = rule_ == Rule::kNoiseFloor
+                            ? 1
+                            : std::max(1, (count_ - scored + kScoresPerStep - 1) / kScoresPerStep);
     return std::max(0, channels_ + 1 - step_) + scoring;
   }
 
   /// The chosen cutoff [Hz] (0 before the first choice).
   double cutoff() const { return cutoff_; }
+  /// Whether the last choice sits on a bound of the search (the lowest or the highest
+  /// cutoff, or no noise floor found): the data do not settle it.
+  bool onBound() const { return on_bound_; }
   /// The bandwidth to use [Hz]: the chosen cutoff, before it the lowest searched; 0 when
   /// there is nothing to search (lowest above highest).
   double bandwidth() const {
@@ -183,13 +209,16 @@ class SpectralCutoff {
     return cutoff_ > 0.0 ? cutoff_ : lowest_;
   }
   int blockSamples() const { return block_; }
+  /// Blocks in the spectrum so far.
+  int blocks() const { return blocks_; }
   int decimation() const { return decimation_; }
 
  private:
   // The grid's interval h [s] and the block layout, once.
   void start(double h) {
     started_ = true;
-    decimation_ = std::max(1, static_cast<int>(std::floor(1.0 / (h * kMaxRate) + 1e-9)));
+    const double max_rate = rule_ == Rule::kNoiseFloor ? kMaxRateNoiseFloor : kMaxRate;
+    decimation_ = std::max(1, static_cast<int>(std::floor(1.0 / (h * max_rate) + 1e-9)));
     h_ = h;
     const double hd = h * decimation_;
     block_ = 16;
@@ -275,6 +304,11 @@ class SpectralCutoff {
   // has the less noisy derivatives.
   bool scoreSome() {
     const double hd = h_ * decimation_;
+    if (rule_ == Rule::kNoiseFloor) {
+      scored_ = count_;
+      chooseNoiseFloor(hd);
+      return true;
+    }
     const int end = std::min(count_, scored_ + kScoresPerStep);
     for (; scored_ < end; ++scored_) {
       scores_[scored_] = score(grid_[scored_] * hd);
@@ -288,6 +322,69 @@ class SpectralCutoff {
         break;
       }
     return true;
+  }
+
+  // Rule::kNoiseFloor on the spectrum so far (grid interval hd [s]): the bands' levels
+  // into band_level_ (their centres [Hz] in band_centre_), then the knee, the floor and
+  // the crossing.
+  void chooseNoiseFloor(double hd) {
+    const double bin = 1.0 / (block_ * hd);  // [Hz] between bins
+    int bands = 0;
+    for (double lo = lowest_; bands < kMaxBands; lo *= kBandRatio) {
+      const int first = std::max(1, static_cast<int>(std::ceil(lo / bin)));
+      const int last =
+          std::min(block_ / 2 - 1, static_cast<int>(std::ceil(kBandRatio * lo / bin)) - 1);
+      if (first > block_ / 2 - 1) break;
+      if (last < first) continue;  // no bin in the band: the next one
+      double sum = 0.0;
+      for (int k = first; k <= last; ++k) sum += spectrum_[k];
+      band_level_[bands] = band_raw_[bands] = std::max(1e-300, sum / (last - first + 1));
+      band_centre_[bands++] = std::sqrt(first * last) * bin;
+    }
+    const double top = std::min(highest_, 0.45 / hd);
+    on_bound_ = true;
+    cutoff_ = top;
+    if (bands < 2) return;
+    for (int j = bands - 2; j >= 0; --j)
+      band_level_[j] = std::max(band_level_[j], band_level_[j + 1]);  // the envelope
+    for (int knee = 0; knee < bands; ++knee) {
+      int end = knee;  // the band an octave above
+      while (end + 1 < bands && band_centre_[end] < 1.95 * band_centre_[knee]) ++end;
+      if (band_centre_[end] < 1.9 * band_centre_[knee]) return;  // no octave left: no floor
+      const double slope = std::log(band_level_[end] / band_level_[knee]) /
+                           std::log(band_centre_[end] / band_centre_[knee]);
+      if (slope > kFlatSlope && band_level_[knee] < kFloorBelowPeak * band_level_[0]) {
+        crossFloor(knee, end, top);
+        return;
+      }
+    }
+  }
+
+  // The crossing of the envelope (non-increasing) with twice the median level of the
+  // bands knee .. end (the floor), interpolated on log-log between the last band above it
+  // and the next; within lowest .. top [Hz].
+  void crossFloor(int knee, int end, double top) {
+    for (int j = knee; j <= end; ++j) floor_[j - knee] = band_raw_[j];
+    const int m = end - knee + 1;
+    std::nth_element(floor_, floor_ + m / 2, floor_ + m);
+    const double twice = 2.0 * floor_[m / 2];
+    // The envelope again up to the floor's octave only: noise that rises above it (a
+    // hump near the Nyquist rate) is not motion coming down to the floor.
+    for (int j = end, k = end; j >= 0; --j)
+      band_level_[j] = j == k ? band_raw_[j] : std::max(band_raw_[j], band_level_[j + 1]);
+    int below = 0;
+    while (below <= end && band_level_[below] > twice) ++below;
+    if (below == 0 || below > end) {
+      cutoff_ = below == 0 ? lowest_ : top;
+      return;
+    }
+    const int c = below - 1;
+    const double u =
+        std::log(band_level_[c] / twice) / std::log(band_level_[c] / band_level_[c + 1]);
+    const double f =
+        std::exp(std::log(band_centre_[c]) + u * std::log(band_centre_[c + 1] / band_centre_[c]));
+    cutoff_ = std::max(lowest_, std::min(top, f));
+    on_bound_ = cutoff_ <= 1.01 * lowest_ || cutoff_ >= 0.99 * top;
   }
 
   // GCV(w), w [cycles per grid sample]; the two-sided means from the one-sided spectrum
@@ -307,8 +404,13 @@ class SpectralCutoff {
     return residual / block_ / (dof * dof);
   }
 
+  static constexpr int kMaxBands = 160;  ///< bands of ratio 1.1 at most (1.1^160: 4e6)
   int channels_ = 0;
   double lowest_ = 0.5, highest_ = 50.0;
+  Rule rule_ = Rule::kGcv;
+  bool on_bound_ = false;
+  double band_level_[kMaxBands] = {}, band_raw_[kMaxBands] = {}, band_centre_[kMaxBands] = {};
+  double floor_[kMaxBands] = {};
   bool started_ = false, have_first_ = false;
   int first_count_ = 0;
   double first_time_ = 0.0;

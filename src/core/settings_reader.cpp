@@ -183,6 +183,7 @@ void readDifferentiator(Section& s, DifferentiatorConfig& c) {
   s.read("process_noise", c.process_noise);
   s.read("measurement_noise", c.measurement_noise);
   s.read("lag", c.lag);
+  s.read("auto_bandwidth", c.auto_bandwidth);
   s.read("max_gap", c.max_gap);
   s.read("min_bandwidth", c.min_bandwidth);
   s.read("max_bandwidth", c.max_bandwidth);

@@ -9,6 +9,8 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/QR>
+
 namespace jle {
 namespace {
 
@@ -216,6 +218,7 @@ struct CutoffSearch {
   // whether it found a floor; spectrum_w < 0: not yet.
   mutable double spectrum_w = -1.0;
   mutable bool spectrum_found = false;
+  mutable double spectrum_floor = 0.0;  // the noise floor's level (white noise's variance)
 
   // Whether time s is far enough from the ends to be scored: there the padding's
   // transient (odd reflection bends the curvature) would dominate at low cutoffs.
@@ -380,10 +383,58 @@ double minimiseOnLog(const Score& score_of_w, double w_lo, double w_hi) {
 // (the same difference of gains, averaged over the L DFT frequencies): the level of
 // white noise that would give the band's power.
 constexpr int kAnalysisOrder = 8;
+// [Hz] the lowest band analysed, or the lowest cutoff searched if lower (a thousandth of
+// the rate: above 1 kHz it lies above where arms and bodies move most, and the floor's
+// threshold, kFloorBelowPeak under the highest level, would be measured against a band
+// that holds little of the motion).
+constexpr double kLowestBand = 1.0;
+
+// The value, rate and acceleration at the end sample `at` of the n rows of x (grid
+// period h), fitted by a quadratic over the `span` samples ending (or starting) there:
+// 3 x channels.
+Eigen::MatrixXd endState(const Eigen::MatrixXd& x, Eigen::Index at, Eigen::Index span, double h) {
+  const Eigen::Index first = at == 0 ? 0 : at - span + 1;
+  Eigen::MatrixXd basis(span, 3);
+  for (Eigen::Index k = 0; k < span; ++k) {
+    const double u = static_cast<double>(first + k - at) * h;
+    basis.row(k) << 1.0, u, u * u;
+  }
+  Eigen::MatrixXd state = basis.colPivHouseholderQr().solve(x.middleRows(first, span));
+  state.row(2) *= 2.0;
+  return state;
+}
+
+// x less the quintic that matches its value, rate and acceleration at both ends (each
+// fitted by endState over kEndFitSeconds): what is left starts and ends at rest with no
+// curvature, so that the analysis filters' odd reflection does not bend it and their end
+// transients, which look like motion above the motion's band, stay below the noise.
+constexpr double kEndFitSeconds = 0.1;
+
+Eigen::MatrixXd restingEnds(const Eigen::MatrixXd& x, double h) {
+  const Eigen::Index n = x.rows();
+  const Eigen::Index span = std::min<Eigen::Index>(
+      n / 4, std::max<Eigen::Index>(5, static_cast<Eigen::Index>(std::lround(kEndFitSeconds / h))));
+  if (span < 5) return x;
+  const Eigen::MatrixXd a = endState(x, 0, span, h), b = endState(x, n - 1, span, h);
+  const double T = static_cast<double>(n - 1) * h;
+  Eigen::MatrixXd out(x.rows(), x.cols());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double s = static_cast<double>(k) / static_cast<double>(n - 1);
+    const double s2 = s * s, s3 = s2 * s, s4 = s3 * s, s5 = s4 * s;
+    const double h0 = 1 - 10 * s3 + 15 * s4 - 6 * s5, h5 = 10 * s3 - 15 * s4 + 6 * s5;
+    const double h1 = s - 6 * s3 + 8 * s4 - 3 * s5, h4 = -4 * s3 + 7 * s4 - 3 * s5;
+    const double h2 = 0.5 * (s2 - 3 * s3 + 3 * s4 - s5), h3 = 0.5 * (s3 - 2 * s4 + s5);
+    out.row(k) = x.row(k) - (h0 * a.row(0) + h1 * T * a.row(1) + h2 * T * T * a.row(2) +
+                             h3 * T * T * b.row(2) + h4 * T * b.row(1) + h5 * b.row(0));
+  }
+  return out;
+}
 
 std::vector<double> bandLevels(const CutoffSearch& search, std::vector<double>& w) {
   w.clear();
-  for (double c = search.w_lo; c < 0.4; c *= 1.1) w.push_back(c);
+  const double first =
+      std::min(search.w_lo, std::max(1.0 / search.grid.m, kLowestBand * search.grid.h));
+  for (double c = first; c < 0.4; c *= 1.1) w.push_back(c);
   if (w.size() < 2) return {};  // a record too short for a band below 0.4 of the rate
   const Eigen::Index n = search.xg.rows();
   const int pad = paddingOf(0, kAnalysisOrder, static_cast<int>(n));
@@ -397,10 +448,11 @@ std::vector<double> bandLevels(const CutoffSearch& search, std::vector<double>& 
     return Eigen::VectorXd((1.0 + (tan2 / (tc * tc)).array().pow(kAnalysisOrder)).inverse());
   };
   std::vector<double> level;
-  Eigen::MatrixXd before = smoothPadded(search.xg, w[0], kAnalysisOrder, pad);
+  const Eigen::MatrixXd xa = restingEnds(search.xg, search.grid.h);
+  Eigen::MatrixXd before = smoothPadded(xa, w[0], kAnalysisOrder, pad);
   Eigen::VectorXd gain_before = gains(w[0]);
   for (std::size_t j = 0; j + 1 < w.size(); ++j) {
-    const Eigen::MatrixXd after = smoothPadded(search.xg, w[j + 1], kAnalysisOrder, pad);
+    const Eigen::MatrixXd after = smoothPadded(xa, w[j + 1], kAnalysisOrder, pad);
     const Eigen::VectorXd gain_after = gains(w[j + 1]);
     double power = 0.0;
     long count = 0;
@@ -428,6 +480,7 @@ std::vector<double> bandLevels(const CutoffSearch& search, std::vector<double>& 
 // corner and falls above it has its floor below the corner, as white noise has.
 // `found`: false when there is no floor up to 0.4 of the rate; then w_hi.
 constexpr double kFlatSlope = -1.5;
+constexpr double kRounding = 1e-10;  // of the positions' largest magnitude
 constexpr double kFloorBelowPeak = 1e-3;
 
 double findSpectrumCutoff(const CutoffSearch& search, bool& found) {
@@ -451,19 +504,94 @@ double findSpectrumCutoff(const CutoffSearch& search, bool& found) {
   std::vector<double> floor(level.begin() + knee, level.begin() + knee + octave + 1);
   std::nth_element(floor.begin(), floor.begin() + octave / 2, floor.end());
   const double twice_floor = 2.0 * floor[octave / 2];
-  int c = knee;
-  while (c >= 0 && envelope[c] <= twice_floor) --c;
-  if (c < 0) return search.w_lo;
+  search.spectrum_floor = floor[octave / 2];
+  // A floor at the numbers' rounding is no noise: exact positions.
+  const double scale = kRounding * search.xg.cwiseAbs().maxCoeff();
+  if (!(search.spectrum_floor > scale * scale)) {
+    found = false;
+    return search.w_hi;
+  }
+  // The envelope again up to the floor's octave only (noise rising above it is not motion
+  // coming down to the floor); the last band above twice the floor, and the next.
+  const int end = knee + octave;
+  envelope[end] = level[end];
+  for (int j = end - 1; j >= 0; --j) envelope[j] = std::max(level[j], envelope[j + 1]);
+  int below = 0;
+  while (below <= end && envelope[below] > twice_floor) ++below;
+  if (below == 0) return search.w_lo;
+  if (below > end) return search.w_hi;
+  const int c = below - 1;
   // The crossing between the centres of bands c and c + 1, interpolated on log-log.
   const double u = std::log(envelope[c] / twice_floor) / std::log(envelope[c] / envelope[c + 1]);
   const double crossing = std::exp(std::log(centre(c)) + u * std::log(centre(c + 1) / centre(c)));
   return std::max(search.w_lo, std::min(search.w_hi, crossing));
 }
 
-// findSpectrumCutoff, once per search.
+// The record's ends at cutoff w [1/sample]: the mean square of the acceleration's end
+// transient (odd reflection bends the curvature) over the 2 S samples that follow the first
+// S after an end (S: the settle length, 0.5 s or a tenth of a shorter record, the
+// project's convention for loads near a record's end; scored beyond it), per channel.
+// Measured on the data: the record cut kEndCuts times near each end, the cut record's
+// acceleration against the whole one's there.
+constexpr int kEndCuts = 3;
+
+double endError(const CutoffSearch& search, double w) {
+  const Eigen::Index n = search.xg.rows();
+  const double h = search.grid.h;
+  const auto settle = static_cast<Eigen::Index>(std::ceil(std::min(0.5, n * h / 10.0) / h));
+  Eigen::MatrixXd rate, full, part_rate, part;
+  differentiate(smoothPadded(search.xg, w, search.order, search.pad), search.pad, h, rate, full);
+  double sum = 0.0;
+  long count = 0;
+  for (int j = 1; j <= kEndCuts; ++j) {
+    const Eigen::Index cut = j * settle, span = 2 * settle;
+    if (2 * cut + settle + span > n) break;
+    const Eigen::Index rows = n - cut;
+    const int pad = paddingOf(0, search.order, static_cast<int>(rows));
+    differentiate(smoothPadded(search.xg.bottomRows(rows), w, search.order, pad), pad, h, part_rate,
+                  part);
+    sum += (part.middleRows(settle, span) - full.middleRows(cut + settle, span)).squaredNorm();
+    differentiate(smoothPadded(search.xg.topRows(rows), w, search.order, pad), pad, h, part_rate,
+                  part);
+    sum +=
+        (part.middleRows(rows - settle - span, span) - full.middleRows(rows - settle - span, span))
+            .squaredNorm();
+    count += 2 * span * search.xg.cols();
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+// The noise spectrum's cutoff moved up where the record's end transients cost the loads
+// more than the noise a wider filter lets through: from the spectrum's w_s, the w (ratio
+// 1.1, at most w_hi) minimising the scored mean square error it adds, the noise floor's
+// (level L, white noise's variance per sample) acceleration error above w_s,
+//   2 L (2 pi)^4 c (w^5 - w_s^5) / h^4, c = int x^4 / (1 + x^(2 order))^2 dx over 0 .. inf
+// (the forward-backward filter's power gain), plus the end transients' (endError) over
+// the share 2 (2 S) / scored samples that they reach. Short records (no cut fits) keep w_s.
+double endAwareCutoff(const CutoffSearch& search, double w_s) {
+  const double n = static_cast<double>(search.xg.rows()), h = search.grid.h;
+  const double settle = std::ceil(std::min(0.5, n * h / 10.0) / h);
+  if (!(search.spectrum_floor > 0.0) || 2.0 * settle + 3.0 * settle > n) return w_s;
+  const double p = 2.0 * search.order;
+  const double c = (1.0 - 5.0 / p) * (M_PI / p) / std::sin(5.0 * M_PI / p);
+  const double noise = 2.0 * search.spectrum_floor * std::pow(2.0 * M_PI, 4) * c / std::pow(h, 4);
+  const double share = 2.0 * 2.0 * settle / (n - 2.0 * settle);
+  double best_w = w_s, best = share * endError(search, w_s);
+  for (double w = 1.1 * w_s; w <= search.w_hi; w *= 1.1) {
+    const double added = noise * (std::pow(w, 5) - std::pow(w_s, 5));
+    if (added >= best) break;  // the noise's share only grows
+    const double cost = added + share * endError(search, w);
+    if (cost < best) best = cost, best_w = w;
+  }
+  return best_w;
+}
+
+// findSpectrumCutoff, then moved for the record's ends, once per search.
 double spectrumCutoff(const CutoffSearch& search, bool& found) {
-  if (search.spectrum_w < 0.0)
+  if (search.spectrum_w < 0.0) {
     search.spectrum_w = findSpectrumCutoff(search, search.spectrum_found);
+    if (search.spectrum_found) search.spectrum_w = endAwareCutoff(search, search.spectrum_w);
+  }
   found = search.spectrum_found;
   return search.spectrum_w;
 }

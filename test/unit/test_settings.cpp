@@ -65,6 +65,7 @@ void expectSame(const jle::DifferentiatorConfig& a, const jle::DifferentiatorCon
   EXPECT_SAME(process_noise);
   EXPECT_SAME(measurement_noise);
   EXPECT_SAME(lag);
+  EXPECT_SAME(auto_bandwidth);
   EXPECT_SAME(max_gap);
   EXPECT_SAME(min_bandwidth);
   EXPECT_SAME(max_bandwidth);

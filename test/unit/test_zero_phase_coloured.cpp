@@ -39,22 +39,13 @@ struct Recording {
   std::vector<std::string> joint;  // the moving joints' names
 };
 
-Recording record(bool noisy) {
+// The Panda chain's `motion` (seed 31) read by `sensor` over `duration` [s] (seed 32).
+Recording record(jle::MotionKind motion, const jle::SensorModel& sensor, double duration) {
   const jle::Model<double> model = jle::modelFromUrdfString(jle_test::readFile(kPandaChain));
   Recording r;
   r.truth = std::make_unique<jle::GroundTruth>(
-      model, jle::randomMotion(model, jle::MotionKind::kStopAndGo, kDuration, 31),
-      std::vector<jle::WrenchMotion>{});
-  jle::SensorModel sensor;
-  sensor.rate = 1000.0;
-  if (noisy) {
-    sensor.coloured_noise = 2.75e-4;
-    sensor.coloured_corner = 50.0;
-    sensor.vibration_amplitude = 3e-5;
-    sensor.vibration_frequency = 80.0;
-    sensor.velocity_noise = 5e-3;
-  }
-  const std::vector<jle::JointReading> readings = r.truth->sample(sensor, kDuration, 32).joints;
+      model, jle::randomMotion(model, motion, duration, 31), std::vector<jle::WrenchMotion>{});
+  const std::vector<jle::JointReading> readings = r.truth->sample(sensor, duration, 32).joints;
   const auto n = static_cast<Eigen::Index>(readings.size());
   const std::vector<int>& moving = model.moving_segments;
   r.q.resize(n, model.nq);
@@ -74,9 +65,32 @@ Recording record(bool noisy) {
   return r;
 }
 
+Recording record(bool noisy) {
+  jle::SensorModel sensor;
+  sensor.rate = 1000.0;
+  if (noisy) {
+    sensor.coloured_noise = 2.75e-4;
+    sensor.coloured_corner = 50.0;
+    sensor.vibration_amplitude = 3e-5;
+    sensor.vibration_frequency = 80.0;
+    sensor.velocity_noise = 5e-3;
+  }
+  return record(jle::MotionKind::kStopAndGo, sensor, kDuration);
+}
+
 const Recording& coloured() {
   static const Recording r = record(true);
   return r;
+}
+
+// Quiet encoders (2^17 counts a turn and 5e-6 rad of noise, as the accuracy study's
+// Panda) at `rate` [Hz].
+jle::SensorModel encoders(double rate) {
+  jle::SensorModel sensor;
+  sensor.rate = rate;
+  sensor.counts_per_revolution = 131072.0;
+  sensor.position_noise = 5e-6;
+  return sensor;
 }
 
 // RMS over the moving joints and the samples kSettle or more from the ends of
@@ -119,15 +133,17 @@ struct Oracle {
   double cutoff = 0.0, error = std::numeric_limits<double>::infinity();
 };
 
+Oracle oracleOf(const Recording& r) {
+  Oracle o;
+  for (double f = 1.0; f < 40.0; f *= 1.1) {
+    const double e = effortError(r, effortsAt(r, f));
+    if (e < o.error) o.error = e, o.cutoff = f;
+  }
+  return o;
+}
+
 const Oracle& oracle() {
-  static const Oracle best = [] {
-    Oracle o;
-    for (double f = 1.0; f < 40.0; f *= 1.1) {
-      const double e = effortError(coloured(), effortsAt(coloured(), f));
-      if (e < o.error) o.error = e, o.cutoff = f;
-    }
-    return o;
-  }();
+  static const Oracle best = oracleOf(coloured());
   return best;
 }
 
@@ -196,6 +212,33 @@ TEST(ColouredNoise, ARecordTooShortForTheSpectrumChoosesTheBoundAndWarns) {
   ASSERT_FALSE(choice.warnings.empty());
   EXPECT_NE(choice.warnings.front().find("no noise floor"), std::string::npos)
       << choice.warnings.front();
+}
+
+// The noise spectrum's choice on quiet encoders, positions only, against the best fixed
+// cutoff (the oracle, scanned with the truth): within 1.3 times its effort error, the
+// bound of issue 37. Slow sines (0.1 .. 0.6 Hz) at 1 kHz: the motion meets the noise near
+// 3 Hz, but there the filter's end transient (odd reflection bends the curvature) still
+// reaches past the settle length, and the choice moves up for it (without: 3.2 Hz here,
+// more than 1.3 times the oracle's error). Stop-and-go at 4 kHz over 5 s, whose motion reaches
+// 11 Hz: the analysis bands' end transients are taken out at the source (the record at
+// rest at its ends), not by leaving out more of the record near its ends, which loses
+// the motion there (8 periods of each band left out: 6.7 Hz, 2.6 times).
+void expectNearTheOracle(const Recording& r) {
+  jle::ZeroPhaseConfig config;
+  config.rule = jle::CutoffRule::kSpectrum;
+  const double cutoff = jle::chooseCutoff(r.t, r.q, config);
+  const Oracle best = oracleOf(r);
+  const double error = effortError(r, effortsAt(r, cutoff));
+  EXPECT_LE(error, 1.3 * best.error)
+      << "chosen " << cutoff << " Hz, best " << best.cutoff << " Hz (" << best.error << " N m)";
+}
+
+TEST(QuietEncoders, SlowSinesChooseNearTheBestFixedCutoff) {
+  expectNearTheOracle(record(jle::MotionKind::kSines, encoders(1000.0), 10.0));
+}
+
+TEST(QuietEncoders, StopAndGoAt4kHzChoosesNearTheBestFixedCutoff) {
+  expectNearTheOracle(record(jle::MotionKind::kStopAndGo, encoders(4000.0), 5.0));
 }
 
 class JointLoadsColoured : public jle_test::ToolTest {
