@@ -104,6 +104,9 @@ class ExternalEffort {
                       const std::vector<double>* model_variance);
   void updateObserver(double t, const std::vector<double>& measured);
   void solveContact(std::size_t k);
+  bool calibrate(double t);
+  double robustSigma(int m);
+  void keepCalibrationSample();
   void detect(double t);
 
   Model<double> model_;
@@ -130,9 +133,14 @@ class ExternalEffort {
   Eigen::VectorXd tau_js_, var_js_;
   VectorX<double> zero_;  // qdd of the forward pass (the joint-space terms need none)
   // Detection.
-  std::vector<double> abs_threshold_, threshold_, sum_sq_;
+  std::vector<double> abs_threshold_, threshold_;
   std::vector<int> depth_;
-  long calib_count_ = 0;
+  // Calibration: every stride-th sample's tau_ext (row-major, sample x joint) up to
+  // kCalibrationSamples; when full, every other one is dropped and the stride doubles.
+  std::vector<double> calib_, calib_scratch_;
+  long calib_seen_ = 0, calib_stride_ = 1;
+  int calib_rows_ = 0;
+  double settle_ = 0.0;  // [s] left out after a start or reset
   double t_start_ = 0.0;
   bool have_start_ = false, calibrated_ = false;
   bool in_contact_ = false, started_ = false, ended_ = false;
