@@ -265,6 +265,10 @@ struct ExternalEffortConfig {
   /// filter's reaches 150 N m on the Panda's joint 2 within 50 ms at 1e-4 rad of position
   /// noise); the observer's own settling, 5 / (2 pi observer_cutoff), when longer.
   double settle_time = 0.2;
+  /// [s] >= 0: the contact's joint is the most distal one loaded (over its threshold,
+  /// until below release_fraction of it) at any sample of the last link_window (a joint
+  /// near its threshold does not flicker).
+  double link_window = 0.02;
   /// Per-joint thresholds [N m or N] (joint name, value) that replace `threshold`.
   std::vector<std::pair<std::string, double>> joint_thresholds;
   /// A contact ends when every joint is below this fraction (0, 1] of its threshold.

@@ -81,8 +81,12 @@ class ExternalEffort {
   /// Per published joint: the detection threshold in use [N m or N] (0: none yet).
   const std::vector<double>& thresholds() const { return threshold_; }
   /// Contact detection at the last sample: in contact; whether it started or ended at it;
-  /// the most distal published joint over its threshold when it started, and its child
-  /// link (the most distal link the contact can be on).
+  /// the contact's joint, the most distal published joint loaded (over its threshold,
+  /// until below release_fraction of it) within the last link_window, re-evaluated at
+  /// every sample where a joint is over its threshold (kept while the contact fades and at
+  /// its end), and that joint's child link. A contact on link k loads joints 1..k only, so the
+  /// contact is on that link or on a more distal one whose joints it does not load (a
+  /// force through their axes): the link is the most proximal one the contact can be on.
   bool inContact() const { return in_contact_; }
   bool contactStarted() const { return started_; }
   bool contactEnded() const { return ended_; }
@@ -134,7 +138,12 @@ class ExternalEffort {
   VectorX<double> zero_;  // qdd of the forward pass (the joint-space terms need none)
   // Detection.
   std::vector<double> abs_threshold_, threshold_;
+  // Per published joint: loaded (over its threshold, until below release_fraction of
+  // it), and when it last was [s].
+  std::vector<char> loaded_;
+  std::vector<double> last_loaded_;
   std::vector<int> depth_;
+  int contact_index_ = -1;  // the contact's published joint
   // Calibration: every stride-th sample's tau_ext (row-major, sample x joint) up to
   // kCalibrationSamples; when full, every other one is dropped and the stride doubles.
   std::vector<double> calib_, calib_scratch_;

@@ -13,6 +13,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // Calibration samples kept per joint: a median of 1024 has a relative scatter of ~4 %.
 constexpr int kCalibrationSamples = 1024;
 // sigma of zero-mean Gaussian noise / its median absolute value.
@@ -113,6 +114,8 @@ void ExternalEffort::setUpThresholds() {
   abs_threshold_.assign(n, config_.threshold);
   threshold_.assign(n, 0.0);
   depth_.assign(n, 0);
+  last_loaded_.assign(n, -kInfinity);
+  loaded_.assign(n, 0);
   calib_.assign(static_cast<std::size_t>(kCalibrationSamples) * n, 0.0);
   calib_scratch_.assign(kCalibrationSamples, 0.0);
   // The observer starts at zero and follows tau_ext through its lag: e^-5 of a start-up
@@ -149,6 +152,9 @@ void ExternalEffort::reset() {
     calib_rows_ = 0;
   }
   in_contact_ = started_ = ended_ = false;
+  std::fill(last_loaded_.begin(), last_loaded_.end(), -kInfinity);
+  std::fill(loaded_.begin(), loaded_.end(), 0);
+  contact_index_ = -1;
 }
 
 void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<double>& qd,
@@ -357,26 +363,40 @@ bool ExternalEffort::calibrate(double t) {
 
 void ExternalEffort::detect(double t) {
   started_ = ended_ = false;
+  if (!calibrate(t)) return;
   const std::vector<double>& ext = external();
   const std::size_t n = published_.size();
-  if (!calibrate(t)) return;
-  int over = -1;  // the most distal joint over its threshold
-  bool above_release = false;
+  bool over = false, above_release = false;
   for (std::size_t i = 0; i < n; ++i) {
     if (!(threshold_[i] > 0.0) || !std::isfinite(ext[i])) continue;
+    // A joint is loaded from when it goes over its threshold until it falls below
+    // release_fraction of it, as the contact is.
     const double m = std::abs(ext[i]);
-    if (m > threshold_[i] && (over < 0 || depth_[i] > depth_[static_cast<std::size_t>(over)]))
-      over = static_cast<int>(i);
-    if (m >= config_.release_fraction * threshold_[i]) above_release = true;
+    const bool above = m >= config_.release_fraction * threshold_[i];
+    loaded_[i] = m > threshold_[i] || (loaded_[i] && above);
+    over = over || m > threshold_[i];
+    above_release = above_release || above;
+    if (loaded_[i]) last_loaded_[i] = t;
   }
-  if (!in_contact_ && over >= 0) {
+  if (!in_contact_ && over) {
     in_contact_ = started_ = true;
-    contact_joint_ = model_.joint_name[published_[static_cast<std::size_t>(over)]];
-    contact_link_ = model_.link_name[published_[static_cast<std::size_t>(over)]];
   } else if (in_contact_ && !above_release) {
     in_contact_ = false;
     ended_ = true;
   }
+  // A contact on link k loads joints 1..k only: the contact's joint is the most distal one
+  // loaded within link_window, re-evaluated while some joint is over its threshold (not
+  // while the contact fades: its distal joints, nearer their thresholds, fade first).
+  if (!in_contact_ || !over) return;
+  int joint = -1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (t - last_loaded_[i] <= config_.link_window &&
+        (joint < 0 || depth_[i] > depth_[static_cast<std::size_t>(joint)]))
+      joint = static_cast<int>(i);
+  if (joint < 0 || (!started_ && joint == contact_index_)) return;
+  contact_index_ = joint;
+  contact_joint_ = model_.joint_name[published_[static_cast<std::size_t>(joint)]];
+  contact_link_ = model_.link_name[published_[static_cast<std::size_t>(joint)]];
 }
 
 }  // namespace jle

@@ -1,8 +1,8 @@
 // Issue 40's scene: a Panda moving at 1 kHz about its ready pose (every joint inside its
 // limits) with three step contacts (20 N at a fingertip 5 cm off the flange's axis,
-// 5 N m on link 4, 15 N on link 5), its measured efforts from KDL's recursive Newton-Euler with external forces
-// (ChainIdSolver_RNE, Debian's liborocos-kdl-dev): an implementation independent of this
-// package's dynamics. Shared by test_external_effort and the node test test_external.
+// 5 N m on link 4, 15 N on link 5), its measured efforts from KDL's recursive Newton-Euler with
+// external forces (ChainIdSolver_RNE, Debian's liborocos-kdl-dev): an implementation independent of
+// this package's dynamics. Shared by test_external_effort and the node test test_external.
 // Header-only, ROS-free; needs KDL and kdl_parser.
 #pragma once
 
@@ -34,7 +34,7 @@ struct StepContact {
 
 class PandaContacts {
  public:
-  static constexpr double kRate = 1000.0;  // [Hz]
+  static constexpr double kRate = 1000.0;   // [Hz]
   static constexpr double kDuration = 5.0;  // [s]
   std::vector<StepContact> contacts = {
       {"panda_hand_tcp", {0.0, 0.05, 0.0}, {18.0, 0.0, -8.7}, {0, 0, 0}, 2.0, 2.5, "panda_link7"},
