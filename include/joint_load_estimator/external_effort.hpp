@@ -33,6 +33,11 @@ namespace jle {
 /// The wrench estimated at one contact link (ExternalEffortConfig::contacts[k]).
 struct ContactEstimate {
   std::string link;
+  /// With contact detection: in contact, and this contact can be the detected one (on the
+  /// contact's link, or distal to it beyond joints it cannot load: a point force through
+  /// their axes); force, moment and covariance are zero when not. Without detection
+  /// (thresholds and noise_multiple 0): always.
+  bool active = false;
   /// Link frame, moment about the link origin (the contact force acts at the configured
   /// point) [N, N m]: the wrench applied TO the robot.
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
@@ -101,12 +106,14 @@ class ExternalEffort {
     Eigen::Matrix3d R_segment_link = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p_segment_link = Eigen::Vector3d::Zero();
     int rows = 6;
+    int moving = 0;  // the moving segment the link is on (fixed joints lumped)
   };
   void setUpContacts();
   void setUpThresholds();
   void updateResidual(const std::vector<double>& model_effort, const std::vector<double>& measured,
                       const std::vector<double>* model_variance);
   void updateObserver(double t, const std::vector<double>& measured);
+  bool explains(std::size_t k) const;
   void solveContact(std::size_t k);
   bool calibrate(double t);
   double robustSigma(int m);
@@ -152,6 +159,7 @@ class ExternalEffort {
   double settle_ = 0.0;  // [s] left out after a start or reset
   double t_start_ = 0.0;
   bool have_start_ = false, calibrated_ = false;
+  bool detection_ = false;  // thresholds configured
   bool in_contact_ = false, started_ = false, ended_ = false;
   std::string contact_joint_, contact_link_;
 };

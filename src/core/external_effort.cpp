@@ -20,6 +20,8 @@ constexpr int kCalibrationSamples = 1024;
 constexpr double kMadToSigma = 1.482602218505602;
 // Calibration samples farther than this many robust sigmas are outliers.
 constexpr double kInlierSigmas = 5.0;
+// [m] a point force this close to a joint's axis cannot load it (1 mm: 0.02 N m of 20 N).
+constexpr double kBlindLever = 1e-3;
 
 [[noreturn]] void fail(const std::string& key, const std::string& what) {
   throw SettingsError("parameter '" + key + "' " + what);
@@ -90,8 +92,8 @@ void ExternalEffort::setUpContacts() {
     setup.point_segment = fr.p_segment_frame + fr.R_segment_frame * c.point;
     setup.rows = c.force_only ? 3 : 6;
     int joints = 0;
-    int s = js_.index[fr.segment] >= 0 ? fr.segment : js_.moving_parent[fr.segment];
-    for (; s >= 0; s = js_.moving_parent[s], ++joints)
+    setup.moving = js_.index[fr.segment] >= 0 ? fr.segment : js_.moving_parent[fr.segment];
+    for (int s = setup.moving; s >= 0; s = js_.moving_parent[s], ++joints)
       if (!is_published[s])
         fail(contactKey(k, "link"), "'" + c.link + "' needs the external effort of joint '" +
                                         model_.joint_name[s] +
@@ -138,6 +140,9 @@ void ExternalEffort::setUpThresholds() {
     calibrated_ = true;
     threshold_ = abs_threshold_;
   }
+  detection_ =
+      config_.noise_multiple > 0.0 ||
+      std::any_of(abs_threshold_.begin(), abs_threshold_.end(), [](double v) { return v > 0.0; });
 }
 
 void ExternalEffort::reset() {
@@ -182,8 +187,8 @@ void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<do
   if (uncertainty_)
     for (std::size_t i = 0; i < published_.size(); ++i)
       stddev_[i] = row_[i] >= 0 ? std::sqrt(var_js_[row_[i]]) : 0.0;
-  for (std::size_t k = 0; k < contacts_.size(); ++k) solveContact(k);
   detect(t);
+  for (std::size_t k = 0; k < contacts_.size(); ++k) solveContact(k);
 }
 
 void ExternalEffort::updateResidual(const std::vector<double>& model_effort,
@@ -272,10 +277,27 @@ void dampedSolve(const Eigen::MatrixXd& J, const Eigen::VectorXd& tau,
 
 }  // namespace
 
+// With detection: whether contact k can be the detected one. A contact on link k loads
+// joints 1..k only; the contact's joint is the most distal one loaded. A contact proximal
+// to it cannot load it; one distal to it would load the joints between, unless it cannot
+// (a point force through their axes: J_'s point-velocity rows zero there). J_ is k's.
+bool ExternalEffort::explains(std::size_t k) const {
+  if (!detection_) return true;
+  if (!in_contact_ || contact_index_ < 0) return false;
+  const int detected = published_[static_cast<std::size_t>(contact_index_)];
+  const Contact& c = contact_setup_[k];
+  for (int s = c.moving; s >= 0; s = js_.moving_parent[s]) {
+    if (s == detected) return true;
+    if (c.rows == 6 || J_.col(js_.index[s]).head<3>().norm() > kBlindLever) return false;
+  }
+  return false;
+}
+
 void ExternalEffort::solveContact(std::size_t k) {
   const Contact& c = contact_setup_[k];
   ContactEstimate& e = contacts_[k];
   pointJacobian(model_, data_, js_, c.segment, c.point_segment, J_);
+  e.active = explains(k);
   Vector6d F;
   if (c.rows == 3)
     dampedSolve<3>(J_, tau_js_, config_, A_, F, e);
@@ -296,6 +318,10 @@ void ExternalEffort::solveContact(std::size_t k) {
     const Eigen::MatrixXd P = T.leftCols(c.rows) * A_.topRows(c.rows);
     e.covariance.noalias() = P * var_js_.asDiagonal() * P.transpose();
   }
+  if (e.active) return;
+  e.force.setZero();  // the Jacobian's figures stay: the diagnostics' conditioning
+  e.moment.setZero();
+  e.covariance.setZero();
 }
 
 void ExternalEffort::keepCalibrationSample() {

@@ -46,6 +46,9 @@ void ExternalOutputs::publish(const LoadsRecord& record) {
   contact_msg_.in_contact = record.in_contact;
   contact_msg_.joint = record.contact_joint;
   contact_msg_.link = record.contact_link;
+  contact_msg_.contacts.clear();
+  for (const ContactEstimate& c : record.contacts)
+    if (c.active && record.in_contact) contact_msg_.contacts.push_back(c.link);
   contact_pub_.publish(contact_msg_);
 }
 
