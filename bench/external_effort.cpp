@@ -14,7 +14,9 @@
 // the residual and the observer; KDL's estimator is fed the same filtered q, qd and the
 // same measured efforts at the same stamps. RMS of the force and moment error over the
 // contact after 0.3 s of settling, per scenario: exact, encoder noise, effort noise,
-// jittered stamps.
+// jittered stamps; at two poses inside the Panda's joint limits and at the historic one
+// beyond them, each row with the range of the tool Jacobian's condition number over the
+// window (sigma_max / sigma_min of its 6 x 7 [m/s; rad/s] rows, as the solve uses it).
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/external_effort.hpp>
 #include <joint_load_estimator/joint_space.hpp>
@@ -32,6 +34,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -188,8 +191,19 @@ struct Scenario {
   double amplitude = 0.3;  // [rad] of the motion (ContactScene)
 };
 
+// The poses the Panda moves about (ContactScene::center; 0.3 rad of motion keeps the
+// first two inside every joint limit), and the historic one beyond joints 4 and 6's.
+struct Pose {
+  const char* name;
+  std::vector<double> q;  // empty: ContactScene's historic pose
+};
+const Pose kPoses[] = {{"ready", {0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785}},
+                       {"reach", {0.5, 0.3, -0.4, -1.8, 0.6, 2.2, -0.5}},
+                       {"near-singular (before issue 40)", {}}};
+
 struct Errors {
   double force2 = 0.0, moment2 = 0.0;
+  double cond_min = 1e300, cond_max = 0.0;  // the tool Jacobian's sigma_max / sigma_min
   long n = 0;
   void add(const Eigen::Vector3d& f, const Eigen::Vector3d& m, const jle_testing::ContactScene& s) {
     force2 += (f - s.force_link).squaredNorm();
@@ -201,8 +215,8 @@ struct Errors {
 };
 
 // One run of the scenario through the Pipeline with `method`; KDL fed alongside.
-void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration, Errors& ours,
-                 Errors& kdl_errors) {
+void runScenario(const Scenario& sc, const Pose& pose, jle::ExternalMethod method, double duration,
+                 Errors& ours, Errors& kdl_errors) {
   const jle::Model<double> model = jle::modelFromUrdfFile(chainPath());
   jle::Settings settings;
   settings.external_effort = externalConfig(method);
@@ -219,6 +233,7 @@ void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration
   scene.link = kTool;
   scene.t_off = std::min(scene.t_off, duration);
   scene.amplitude = sc.amplitude;
+  scene.center = Eigen::Map<const Eigen::VectorXd>(pose.q.data(), static_cast<long>(pose.q.size()));
   jle::Data<double> data(model);
   std::mt19937 rng(5);
   std::normal_distribution<double> gauss(0.0, 1.0);
@@ -250,6 +265,8 @@ void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration
     const double tr = std::floor(static_cast<double>(r.stamp - t0) * 1e-6 + 1e-6) * 1e-3;
     if (!(tr >= scene.t_on + 0.3 && scene.active(tr))) continue;
     ours.add(r.contacts[0].force, r.contacts[0].moment, scene);
+    ours.cond_min = std::min(ours.cond_min, 1.0 / r.contacts[0].conditioning);
+    ours.cond_max = std::max(ours.cond_max, 1.0 / r.contacts[0].conditioning);
     kdl_errors.add(Eigen::Vector3d(kw.force.x(), kw.force.y(), kw.force.z()),
                    Eigen::Vector3d(kw.torque.x(), kw.torque.y(), kw.torque.z()), scene);
   }
@@ -263,16 +280,19 @@ int table(bool quick) {
                                 {"exact, slow motion (0.03 rad)", 0.0, 0.0, 0.0, 0.03}};
   const double duration = quick ? 1.5 : 2.2;
   std::printf(
-      "| scenario | residual F [N] | residual M [N m] | observer F [N] | observer M [N m] "
-      "| KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|\n");
-  for (const Scenario& sc : scenarios) {
-    Errors residual, observer, kdl, kdl_again;
-    runScenario(sc, jle::ExternalMethod::kResidual, duration, residual, kdl);
-    runScenario(sc, jle::ExternalMethod::kObserver, duration, observer, kdl_again);
-    std::printf("| %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", sc.name, residual.force(),
-                residual.moment(), observer.force(), observer.moment(), kdl.force(), kdl.moment());
-    if (!(residual.n > 0 && observer.n > 0)) return 1;
-  }
+      "| pose | scenario | cond | residual F [N] | residual M [N m] | observer F [N] "
+      "| observer M [N m] | KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|---|---|\n");
+  for (const Pose& pose : kPoses)
+    for (const Scenario& sc : scenarios) {
+      Errors residual, observer, kdl, kdl_again;
+      runScenario(sc, pose, jle::ExternalMethod::kResidual, duration, residual, kdl);
+      runScenario(sc, pose, jle::ExternalMethod::kObserver, duration, observer, kdl_again);
+      std::printf("| %s | %s | %.0f-%.0f | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", pose.name,
+                  sc.name, residual.cond_min, residual.cond_max, residual.force(),
+                  residual.moment(), observer.force(), observer.moment(), kdl.force(),
+                  kdl.moment());
+      if (!(residual.n > 0 && observer.n > 0)) return 1;
+    }
   return 0;
 }
 
