@@ -70,7 +70,8 @@ class ExternalEffort {
   void update(double t, const VectorX<double>& q, const VectorX<double>& qd,
               const BaseState<double>& base, const std::vector<double>& model_effort,
               const std::vector<double>& measured, const std::vector<double>* model_variance);
-  /// Forgets the observer's and the detector's history (a jump of time).
+  /// Forgets the observer's and the detector's history (a jump of time); with
+  /// noise_multiple, the calibration starts again (thresholds 0 until it ends).
   void reset();
 
   const ExternalEffortConfig& config() const { return config_; }

@@ -152,6 +152,7 @@ void ExternalEffort::reset() {
   have_start_ = false;
   if (config_.noise_multiple > 0.0) {
     calibrated_ = false;
+    std::fill(threshold_.begin(), threshold_.end(), 0.0);
     calib_seen_ = 0;
     calib_stride_ = 1;
     calib_rows_ = 0;

@@ -417,6 +417,47 @@ TEST(FreeMotion, ContactIsDetectedAtTheToolAndItsWrenchEstimated) {
 }
 
 // ---------------------------------------------------------------------------------------
+// The noise calibration.
+
+// At rest the residual is the effort noise itself (sigma 0.1 N m): 6 sigma = 0.6 N m. One
+// sample in 50 of the calibration window carries a 50 N m jolt (a filter's answer to a
+// lost message): an RMS would make the threshold 6 sqrt(0.01 + 50^2 / 50) = 42 N m; the
+// median-based sigma does not see them (the median of 1000 |N(0, sigma)| scatters by
+// ~4 %: 15 % is 3.5 of those). A reset starts the calibration again: no threshold until
+// settle_time + calibration_time later, then the same one.
+TEST(Calibration, RobustToJoltsAndRestartedByAReset) {
+  Scene s = makeScene("panda.urdf", 6);
+  s.qd.setZero();
+  s.qdd.setZero();
+  std::vector<double> model_effort, measured;
+  simulate(s, "panda_hand_tcp", Vector3d::Zero(), Vector3d::Zero(), Vector3d::Zero(), model_effort,
+           measured);
+  jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
+  c.noise_multiple = 6.0;
+  jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, false);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::vector<double> noisy;
+  auto run = [&](double from, double to) {
+    for (int k = static_cast<int>(from * 1e3); k < static_cast<int>(to * 1e3); ++k) {
+      noisy = measured;
+      for (double& e : noisy) e += noise(rng) + (k % 50 == 7 ? 50.0 : 0.0);
+      ext.update(k * 1e-3, s.q, s.qd, jle::BaseState<double>(), model_effort, noisy, nullptr);
+    }
+  };
+  run(0.0, c.settle_time + c.calibration_time - 0.01);
+  for (double v : ext.thresholds()) EXPECT_EQ(v, 0.0);
+  run(c.settle_time + c.calibration_time - 0.01, 1.5);
+  for (double v : ext.thresholds()) EXPECT_NEAR(v, 0.6, 0.15 * 0.6);
+  ext.reset();
+  for (double v : ext.thresholds()) EXPECT_EQ(v, 0.0);
+  run(2.0, 2.0 + c.settle_time + c.calibration_time - 0.01);
+  for (double v : ext.thresholds()) EXPECT_EQ(v, 0.0);
+  run(2.0 + c.settle_time + c.calibration_time - 0.01, 3.5);
+  for (double v : ext.thresholds()) EXPECT_NEAR(v, 0.6, 0.15 * 0.6);
+}
+
+// ---------------------------------------------------------------------------------------
 // Issue 40's scene (jle_testing::PandaContacts): the Panda at 1 kHz inside its joint
 // limits, three step contacts, effort noise 0.1 N m, position noise 1e-4 rad, the efforts
 // from KDL's RNE with external forces; the defaults but for the detection rule (6 sigma)
