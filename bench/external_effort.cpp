@@ -3,6 +3,7 @@
 //
 //   bench_external_effort [Google Benchmark flags]   time per sample (docs/external_effort.md)
 //   bench_external_effort --table [--quick]          the error table against a known contact
+//   bench_external_effort --friction                 unmodelled friction (issue 40's scene)
 //
 // Speed: per sample on the Panda chain (7 joints, a wrench at panda_hand_tcp): our
 // update (forward pass, M by the composite-rigid-body pass, C^T qd and g through the
@@ -14,7 +15,9 @@
 // the residual and the observer; KDL's estimator is fed the same filtered q, qd and the
 // same measured efforts at the same stamps. RMS of the force and moment error over the
 // contact after 0.3 s of settling, per scenario: exact, encoder noise, effort noise,
-// jittered stamps.
+// jittered stamps; at two poses inside the Panda's joint limits and at the historic one
+// beyond them, each row with the range of the tool Jacobian's condition number over the
+// window (sigma_max / sigma_min of its 6 x 7 [m/s; rad/s] rows, as the solve uses it).
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/external_effort.hpp>
 #include <joint_load_estimator/joint_space.hpp>
@@ -22,6 +25,7 @@
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <jle_testing/contact_scene.hpp>
+#include <jle_testing/panda_contacts.hpp>
 
 #include <benchmark/benchmark.h>
 #include <kdl/chain.hpp>
@@ -32,6 +36,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -188,8 +193,19 @@ struct Scenario {
   double amplitude = 0.3;  // [rad] of the motion (ContactScene)
 };
 
+// The poses the Panda moves about (ContactScene::center; 0.3 rad of motion keeps the
+// first two inside every joint limit), and the historic one beyond joints 4 and 6's.
+struct Pose {
+  const char* name;
+  std::vector<double> q;  // empty: ContactScene's historic pose
+};
+const Pose kPoses[] = {{"ready", {0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785}},
+                       {"reach", {0.5, 0.3, -0.4, -1.8, 0.6, 2.2, -0.5}},
+                       {"near-singular (before issue 40)", {}}};
+
 struct Errors {
   double force2 = 0.0, moment2 = 0.0;
+  double cond_min = 1e300, cond_max = 0.0;  // the tool Jacobian's sigma_max / sigma_min
   long n = 0;
   void add(const Eigen::Vector3d& f, const Eigen::Vector3d& m, const jle_testing::ContactScene& s) {
     force2 += (f - s.force_link).squaredNorm();
@@ -201,8 +217,8 @@ struct Errors {
 };
 
 // One run of the scenario through the Pipeline with `method`; KDL fed alongside.
-void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration, Errors& ours,
-                 Errors& kdl_errors) {
+void runScenario(const Scenario& sc, const Pose& pose, jle::ExternalMethod method, double duration,
+                 Errors& ours, Errors& kdl_errors) {
   const jle::Model<double> model = jle::modelFromUrdfFile(chainPath());
   jle::Settings settings;
   settings.external_effort = externalConfig(method);
@@ -219,6 +235,7 @@ void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration
   scene.link = kTool;
   scene.t_off = std::min(scene.t_off, duration);
   scene.amplitude = sc.amplitude;
+  scene.center = Eigen::Map<const Eigen::VectorXd>(pose.q.data(), static_cast<long>(pose.q.size()));
   jle::Data<double> data(model);
   std::mt19937 rng(5);
   std::normal_distribution<double> gauss(0.0, 1.0);
@@ -250,6 +267,8 @@ void runScenario(const Scenario& sc, jle::ExternalMethod method, double duration
     const double tr = std::floor(static_cast<double>(r.stamp - t0) * 1e-6 + 1e-6) * 1e-3;
     if (!(tr >= scene.t_on + 0.3 && scene.active(tr))) continue;
     ours.add(r.contacts[0].force, r.contacts[0].moment, scene);
+    ours.cond_min = std::min(ours.cond_min, 1.0 / r.contacts[0].conditioning);
+    ours.cond_max = std::max(ours.cond_max, 1.0 / r.contacts[0].conditioning);
     kdl_errors.add(Eigen::Vector3d(kw.force.x(), kw.force.y(), kw.force.z()),
                    Eigen::Vector3d(kw.torque.x(), kw.torque.y(), kw.torque.z()), scene);
   }
@@ -263,15 +282,149 @@ int table(bool quick) {
                                 {"exact, slow motion (0.03 rad)", 0.0, 0.0, 0.0, 0.03}};
   const double duration = quick ? 1.5 : 2.2;
   std::printf(
-      "| scenario | residual F [N] | residual M [N m] | observer F [N] | observer M [N m] "
-      "| KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|\n");
-  for (const Scenario& sc : scenarios) {
-    Errors residual, observer, kdl, kdl_again;
-    runScenario(sc, jle::ExternalMethod::kResidual, duration, residual, kdl);
-    runScenario(sc, jle::ExternalMethod::kObserver, duration, observer, kdl_again);
-    std::printf("| %s | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", sc.name, residual.force(),
-                residual.moment(), observer.force(), observer.moment(), kdl.force(), kdl.moment());
-    if (!(residual.n > 0 && observer.n > 0)) return 1;
+      "| pose | scenario | cond | residual F [N] | residual M [N m] | observer F [N] "
+      "| observer M [N m] | KDL F [N] | KDL M [N m] |\n|---|---|---|---|---|---|---|---|---|\n");
+  for (const Pose& pose : kPoses)
+    for (const Scenario& sc : scenarios) {
+      Errors residual, observer, kdl, kdl_again;
+      runScenario(sc, pose, jle::ExternalMethod::kResidual, duration, residual, kdl);
+      runScenario(sc, pose, jle::ExternalMethod::kObserver, duration, observer, kdl_again);
+      std::printf("| %s | %s | %.0f-%.0f | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", pose.name,
+                  sc.name, residual.cond_min, residual.cond_max, residual.force(),
+                  residual.moment(), observer.force(), observer.moment(), kdl.force(),
+                  kdl.moment());
+      if (!(residual.n > 0 && observer.n > 0)) return 1;
+    }
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Unmodelled friction: issue 40's scene (jle_testing::PandaContacts, KDL's RNE efforts,
+// effort noise 0.1 N m, position noise 1e-4 rad, the observer, noise_multiple 6, contacts
+// at the fingertip and on link 5) with joint friction added to the measured efforts:
+// damping 0.1 N m s/rad and Coulomb 0.5 N m on joints 1-4, 0.05 and 0.2 on joints 5-7,
+// tanh(qd / 0.01) (friction.hpp's model).
+
+struct FrictionRow {
+  const char* name;
+  bool friction;                   // in the measured efforts
+  bool modelled;                   // in the model, friction/enabled
+  double noise_multiple;           // external_effort/noise_multiple
+  std::vector<double> thresholds;  // joint_thresholds of joints 1..7 [N m] (empty: none)
+};
+
+struct FrictionFigures {
+  double free_rms[7] = {0, 0, 0, 0, 0, 0, 0};  // tau_ext in free motion [N m]
+  long free_n = 0, false_samples = 0;
+  double delay[3] = {NAN, NAN, NAN};  // [ms] per scene contact
+  double force2 = 0.0;                // fingertip force error where reported, 0.1 s into
+  long force_n = 0, contact_n = 0;    // its contact on; samples there
+};
+
+// The defaults but for the row's detection, friction and the two contacts.
+jle::Settings frictionSettings(const FrictionRow& row, const jle::Model<double>& model,
+                               const std::vector<int>& published,
+                               const jle_testing::PandaContacts& scene) {
+  jle::Settings settings;
+  settings.smoothed.enabled = false;
+  settings.friction.enabled = row.modelled;
+  jle::ExternalEffortConfig& x = settings.external_effort;
+  x.enabled = true;
+  x.noise_multiple = row.noise_multiple;
+  for (std::size_t i = 0; i < row.thresholds.size(); ++i)
+    x.joint_thresholds.emplace_back(model.joint_name[published[i]], row.thresholds[i]);
+  for (int k : {0, 2}) {
+    jle::ContactLinkConfig c;
+    c.link = scene.contacts[k].link;
+    c.point = scene.contacts[k].point;
+    c.force_only = true;
+    x.contacts.push_back(c);
+  }
+  return settings;
+}
+
+FrictionFigures runFriction(const FrictionRow& row) {
+  jle::Model<double> model = jle::modelFromUrdfFile(chainPath());
+  const jle_testing::PandaContacts scene(readFile(chainPath()));
+  const std::vector<int> published = jle::publishedSegments(model, {});
+  std::vector<double> damping(7), coulomb(7);
+  for (int i = 0; i < 7; ++i) {
+    damping[i] = i < 4 ? 0.1 : 0.05;
+    coulomb[i] = i < 4 ? 0.5 : 0.2;
+    model.damping[published[i]] = row.modelled ? damping[i] : 0.0;
+    model.friction[published[i]] = row.modelled ? coulomb[i] : 0.0;
+  }
+  jle::Pipeline pipeline(model, frictionSettings(row, model, published, scene), nullptr);
+  std::mt19937 rng(40);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  FrictionFigures f;
+  const jle::Stamp t0 = 1000000000000LL;
+  std::vector<double> position(7), none;
+  for (int k = 0; k < 5000; ++k) {
+    const double t = k * 1e-3;
+    Eigen::VectorXd q, qd, qdd;
+    scene.state(t, q, qd, qdd);
+    std::vector<double> effort = scene.efforts(t);
+    for (int i = 0; i < 7; ++i) {
+      position[i] = q[i] + 1e-4 * gauss(rng);
+      effort[i] += 0.1 * gauss(rng);
+      if (row.friction) effort[i] += damping[i] * qd[i] + coulomb[i] * std::tanh(qd[i] / 0.01);
+    }
+    const jle::Stamp stamp = t0 + static_cast<jle::Stamp>(k) * 1000000;
+    if (pipeline.onJointState(stamp, stamp, model.coordinate_names, position, none, effort) !=
+        jle::Outcome::kPublished)
+      continue;
+    const jle::LoadsRecord& r = pipeline.record();
+    const double tr = std::round(static_cast<double>(r.stamp - t0) * 1e-6) * 1e-3;
+    int near = -1;  // the scene contact whose window (+ 0.15 s release) holds tr
+    for (int c = 0; c < 3; ++c)
+      if (tr >= scene.contacts[c].t_on && tr < scene.contacts[c].t_off + 0.15) near = c;
+    if (near >= 0 && r.contact_started && std::isnan(f.delay[near]))
+      f.delay[near] = (tr - scene.contacts[near].t_on) * 1e3;
+    if (near < 0 && tr > 1.5) {
+      ++f.free_n;
+      f.false_samples += r.in_contact;
+      for (int i = 0; i < 7; ++i) f.free_rms[i] += r.external_effort[i] * r.external_effort[i];
+    }
+    if (scene.active(tr) == 0 && tr >= scene.contacts[0].t_on + 0.1) {
+      ++f.contact_n;
+      if (!r.contacts[0].active) continue;
+      f.force2 += (r.contacts[0].force - scene.contacts[0].force).squaredNorm();
+      ++f.force_n;
+    }
+  }
+  for (double& v : f.free_rms) v = std::sqrt(v / std::max(1L, f.free_n));
+  return f;
+}
+
+int frictionTable() {
+  // 6 x the friction-free RMS of tau_ext (the first row's calibration), and those raised by
+  // the friction's peak (Coulomb + damping at 0.5 rad/s: 0.55 N m on joints 1-4, 0.23 on
+  // joints 5-7) plus 0.5 and 0.2 N m.
+  const std::vector<double> free = {0.8, 2.4, 1.3, 1.6, 0.15, 0.22, 0.1};
+  const std::vector<double> raised = {1.85, 3.45, 2.35, 2.65, 0.58, 0.65, 0.53};
+  const FrictionRow rows[] = {
+      {"none; noise_multiple 6", false, false, 6.0, {}},
+      {"not modelled; noise_multiple 6", true, false, 6.0, {}},
+      {"modelled (friction/enabled); noise_multiple 6", true, true, 6.0, {}},
+      {"none; joint_thresholds: the friction-free ones", false, false, 0.0, free},
+      {"not modelled; joint_thresholds: the friction-free ones", true, false, 0.0, free},
+      {"not modelled; joint_thresholds raised over the friction", true, false, 0.0, raised},
+      {"none; no detection", false, false, 0.0, {}},
+      {"not modelled; no detection", true, false, 0.0, {}}};
+  std::printf(
+      "| friction; detection | RMS tau_ext free, joints 1..7 [N m] | false-contact samples | "
+      "delays fingertip / link 4 / link 5 [ms] | fingertip force error [N] (reported) "
+      "|\n|---|---|---|---|---|\n");
+  for (const FrictionRow& row : rows) {
+    const FrictionFigures f = runFriction(row);
+    std::printf("| %s |", row.name);
+    for (double v : f.free_rms) std::printf(" %.3g", v);
+    std::printf(" | %ld / %ld |", f.false_samples, f.free_n);
+    for (double d : f.delay) std::isnan(d) ? std::printf(" missed") : std::printf(" %.0f", d);
+    std::printf(" | %.3g (%.0f %%) |\n",
+                f.force_n ? std::sqrt(f.force2 / static_cast<double>(f.force_n)) : NAN,
+                100.0 * static_cast<double>(f.force_n) / std::max(1L, f.contact_n));
   }
   return 0;
 }
@@ -279,11 +432,13 @@ int table(bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool want_table = false, quick = false;
+  bool want_table = false, quick = false, friction = false;
   for (int i = 1; i < argc; ++i) {
     want_table = want_table || std::strcmp(argv[i], "--table") == 0;
     quick = quick || std::strcmp(argv[i], "--quick") == 0;
+    friction = friction || std::strcmp(argv[i], "--friction") == 0;
   }
+  if (friction) return frictionTable();
   if (want_table) return table(quick);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -47,7 +47,10 @@ jle_add_node_test(test_node_bad_config bad_config.test rostest/test_bad_config.c
 jle_add_node_test(test_node_hostile hostile.test rostest/test_hostile.cpp)
 # External efforts of the running node: ~contact, ~external_wrench/<link>, diagnostics.
 jle_add_node_test(test_node_external external.test rostest/test_external.cpp)
-target_link_libraries(test_node_external joint_load_estimator_testing)
+target_link_libraries(test_node_external joint_load_estimator_testing ${orocos_kdl_LIBRARIES}
+  ${kdl_parser_LIBRARIES})
+target_include_directories(test_node_external PRIVATE ${orocos_kdl_INCLUDE_DIRS}
+  ${kdl_parser_INCLUDE_DIRS})
 # One message path: the node under rosbag play and process_bag on the same bag agree.
 jle_add_node_test(test_node_agreement agreement.test rostest/test_agreement.cpp)
 target_compile_definitions(test_node_agreement PRIVATE JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>")

@@ -33,6 +33,11 @@ namespace jle {
 /// The wrench estimated at one contact link (ExternalEffortConfig::contacts[k]).
 struct ContactEstimate {
   std::string link;
+  /// With contact detection: in contact, and this contact can be the detected one (on the
+  /// contact's link, or distal to it beyond joints it cannot load: a point force through
+  /// their axes); force, moment and covariance are zero when not. Without detection
+  /// (thresholds and noise_multiple 0): always.
+  bool active = false;
   /// Link frame, moment about the link origin (the contact force acts at the configured
   /// point) [N, N m]: the wrench applied TO the robot.
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
@@ -65,7 +70,8 @@ class ExternalEffort {
   void update(double t, const VectorX<double>& q, const VectorX<double>& qd,
               const BaseState<double>& base, const std::vector<double>& model_effort,
               const std::vector<double>& measured, const std::vector<double>* model_variance);
-  /// Forgets the observer's and the detector's history (a jump of time).
+  /// Forgets the observer's and the detector's history (a jump of time); with
+  /// noise_multiple, the calibration starts again (thresholds 0 until it ends).
   void reset();
 
   const ExternalEffortConfig& config() const { return config_; }
@@ -81,8 +87,12 @@ class ExternalEffort {
   /// Per published joint: the detection threshold in use [N m or N] (0: none yet).
   const std::vector<double>& thresholds() const { return threshold_; }
   /// Contact detection at the last sample: in contact; whether it started or ended at it;
-  /// the most distal published joint over its threshold when it started, and its child
-  /// link (the most distal link the contact can be on).
+  /// the contact's joint, the most distal published joint loaded (over its threshold,
+  /// until below release_fraction of it) within the last link_window, re-evaluated at
+  /// every sample where a joint is over its threshold (kept while the contact fades and at
+  /// its end), and that joint's child link. A contact on link k loads joints 1..k only, so the
+  /// contact is on that link or on a more distal one whose joints it does not load (a
+  /// force through their axes): the link is the most proximal one the contact can be on.
   bool inContact() const { return in_contact_; }
   bool contactStarted() const { return started_; }
   bool contactEnded() const { return ended_; }
@@ -97,13 +107,18 @@ class ExternalEffort {
     Eigen::Matrix3d R_segment_link = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p_segment_link = Eigen::Vector3d::Zero();
     int rows = 6;
+    int moving = 0;  // the moving segment the link is on (fixed joints lumped)
   };
   void setUpContacts();
   void setUpThresholds();
   void updateResidual(const std::vector<double>& model_effort, const std::vector<double>& measured,
                       const std::vector<double>* model_variance);
   void updateObserver(double t, const std::vector<double>& measured);
+  bool explains(std::size_t k) const;
   void solveContact(std::size_t k);
+  bool calibrate(double t);
+  double robustSigma(int m);
+  void keepCalibrationSample();
   void detect(double t);
 
   Model<double> model_;
@@ -130,11 +145,22 @@ class ExternalEffort {
   Eigen::VectorXd tau_js_, var_js_;
   VectorX<double> zero_;  // qdd of the forward pass (the joint-space terms need none)
   // Detection.
-  std::vector<double> abs_threshold_, threshold_, sum_sq_;
+  std::vector<double> abs_threshold_, threshold_;
+  // Per published joint: loaded (over its threshold, until below release_fraction of
+  // it), and when it last was [s].
+  std::vector<char> loaded_;
+  std::vector<double> last_loaded_;
   std::vector<int> depth_;
-  long calib_count_ = 0;
+  int contact_index_ = -1;  // the contact's published joint
+  // Calibration: every stride-th sample's tau_ext (row-major, sample x joint) up to
+  // kCalibrationSamples; when full, every other one is dropped and the stride doubles.
+  std::vector<double> calib_, calib_scratch_;
+  long calib_seen_ = 0, calib_stride_ = 1;
+  int calib_rows_ = 0;
+  double settle_ = 0.0;  // [s] left out after a start or reset
   double t_start_ = 0.0;
   bool have_start_ = false, calibrated_ = false;
+  bool detection_ = false;  // thresholds configured
   bool in_contact_ = false, started_ = false, ended_ = false;
   std::string contact_joint_, contact_link_;
 };

@@ -170,8 +170,9 @@ struct LoadsRecord {
   std::vector<double> external_effort, external_effort_stddev;
   /// The wrench at each external_effort/contacts link (link frame, about its origin).
   std::vector<ContactEstimate> contacts;
-  /// Contact detection at this sample: in contact, it started / ended here, and the most
-  /// distal joint over its threshold when it started, with its child link.
+  /// Contact detection at this sample: in contact, it started / ended here, and the
+  /// contact's joint (the most distal over its threshold, ExternalEffort::contactJoint),
+  /// with its child link.
   bool in_contact = false, contact_started = false, contact_ended = false;
   std::string contact_joint, contact_link;
   /// The estimated q, q-dot, q-ddot of every coordinate (model coordinate order) [rad or

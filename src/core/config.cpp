@@ -124,6 +124,8 @@ void validate(const ExternalEffortConfig& c) {
   nonNegative("external_effort/threshold", c.threshold);
   nonNegative("external_effort/noise_multiple", c.noise_multiple);
   positive("external_effort/calibration_time", c.calibration_time);
+  nonNegative("external_effort/settle_time", c.settle_time);
+  nonNegative("external_effort/link_window", c.link_window);
   if (!(c.release_fraction > 0.0 && c.release_fraction <= 1.0))
     fail("external_effort/release_fraction",
          "must be in (0, 1], it is " + number(c.release_fraction));

@@ -13,6 +13,15 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// Calibration samples kept per joint: a median of 1024 has a relative scatter of ~4 %.
+constexpr int kCalibrationSamples = 1024;
+// sigma of zero-mean Gaussian noise / its median absolute value.
+constexpr double kMadToSigma = 1.482602218505602;
+// Calibration samples farther than this many robust sigmas are outliers.
+constexpr double kInlierSigmas = 5.0;
+// [m] a point force this close to a joint's axis cannot load it (1 mm: 0.02 N m of 20 N).
+constexpr double kBlindLever = 1e-3;
 
 [[noreturn]] void fail(const std::string& key, const std::string& what) {
   throw SettingsError("parameter '" + key + "' " + what);
@@ -83,8 +92,8 @@ void ExternalEffort::setUpContacts() {
     setup.point_segment = fr.p_segment_frame + fr.R_segment_frame * c.point;
     setup.rows = c.force_only ? 3 : 6;
     int joints = 0;
-    int s = js_.index[fr.segment] >= 0 ? fr.segment : js_.moving_parent[fr.segment];
-    for (; s >= 0; s = js_.moving_parent[s], ++joints)
+    setup.moving = js_.index[fr.segment] >= 0 ? fr.segment : js_.moving_parent[fr.segment];
+    for (int s = setup.moving; s >= 0; s = js_.moving_parent[s], ++joints)
       if (!is_published[s])
         fail(contactKey(k, "link"), "'" + c.link + "' needs the external effort of joint '" +
                                         model_.joint_name[s] +
@@ -106,8 +115,15 @@ void ExternalEffort::setUpThresholds() {
   const std::size_t n = published_.size();
   abs_threshold_.assign(n, config_.threshold);
   threshold_.assign(n, 0.0);
-  sum_sq_.assign(n, 0.0);
   depth_.assign(n, 0);
+  last_loaded_.assign(n, -kInfinity);
+  loaded_.assign(n, 0);
+  calib_.assign(static_cast<std::size_t>(kCalibrationSamples) * n, 0.0);
+  calib_scratch_.assign(kCalibrationSamples, 0.0);
+  // The observer starts at zero and follows tau_ext through its lag: e^-5 of a start-up
+  // error is left after 5 time constants.
+  settle_ = config_.method == ExternalMethod::kObserver ? std::max(config_.settle_time, 5.0 / gain_)
+                                                        : config_.settle_time;
   for (const auto& jt : config_.joint_thresholds) {
     bool found = false;
     for (std::size_t i = 0; i < n; ++i)
@@ -124,6 +140,9 @@ void ExternalEffort::setUpThresholds() {
     calibrated_ = true;
     threshold_ = abs_threshold_;
   }
+  detection_ =
+      config_.noise_multiple > 0.0 ||
+      std::any_of(abs_threshold_.begin(), abs_threshold_.end(), [](double v) { return v > 0.0; });
 }
 
 void ExternalEffort::reset() {
@@ -133,10 +152,15 @@ void ExternalEffort::reset() {
   have_start_ = false;
   if (config_.noise_multiple > 0.0) {
     calibrated_ = false;
-    calib_count_ = 0;
-    std::fill(sum_sq_.begin(), sum_sq_.end(), 0.0);
+    std::fill(threshold_.begin(), threshold_.end(), 0.0);
+    calib_seen_ = 0;
+    calib_stride_ = 1;
+    calib_rows_ = 0;
   }
   in_contact_ = started_ = ended_ = false;
+  std::fill(last_loaded_.begin(), last_loaded_.end(), -kInfinity);
+  std::fill(loaded_.begin(), loaded_.end(), 0);
+  contact_index_ = -1;
 }
 
 void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<double>& qd,
@@ -164,8 +188,8 @@ void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<do
   if (uncertainty_)
     for (std::size_t i = 0; i < published_.size(); ++i)
       stddev_[i] = row_[i] >= 0 ? std::sqrt(var_js_[row_[i]]) : 0.0;
-  for (std::size_t k = 0; k < contacts_.size(); ++k) solveContact(k);
   detect(t);
+  for (std::size_t k = 0; k < contacts_.size(); ++k) solveContact(k);
 }
 
 void ExternalEffort::updateResidual(const std::vector<double>& model_effort,
@@ -254,10 +278,27 @@ void dampedSolve(const Eigen::MatrixXd& J, const Eigen::VectorXd& tau,
 
 }  // namespace
 
+// With detection: whether contact k can be the detected one. A contact on link k loads
+// joints 1..k only; the contact's joint is the most distal one loaded. A contact proximal
+// to it cannot load it; one distal to it would load the joints between, unless it cannot
+// (a point force through their axes: J_'s point-velocity rows zero there). J_ is k's.
+bool ExternalEffort::explains(std::size_t k) const {
+  if (!detection_) return true;
+  if (!in_contact_ || contact_index_ < 0) return false;
+  const int detected = published_[static_cast<std::size_t>(contact_index_)];
+  const Contact& c = contact_setup_[k];
+  for (int s = c.moving; s >= 0; s = js_.moving_parent[s]) {
+    if (s == detected) return true;
+    if (c.rows == 6 || J_.col(js_.index[s]).head<3>().norm() > kBlindLever) return false;
+  }
+  return false;
+}
+
 void ExternalEffort::solveContact(std::size_t k) {
   const Contact& c = contact_setup_[k];
   ContactEstimate& e = contacts_[k];
   pointJacobian(model_, data_, js_, c.segment, c.point_segment, J_);
+  e.active = explains(k);
   Vector6d F;
   if (c.rows == 3)
     dampedSolve<3>(J_, tau_js_, config_, A_, F, e);
@@ -278,44 +319,111 @@ void ExternalEffort::solveContact(std::size_t k) {
     const Eigen::MatrixXd P = T.leftCols(c.rows) * A_.topRows(c.rows);
     e.covariance.noalias() = P * var_js_.asDiagonal() * P.transpose();
   }
+  if (e.active) return;
+  e.force.setZero();  // the Jacobian's figures stay: the diagnostics' conditioning
+  e.moment.setZero();
+  e.covariance.setZero();
+}
+
+void ExternalEffort::keepCalibrationSample() {
+  const std::size_t n = published_.size();
+  if (calib_seen_++ % calib_stride_ != 0) return;
+  if (calib_rows_ == kCalibrationSamples) {  // full: keep every other sample
+    for (int r = 0; r < kCalibrationSamples / 2; ++r)
+      std::copy_n(calib_.begin() + static_cast<long>(2 * r * n), n,
+                  calib_.begin() + static_cast<long>(r * n));
+    calib_rows_ = kCalibrationSamples / 2;
+    calib_stride_ *= 2;
+    if ((calib_seen_ - 1) % calib_stride_ != 0) return;
+  }
+  const std::vector<double>& ext = external();
+  std::copy(ext.begin(), ext.end(), calib_.begin() + static_cast<long>(calib_rows_ * n));
+  ++calib_rows_;
+}
+
+// sigma of the first m values of calib_scratch_ (each |tau_ext|): the median gives a
+// robust sigma, 1.4826 median; the RMS of the values within kInlierSigmas of it is the
+// sigma returned when larger: a Gaussian's own (nothing of it lies beyond), and the
+// heavier tails of the model error the free motion carries (the observer's on the Panda:
+// peaks 4.5 times its RMS) kept, while a transient's or a jolt's samples are dropped.
+double ExternalEffort::robustSigma(int m) {
+  if (m == 0) return 0.0;
+  const auto mid = calib_scratch_.begin() + m / 2;
+  std::nth_element(calib_scratch_.begin(), mid, calib_scratch_.begin() + m);
+  const double robust = kMadToSigma * *mid;
+  double sum = 0.0;
+  int inliers = 0;
+  for (int r = 0; r < m; ++r)
+    if (calib_scratch_[r] <= kInlierSigmas * robust) {
+      sum += calib_scratch_[r] * calib_scratch_[r];
+      ++inliers;
+    }
+  return std::max(robust, std::sqrt(sum / std::max(1, inliers)));
+}
+
+// The noise calibration after a start or a reset: the first settle_ s are the filters'
+// transient and left out; the next calibration_time s give each joint's sigma
+// (robustSigma: a few outliers, such as a filter's jolt after a lost message, move a
+// median little and an RMS much). True once
+// the thresholds are set. Allocates nothing.
+bool ExternalEffort::calibrate(double t) {
+  if (calibrated_) return true;
+  if (!have_start_) {
+    have_start_ = true;
+    t_start_ = t;
+  }
+  if (t - t_start_ < settle_) return false;
+  keepCalibrationSample();
+  if (t - t_start_ < settle_ + config_.calibration_time) return false;
+  const std::size_t n = published_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    int m = 0;
+    for (int r = 0; r < calib_rows_; ++r) {
+      const double v = calib_[static_cast<std::size_t>(r) * n + i];
+      if (std::isfinite(v)) calib_scratch_[m++] = std::abs(v);
+    }
+    threshold_[i] = std::max(abs_threshold_[i], config_.noise_multiple * robustSigma(m));
+  }
+  calibrated_ = true;
+  return false;
 }
 
 void ExternalEffort::detect(double t) {
   started_ = ended_ = false;
+  if (!calibrate(t)) return;
   const std::vector<double>& ext = external();
   const std::size_t n = published_.size();
-  if (!calibrated_) {
-    if (!have_start_) {
-      have_start_ = true;
-      t_start_ = t;
-    }
-    ++calib_count_;
-    for (std::size_t i = 0; i < n; ++i)
-      if (std::isfinite(ext[i])) sum_sq_[i] += ext[i] * ext[i];
-    if (t - t_start_ < config_.calibration_time) return;
-    for (std::size_t i = 0; i < n; ++i)
-      threshold_[i] = std::max(abs_threshold_[i],
-                               config_.noise_multiple * std::sqrt(sum_sq_[i] / calib_count_));
-    calibrated_ = true;
-    return;
-  }
-  int over = -1;  // the most distal joint over its threshold
-  bool above_release = false;
+  bool over = false, above_release = false;
   for (std::size_t i = 0; i < n; ++i) {
     if (!(threshold_[i] > 0.0) || !std::isfinite(ext[i])) continue;
+    // A joint is loaded from when it goes over its threshold until it falls below
+    // release_fraction of it, as the contact is.
     const double m = std::abs(ext[i]);
-    if (m > threshold_[i] && (over < 0 || depth_[i] > depth_[static_cast<std::size_t>(over)]))
-      over = static_cast<int>(i);
-    if (m >= config_.release_fraction * threshold_[i]) above_release = true;
+    const bool above = m >= config_.release_fraction * threshold_[i];
+    loaded_[i] = m > threshold_[i] || (loaded_[i] && above);
+    over = over || m > threshold_[i];
+    above_release = above_release || above;
+    if (loaded_[i]) last_loaded_[i] = t;
   }
-  if (!in_contact_ && over >= 0) {
+  if (!in_contact_ && over) {
     in_contact_ = started_ = true;
-    contact_joint_ = model_.joint_name[published_[static_cast<std::size_t>(over)]];
-    contact_link_ = model_.link_name[published_[static_cast<std::size_t>(over)]];
   } else if (in_contact_ && !above_release) {
     in_contact_ = false;
     ended_ = true;
   }
+  // A contact on link k loads joints 1..k only: the contact's joint is the most distal one
+  // loaded within link_window, re-evaluated while some joint is over its threshold (not
+  // while the contact fades: its distal joints, nearer their thresholds, fade first).
+  if (!in_contact_ || !over) return;
+  int joint = -1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (t - last_loaded_[i] <= config_.link_window &&
+        (joint < 0 || depth_[i] > depth_[static_cast<std::size_t>(joint)]))
+      joint = static_cast<int>(i);
+  if (joint < 0 || (!started_ && joint == contact_index_)) return;
+  contact_index_ = joint;
+  contact_joint_ = model_.joint_name[published_[static_cast<std::size_t>(joint)]];
+  contact_link_ = model_.link_name[published_[static_cast<std::size_t>(joint)]];
 }
 
 }  // namespace jle

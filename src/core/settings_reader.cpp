@@ -248,6 +248,8 @@ void readExternalEffort(Section& s, ExternalEffortConfig& e) {
                   {"threshold", &e.threshold},
                   {"noise_multiple", &e.noise_multiple},
                   {"calibration_time", &e.calibration_time},
+                  {"settle_time", &e.settle_time},
+                  {"link_window", &e.link_window},
                   {"release_fraction", &e.release_fraction}});
   s.readList("contacts", [&](Section& m) { readContact(m, e.contacts.emplace_back()); });
   s.readList("joint_thresholds", [&](Section& m) {

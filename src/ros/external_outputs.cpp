@@ -35,16 +35,20 @@ void ExternalOutputs::publish(const LoadsRecord& record) {
     wrench_pubs_[k].publish(wrench_msg_);
   }
   in_contact_ = record.in_contact;
-  if (!record.contact_started && !record.contact_ended) return;
-  if (record.contact_started) {
-    ++contacts_;
-    joint_ = record.contact_joint;
-    link_ = record.contact_link;
-  }
+  // The contact's joint is re-evaluated at every sample: an event when it changes.
+  const bool changed =
+      record.in_contact && !record.contact_started && record.contact_joint != joint_;
+  if (!record.contact_started && !record.contact_ended && !changed) return;
+  if (record.contact_started) ++contacts_;
+  joint_ = record.contact_joint;
+  link_ = record.contact_link;
   contact_msg_.header.stamp = toRosTime(record.stamp);
-  contact_msg_.in_contact = record.contact_started;
+  contact_msg_.in_contact = record.in_contact;
   contact_msg_.joint = record.contact_joint;
   contact_msg_.link = record.contact_link;
+  contact_msg_.contacts.clear();
+  for (const ContactEstimate& c : record.contacts)
+    if (c.active && record.in_contact) contact_msg_.contacts.push_back(c.link);
   contact_pub_.publish(contact_msg_);
 }
 

@@ -16,6 +16,7 @@
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <jle_testing/contact_scene.hpp>
+#include <jle_testing/panda_contacts.hpp>
 
 #include <gtest/gtest.h>
 #include <kdl/chain.hpp>
@@ -305,7 +306,7 @@ TEST(Observer, MovingFollowsTheLaggedResidual) {
 struct PipelineRun {
   std::vector<double> rms;  // per joint, of tau_ext over the free samples after calibration
   long free_samples = 0, false_contact_samples = 0, contacts_started = 0;
-  std::string first_joint, first_link;
+  std::string joints;        // the contact's joints reported 20 ms or more into the contact
   double force_error = 0.0;  // RMS |F - F_true| over the contact window after 0.3 s [N]
 };
 
@@ -317,14 +318,20 @@ PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double 
   x.enabled = true;
   x.method = method;
   x.noise_multiple = 6.0;
-  x.calibration_time = 0.5;
+  // One period of the slowest joint (0.4 Hz): the model error the observer carries follows
+  // the motion, and a window over part of it may miss its peaks.
+  x.calibration_time = 2.5;
   jle::ContactLinkConfig c;
   c.link = "panda_hand_tcp";
   x.contacts.push_back(c);
   jle::Pipeline pipeline(model, settings, nullptr);
   jle_testing::ContactScene scene;
   scene.link = "panda_hand_tcp";
-  if (!contact) scene.t_on = scene.t_off = 100.0;
+  scene.t_on = contact ? 3.0 : 100.0;  // after the calibration (0.2 s settle + 2.5 s)
+  scene.t_off = contact ? 4.0 : 100.0;
+  // The Panda's ready pose: every joint inside its limits (condition number 8-9 at the tool).
+  scene.center.resize(7);
+  scene.center << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
   const std::vector<int>& published = pipeline.record().segment;
   jle::Data<double> data(model);
   std::mt19937 rng(11);
@@ -335,7 +342,7 @@ PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double 
   double err2 = 0.0;
   long err_n = 0;
   const long kMs = 1000000;
-  for (int k = 0; k < 3000; ++k) {
+  for (int k = 0; k < 5000; ++k) {
     const double t = k * 1e-3;
     VectorX<double> q, qd, qdd;
     scene.state(model, t, q, qd, qdd);
@@ -349,14 +356,11 @@ PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double 
       continue;
     const jle::LoadsRecord& r = pipeline.record();
     const double tr = static_cast<double>(r.stamp - 1000 * kMs) * 1e-9;
-    if (r.contact_started) {
-      ++run.contacts_started;
-      if (run.first_joint.empty()) {
-        run.first_joint = r.contact_joint;
-        run.first_link = r.contact_link;
-      }
-    }
-    if (!scene.active(tr) && tr > 0.6 && (tr < scene.t_on || tr > scene.t_off + 0.5)) {
+    if (r.contact_started) ++run.contacts_started;
+    if (r.in_contact && scene.active(tr) && tr >= scene.t_on + 0.02 &&
+        run.joints.find(r.contact_joint) == std::string::npos)
+      run.joints += r.contact_joint + " ";
+    if (!scene.active(tr) && tr > 2.8 && (tr < scene.t_on || tr > scene.t_off + 0.5)) {
       ++run.free_samples;
       if (r.in_contact) ++run.false_contact_samples;
       for (std::size_t i = 0; i < published.size(); ++i)
@@ -374,10 +378,10 @@ PipelineRun runPipeline(jle::ExternalMethod method, double effort_noise, double 
 
 // Free motion, effort noise 0.05 N m, encoder noise 1e-5 rad: the RMS of tau_ext per joint
 // and the fraction of samples flagged in contact with thresholds of 6 sigma of the
-// calibration window. The residual carries the filtered q-ddot's error besides the effort
-// noise; the observer low-passes both. No sample may be flagged: a Gaussian exceeds 6
-// sigma with probability 2e-9 per joint and sample, and the window's RMS includes the
-// motion's model error.
+// calibration window (0.2 to 2.7 s: a period of the motion). The residual carries the
+// filtered q-ddot's error besides the effort noise; the observer low-passes both. No
+// sample may be flagged: a Gaussian exceeds 6 sigma with probability 2e-9 per joint and
+// sample, and the window holds the motion's model error at its peaks.
 TEST(FreeMotion, NoiseAndFalseContacts) {
   for (jle::ExternalMethod method :
        {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
@@ -387,29 +391,198 @@ TEST(FreeMotion, NoiseAndFalseContacts) {
                 run.free_samples, run.false_contact_samples);
     for (double v : run.rms) std::printf(" %.3g", v);
     std::printf("\n");
-    EXPECT_GT(run.free_samples, 2000);
+    EXPECT_GT(run.free_samples, 2000);  // 2.8 to 5 s
     EXPECT_EQ(run.false_contact_samples, 0) << name;
     EXPECT_EQ(run.contacts_started, 0) << name;
     for (double v : run.rms) EXPECT_LT(v, 1.0) << name;
   }
 }
 
-// A wrench at the tool from 1 s to 2 s (|F| 11.9 N, |M| 0.37 N m): detected once, on the
-// last joint, its force estimated to within half its size under this noise (measured
-// RMS error 3.7 N residual, 2.2 N observer: the force comes from efforts of 0.05 N m
-// noise through lever arms of ~0.1 m; a wrong sign or frame errs by ~24 N).
+// A wrench at the tool from 3 s to 4 s (|F| 11.9 N, |M| 0.37 N m): detected once, on the
+// last joint from 20 ms into it on, its force estimated to within a tenth of its size
+// under this noise (measured RMS error 0.35 N residual, 0.33 N observer at the ready pose;
+// 5.6 N and 4.5 N at ContactScene's historic pose near the elbow's singularity; a wrong
+// sign or frame errs by ~24 N).
 TEST(FreeMotion, ContactIsDetectedAtTheToolAndItsWrenchEstimated) {
   for (jle::ExternalMethod method :
        {jle::ExternalMethod::kResidual, jle::ExternalMethod::kObserver}) {
     const PipelineRun run = runPipeline(method, 0.05, 1e-5, true);
     const char* name = method == jle::ExternalMethod::kResidual ? "residual" : "observer";
-    std::printf("%s: contacts started %ld at %s (%s), RMS force error %.3g N\n", name,
-                run.contacts_started, run.first_joint.c_str(), run.first_link.c_str(),
-                run.force_error);
+    std::printf("%s: contacts started %ld at %s, RMS force error %.3g N\n", name,
+                run.contacts_started, run.joints.c_str(), run.force_error);
     EXPECT_EQ(run.contacts_started, 1) << name;
-    EXPECT_EQ(run.first_joint, "panda_joint7") << name;
-    EXPECT_LT(run.force_error, 0.5 * jle_testing::ContactScene().force_link.norm()) << name;
+    EXPECT_EQ(run.joints, "panda_joint7 ") << name;
+    EXPECT_LT(run.force_error, 0.1 * jle_testing::ContactScene().force_link.norm()) << name;
   }
+}
+
+// ---------------------------------------------------------------------------------------
+// The noise calibration.
+
+// At rest the residual is the effort noise itself (sigma 0.1 N m): 6 sigma = 0.6 N m. One
+// sample in 50 of the calibration window carries a 50 N m jolt (a filter's answer to a
+// lost message): an RMS would make the threshold 6 sqrt(0.01 + 50^2 / 50) = 42 N m; the
+// median-based sigma does not see them (the median of 1000 |N(0, sigma)| scatters by
+// ~4 %: 15 % is 3.5 of those). A reset starts the calibration again: no threshold until
+// settle_time + calibration_time later, then the same one.
+TEST(Calibration, RobustToJoltsAndRestartedByAReset) {
+  Scene s = makeScene("panda.urdf", 6);
+  s.qd.setZero();
+  s.qdd.setZero();
+  std::vector<double> model_effort, measured;
+  simulate(s, "panda_hand_tcp", Vector3d::Zero(), Vector3d::Zero(), Vector3d::Zero(), model_effort,
+           measured);
+  jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
+  c.noise_multiple = 6.0;
+  jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, false);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::vector<double> noisy;
+  auto run = [&](double from, double to) {
+    for (int k = static_cast<int>(from * 1e3); k < static_cast<int>(to * 1e3); ++k) {
+      noisy = measured;
+      for (double& e : noisy) e += noise(rng) + (k % 50 == 7 ? 50.0 : 0.0);
+      ext.update(k * 1e-3, s.q, s.qd, jle::BaseState<double>(), model_effort, noisy, nullptr);
+    }
+  };
+  run(0.0, c.settle_time + c.calibration_time - 0.01);
+  for (double v : ext.thresholds()) EXPECT_EQ(v, 0.0);
+  run(c.settle_time + c.calibration_time - 0.01, 1.5);
+  for (double v : ext.thresholds()) EXPECT_NEAR(v, 0.6, 0.15 * 0.6);
+  ext.reset();
+  for (double v : ext.thresholds()) EXPECT_EQ(v, 0.0);
+  run(2.0, 2.0 + c.settle_time + c.calibration_time - 0.01);
+  for (double v : ext.thresholds()) EXPECT_EQ(v, 0.0);
+  run(2.0 + c.settle_time + c.calibration_time - 0.01, 3.5);
+  for (double v : ext.thresholds()) EXPECT_NEAR(v, 0.6, 0.15 * 0.6);
+}
+
+// ---------------------------------------------------------------------------------------
+// Issue 40's scene (jle_testing::PandaContacts): the Panda at 1 kHz inside its joint
+// limits, three step contacts, effort noise 0.1 N m, position noise 1e-4 rad, the efforts
+// from KDL's RNE with external forces; the defaults but for the detection rule (6 sigma)
+// and two contact links (the fingertip's force and link 5's, both point forces).
+
+struct ScenarioRun {
+  std::vector<double> delay;       // per scene contact: start - t_on [s] (NaN: missed)
+  std::vector<long> wrong_link;    // per scene contact: samples with another contact link
+  std::vector<std::string> links;  // per scene contact: the links reported in it
+  long false_samples = 0;          // in contact outside [t_on, t_off + 0.15 s)
+  long phantom = 0;                // samples with a wrench at a contact not acting
+  long missing = 0;                // samples without the acting contact's wrench (settled)
+  long flag_mismatch = 0;          // samples where ContactEstimate::active is not "reported"
+};
+
+// `drops`: samples [first, last) not delivered (a loaded node at start-up).
+ScenarioRun runScenario(jle::ExternalMethod method,
+                        const std::vector<std::pair<int, int>>& drops = {}) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(urdfPath("chains/panda_chain.urdf"));
+  const jle_testing::PandaContacts scene(readFile(urdfPath("chains/panda_chain.urdf")));
+  jle::Settings settings;
+  jle::ExternalEffortConfig& x = settings.external_effort;
+  x.enabled = true;
+  x.method = method;
+  x.noise_multiple = 6.0;
+  // Contact 0: the fingertip (scene contact 0), contact 1: link 5 (scene contact 2).
+  for (int k : {0, 2}) {
+    jle::ContactLinkConfig c;
+    c.link = scene.contacts[k].link;
+    c.point = scene.contacts[k].point;
+    c.force_only = true;
+    x.contacts.push_back(c);
+  }
+  const int configured_for[3] = {0, -1, 1};  // scene contact -> configured contact
+  jle::Pipeline pipeline(model, settings, nullptr);
+  std::mt19937 rng(40);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  ScenarioRun run;
+  run.delay.assign(scene.contacts.size(), std::nan(""));
+  run.wrong_link.assign(scene.contacts.size(), 0);
+  run.links.assign(scene.contacts.size(), "");
+  const jle::Stamp t0 = 1000000000000LL;
+  std::vector<double> position(7), none;
+  const int n = static_cast<int>(jle_testing::PandaContacts::kDuration * 1000.0);
+  for (int k = 0; k < n; ++k) {
+    const double t = k * 1e-3;
+    Eigen::VectorXd q, qd, qdd;
+    scene.state(t, q, qd, qdd);
+    std::vector<double> effort = scene.efforts(t);
+    for (int i = 0; i < 7; ++i) position[i] = q[i] + 1e-4 * gauss(rng);
+    for (double& e : effort) e += 0.1 * gauss(rng);
+    bool dropped = false;
+    for (const auto& d : drops) dropped = dropped || (k >= d.first && k < d.second);
+    const jle::Stamp stamp = t0 + static_cast<jle::Stamp>(k) * 1000000;
+    if (dropped || pipeline.onJointState(stamp, stamp, model.coordinate_names, position, none,
+                                         effort) != jle::Outcome::kPublished)
+      continue;
+    const jle::LoadsRecord& r = pipeline.record();
+    const double tr = std::round(static_cast<double>(r.stamp - t0) * 1e-6) * 1e-3;
+    int acting = -1;  // the scene contact whose window (+ release) holds tr
+    for (std::size_t c = 0; c < scene.contacts.size(); ++c)
+      if (tr >= scene.contacts[c].t_on && tr < scene.contacts[c].t_off + 0.15)
+        acting = static_cast<int>(c);
+    if (r.contact_started && acting >= 0 && std::isnan(run.delay[acting]))
+      run.delay[acting] = tr - scene.contacts[acting].t_on;
+    if (r.in_contact && acting < 0) ++run.false_samples;
+    const int now = scene.active(tr);
+    if (now >= 0 && tr >= scene.contacts[now].t_on + 0.02 && r.in_contact) {
+      if (r.contact_link != scene.contacts[now].detected_link) ++run.wrong_link[now];
+      if (run.links[now].find(r.contact_link) == std::string::npos)
+        run.links[now] += r.contact_link + " ";
+    }
+    // The acting contact's wrench may be reported from its onset to its release; every
+    // other one never (a configured contact the scene does not touch: none).
+    for (int c = 0; c < static_cast<int>(r.contacts.size()); ++c) {
+      const bool reported = r.contacts[c].force.norm() > 0.0;
+      if (reported != r.contacts[c].active) ++run.flag_mismatch;
+      if (reported && !(acting >= 0 && configured_for[acting] == c)) ++run.phantom;
+      if (!reported && now >= 0 && configured_for[now] == c &&
+          tr >= scene.contacts[now].t_on + 0.02)
+        ++run.missing;
+    }
+  }
+  return run;
+}
+
+void printScenario(const char* name, const ScenarioRun& run) {
+  std::printf("%s: delays [ms]", name);
+  for (double d : run.delay) std::printf(" %.0f", d * 1e3);
+  std::printf("; links:");
+  for (const std::string& l : run.links) std::printf(" [%s]", l.c_str());
+  std::printf("; false-contact samples %ld, phantom wrenches %ld, missing %ld\n", run.false_samples,
+              run.phantom, run.missing);
+}
+
+void expectScenario(const char* name, const ScenarioRun& run) {
+  printScenario(name, run);
+  const jle_testing::PandaContacts scene(readFile(urdfPath("chains/panda_chain.urdf")));
+  for (std::size_t c = 0; c < run.delay.size(); ++c) {
+    // Detected within 20 ms of its onset.
+    EXPECT_LE(run.delay[c], 0.020) << name << " contact on " << scene.contacts[c].link;
+    // From 20 ms into the contact on: its link (that of the most distal loaded joint).
+    EXPECT_EQ(run.wrong_link[c], 0)
+        << name << " contact on " << scene.contacts[c].link << ": reported " << run.links[c];
+  }
+  EXPECT_EQ(run.false_samples, 0) << name;
+  // The fingertip's wrench during the fingertip's contact only, link 5's during link 5's,
+  // neither in free motion or during the contact on link 4.
+  EXPECT_EQ(run.phantom, 0) << name;
+  EXPECT_EQ(run.missing, 0) << name;
+  EXPECT_EQ(run.flag_mismatch, 0) << name;
+}
+
+TEST(Issue40Scene, EachContactDetectedWithin20MsOnItsLinkWithItsWrenchOnly) {
+  expectScenario("observer", runScenario(jle::ExternalMethod::kObserver));
+  expectScenario("residual", runScenario(jle::ExternalMethod::kResidual));
+}
+
+// The same with samples lost in the first 0.1 s (a loaded node at start-up) and a burst
+// of 15 lost in the calibration window: the filter's jolts must not inflate the
+// thresholds.
+TEST(Issue40Scene, StartUpDropsDoNotInflateTheThresholds) {
+  const std::vector<std::pair<int, int>> drops = {{3, 9}, {20, 41}, {60, 63}, {85, 97}, {500, 515}};
+  expectScenario("observer, drops", runScenario(jle::ExternalMethod::kObserver, drops));
+  expectScenario("residual, drops", runScenario(jle::ExternalMethod::kResidual, drops));
 }
 
 // ---------------------------------------------------------------------------------------

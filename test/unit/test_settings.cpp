@@ -162,6 +162,8 @@ void expectSame(const jle::ExternalEffortConfig& a, const jle::ExternalEffortCon
   EXPECT_SAME(threshold);
   EXPECT_SAME(noise_multiple);
   EXPECT_SAME(calibration_time);
+  EXPECT_SAME(settle_time);
+  EXPECT_SAME(link_window);
   EXPECT_SAME(joint_thresholds);
   EXPECT_SAME(release_fraction);
   expectSameList(a.contacts, b.contacts, "external_effort/contacts");
@@ -366,6 +368,8 @@ TEST(SettingsReader, ExternalEffortKeys) {
   x.threshold = 1.5;
   x.noise_multiple = 6.0;
   x.calibration_time = 0.5;
+  x.settle_time = 0.3;
+  x.link_window = 0.05;
   x.release_fraction = 0.25;
   x.joint_thresholds = {{"panda_joint7", 0.4}};
   jle::ContactLinkConfig c;

@@ -25,10 +25,14 @@ struct ContactScene {
   double t_on = 1.0, t_off = 2.0;               ///< [s] the wrench acts in [t_on, t_off)
   double amplitude = 0.3;                       ///< [rad] of every joint's sinusoid
   double frequency = 0.4;                       ///< [Hz] of the first joint (others faster)
+  /// [rad] the pose the sinusoids are about (model.nq values); empty: q0_i = 0.3 + 0.1 i
+  /// (i even), -0.6 + 0.1 i (i odd), which on the Panda puts joints 4 and 6 beyond their
+  /// limits, near the elbow's singularity (the Jacobian's condition number 220-290).
+  Eigen::VectorXd center;
 
   bool active(double t) const { return t >= t_on && t < t_off; }
 
-  /// q, qd, qdd of coordinate i at t (q0 a mid-range pose).
+  /// q, qd, qdd of coordinate i at t (about `center`).
   void state(const jle::Model<double>& model, double t, jle::VectorX<double>& q,
              jle::VectorX<double>& qd, jle::VectorX<double>& qdd) const {
     const int n = model.nq;
@@ -38,7 +42,7 @@ struct ContactScene {
     for (int i = 0; i < n; ++i) {
       const double w = 2.0 * M_PI * frequency * (1.0 + 0.23 * i);
       const double phase = 0.7 * i;
-      const double q0 = (i % 2 == 0 ? 0.3 : -0.6) + 0.1 * i;
+      const double q0 = center.size() == n ? center[i] : (i % 2 == 0 ? 0.3 : -0.6) + 0.1 * i;
       q[i] = q0 + amplitude * std::sin(w * t + phase);
       qd[i] = amplitude * w * std::cos(w * t + phase);
       qdd[i] = -amplitude * w * w * std::sin(w * t + phase);
