@@ -45,7 +45,7 @@ export ASAN_OPTIONS="halt_on_error=1:detect_leaks=${JLE_FUZZ_LEAKS:-1}:allocator
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 status=0
 for t in "${targets[@]}"; do
-  "$cxx" "${common[@]}" -fsanitize=fuzzer "$here/$t.cpp" "${objs[@]}" -ltinyxml2 -o "$work/$t"
+  "$cxx" "${common[@]}" -fsanitize=fuzzer "$here/$t.cpp" "${objs[@]}" -ltinyxml2 -lyaml-cpp -o "$work/$t"
   # Regressions first: each must now run clean.
   reg="$here/regressions/$t"
   if [ -d "$reg" ] && [ -n "$(ls -A "$reg")" ]; then
