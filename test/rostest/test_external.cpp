@@ -185,8 +185,8 @@ TEST(External, Issue40SceneThroughTheNodeWithStartUpDrops) {
   }
   spinUntilQuiet([&] { return node.loads().size() + tool.size() + link5.size() + contact.size(); });
   RecordProperty("loads", std::to_string(node.loads().size()));
-  std::printf("issue 40 scene: %zu loads of %d sent, %zu contact events\n", node.loads().size(),
-              node.sent(), contact.size());
+  std::printf("issue 40 scene: %zu loads of %ld sent, %zu contact events\n", node.loads().size(),
+              static_cast<long>(node.sent()), contact.size());
 
   // Which scene contact (index) a stamp falls in, its release (0.15 s) included; -1 none.
   auto within = [&](const ros::Time& stamp, double from, double to) {
