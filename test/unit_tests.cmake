@@ -128,7 +128,10 @@ add_dependencies(test_gait_csv make_gait_bag joint_loads)
 
 # --- Unit tests of the ROS library and the bag tools (no master) --------------------
 catkin_add_gtest(test_process_bag unit/test_process_bag.cpp)
-target_link_libraries(test_process_bag joint_load_estimator_ros ${catkin_LIBRARIES})
+target_link_libraries(test_process_bag joint_load_estimator_ros joint_load_estimator_testing
+  ${catkin_LIBRARIES} ${orocos_kdl_LIBRARIES} ${kdl_parser_LIBRARIES})
+target_include_directories(test_process_bag PRIVATE ${orocos_kdl_INCLUDE_DIRS}
+  ${kdl_parser_INCLUDE_DIRS})
 target_compile_definitions(test_process_bag PRIVATE
   JLE_TEST_DATA="${JLE_TEST_DATA}"
   JLE_PROCESS_BAG="$<TARGET_FILE:process_bag>"

@@ -35,7 +35,9 @@ struct ContactEstimate {
   std::string link;
   /// With contact detection: in contact, and this contact can be the detected one (on the
   /// contact's link, or distal to it beyond joints it cannot load: a point force through
-  /// their axes); force, moment and covariance are zero when not. Without detection
+  /// their axes; failing any such contact, a 6-D one distal to it whose wrench reproduces
+  /// every joint's external effort within its threshold); force, moment and covariance are
+  /// zero when not. Without detection
   /// (thresholds and noise_multiple 0): always.
   bool active = false;
   /// Link frame, moment about the link origin (the contact force acts at the configured
@@ -93,9 +95,12 @@ class ExternalEffort {
   /// its end), and that joint's child link. A contact on link k loads joints 1..k only, so the
   /// contact is on that link or on a more distal one whose joints it does not load (a
   /// force through their axes): the link is the most proximal one the contact can be on.
+  /// contactChanged: the contact's joint changed at this sample while it lasts (not at
+  /// its start).
   bool inContact() const { return in_contact_; }
   bool contactStarted() const { return started_; }
   bool contactEnded() const { return ended_; }
+  bool contactChanged() const { return changed_; }
   const std::string& contactJoint() const { return contact_joint_; }
   const std::string& contactLink() const { return contact_link_; }
   const JointSpace& jointSpace() const { return js_; }
@@ -114,7 +119,10 @@ class ExternalEffort {
   void updateResidual(const std::vector<double>& model_effort, const std::vector<double>& measured,
                       const std::vector<double>* model_variance);
   void updateObserver(double t, const std::vector<double>& measured);
-  bool explains(std::size_t k) const;
+  enum class Explains { kNo, kYes, kIfItFits };
+  Explains explains(std::size_t k) const;
+  bool fits(const Eigen::Matrix<double, 6, 1>& F, int rows) const;
+  void chooseActive();
   void solveContact(std::size_t k);
   bool calibrate(double t);
   double robustSigma(int m);
@@ -133,6 +141,8 @@ class ExternalEffort {
   JointSpace js_;
   std::vector<Contact> contact_setup_;
   std::vector<ContactEstimate> contacts_;
+  std::vector<Explains> explained_;  // per contact, at the last sample (explains())
+  std::vector<char> fit_;            // per contact: a 6-D one beyond whose wrench fits
   std::vector<double> residual_, observer_, stddev_, residual_var_;
   // Observer state per joint-space row.
   Eigen::VectorXd p_prev_, beta_prev_, r_;
@@ -161,7 +171,7 @@ class ExternalEffort {
   double t_start_ = 0.0;
   bool have_start_ = false, calibrated_ = false;
   bool detection_ = false;  // thresholds configured
-  bool in_contact_ = false, started_ = false, ended_ = false;
+  bool in_contact_ = false, started_ = false, ended_ = false, changed_ = false;
   std::string contact_joint_, contact_link_;
 };
 

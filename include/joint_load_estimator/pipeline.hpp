@@ -147,10 +147,11 @@ struct LoadsRecord {
   std::vector<double> external_effort, external_effort_stddev;
   /// The wrench at each external_effort/contacts link (link frame, about its origin).
   std::vector<ContactEstimate> contacts;
-  /// Contact detection at this sample: in contact, it started / ended here, and the
-  /// contact's joint (the most distal over its threshold, ExternalEffort::contactJoint),
-  /// with its child link.
-  bool in_contact = false, contact_started = false, contact_ended = false;
+  /// Contact detection at this sample: in contact, it started / ended here, its joint
+  /// changed here while it lasts, and the contact's joint (the most distal over its
+  /// threshold, ExternalEffort::contactJoint), with its child link. A contact event (the
+  /// node's ~contact) is a sample where it started, changed or ended.
+  bool in_contact = false, contact_started = false, contact_ended = false, contact_changed = false;
   std::string contact_joint, contact_link;
   /// The estimated q, q-dot, q-ddot of every coordinate (model coordinate order) [rad or
   /// m, /s, /s^2].

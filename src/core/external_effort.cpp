@@ -107,6 +107,8 @@ void ExternalEffort::setUpContacts() {
     ContactEstimate e;
     e.link = c.link;
     contacts_.push_back(e);
+    explained_.push_back(Explains::kNo);
+    fit_.push_back(0);
   }
   A_ = Eigen::MatrixXd::Zero(6, js_.size());
 }
@@ -157,7 +159,7 @@ void ExternalEffort::reset() {
     calib_stride_ = 1;
     calib_rows_ = 0;
   }
-  in_contact_ = started_ = ended_ = false;
+  in_contact_ = started_ = ended_ = changed_ = false;
   std::fill(last_loaded_.begin(), last_loaded_.end(), -kInfinity);
   std::fill(loaded_.begin(), loaded_.end(), 0);
   contact_index_ = -1;
@@ -190,6 +192,7 @@ void ExternalEffort::update(double t, const VectorX<double>& q, const VectorX<do
       stddev_[i] = row_[i] >= 0 ? std::sqrt(var_js_[row_[i]]) : 0.0;
   detect(t);
   for (std::size_t k = 0; k < contacts_.size(); ++k) solveContact(k);
+  chooseActive();
 }
 
 void ExternalEffort::updateResidual(const std::vector<double>& model_effort,
@@ -280,30 +283,49 @@ void dampedSolve(const Eigen::MatrixXd& J, const Eigen::VectorXd& tau,
 
 // With detection: whether contact k can be the detected one. A contact on link k loads
 // joints 1..k only; the contact's joint is the most distal one loaded. A contact proximal
-// to it cannot load it; one distal to it would load the joints between, unless it cannot
-// (a point force through their axes: J_'s point-velocity rows zero there). J_ is k's.
-bool ExternalEffort::explains(std::size_t k) const {
-  if (!detection_) return true;
-  if (!in_contact_ || contact_index_ < 0) return false;
+// to it cannot load it (kNo). One distal to it must leave the joints between unloaded: a
+// point force can only through their axes (J_'s point-velocity rows zero there: kYes, else
+// kNo); a 6-D wrench always can (one condition a joint), so it is the contact if its
+// wrench fits (kIfItFits: ExternalEffort::fits). J_ is k's.
+ExternalEffort::Explains ExternalEffort::explains(std::size_t k) const {
+  if (!detection_) return Explains::kYes;
+  if (!in_contact_ || contact_index_ < 0) return Explains::kNo;
   const int detected = published_[static_cast<std::size_t>(contact_index_)];
   const Contact& c = contact_setup_[k];
+  Explains x = Explains::kYes;
   for (int s = c.moving; s >= 0; s = js_.moving_parent[s]) {
-    if (s == detected) return true;
-    if (c.rows == 6 || J_.col(js_.index[s]).head<3>().norm() > kBlindLever) return false;
+    if (s == detected) return x;
+    if (c.rows == 6)
+      x = Explains::kIfItFits;
+    else if (J_.col(js_.index[s]).head<3>().norm() > kBlindLever)
+      return Explains::kNo;
   }
-  return false;
+  return Explains::kNo;
+}
+
+// Whether contact k's wrench F (its first `rows`) reproduces the external effort: at every
+// published joint with a threshold, |tau_ext - (J^T F)| within it. J_ is k's.
+bool ExternalEffort::fits(const Vector6d& F, int rows) const {
+  for (std::size_t i = 0; i < published_.size(); ++i) {
+    const int j = row_[i];
+    if (j < 0 || !(threshold_[i] > 0.0)) continue;
+    const double predicted = J_.col(j).head(rows).dot(F.head(rows));
+    if (std::abs(tau_js_[j] - predicted) > threshold_[i]) return false;
+  }
+  return true;
 }
 
 void ExternalEffort::solveContact(std::size_t k) {
   const Contact& c = contact_setup_[k];
   ContactEstimate& e = contacts_[k];
   pointJacobian(model_, data_, js_, c.segment, c.point_segment, J_);
-  e.active = explains(k);
+  explained_[k] = explains(k);
   Vector6d F;
   if (c.rows == 3)
     dampedSolve<3>(J_, tau_js_, config_, A_, F, e);
   else
     dampedSolve<6>(J_, tau_js_, config_, A_, F, e);
+  fit_[k] = explained_[k] == Explains::kIfItFits && fits(F, c.rows);
   // To the link frame, moment about the link origin: T (6 x 6) acting on (f; m_point).
   const Eigen::Matrix3d R_world_link = data_.R_world[c.segment] * c.R_segment_link;
   const Eigen::Vector3d lever =
@@ -319,10 +341,24 @@ void ExternalEffort::solveContact(std::size_t k) {
     const Eigen::MatrixXd P = T.leftCols(c.rows) * A_.topRows(c.rows);
     e.covariance.noalias() = P * var_js_.asDiagonal() * P.transpose();
   }
-  if (e.active) return;
-  e.force.setZero();  // the Jacobian's figures stay: the diagnostics' conditioning
-  e.moment.setZero();
-  e.covariance.setZero();
+}
+
+// The contacts that can be the detected one: those on its link (or beyond joints a point
+// force through their axes cannot load); failing any, the 6-D ones beyond it whose
+// wrench fits. A 6-D wrench on a 7-joint arm reproduces most efforts within the
+// thresholds: it is the candidate of last resort, not beside one that needs no such
+// assumption. The others report no wrench.
+void ExternalEffort::chooseActive() {
+  const bool specific =
+      std::find(explained_.begin(), explained_.end(), Explains::kYes) != explained_.end();
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    ContactEstimate& e = contacts_[k];
+    e.active = explained_[k] == Explains::kYes || (!specific && fit_[k]);
+    if (e.active) continue;
+    e.force.setZero();  // the Jacobian's figures stay: the diagnostics' conditioning
+    e.moment.setZero();
+    e.covariance.setZero();
+  }
 }
 
 void ExternalEffort::keepCalibrationSample() {
@@ -389,7 +425,7 @@ bool ExternalEffort::calibrate(double t) {
 }
 
 void ExternalEffort::detect(double t) {
-  started_ = ended_ = false;
+  started_ = ended_ = changed_ = false;
   if (!calibrate(t)) return;
   const std::vector<double>& ext = external();
   const std::size_t n = published_.size();
@@ -421,6 +457,7 @@ void ExternalEffort::detect(double t) {
         (joint < 0 || depth_[i] > depth_[static_cast<std::size_t>(joint)]))
       joint = static_cast<int>(i);
   if (joint < 0 || (!started_ && joint == contact_index_)) return;
+  changed_ = !started_;
   contact_index_ = joint;
   contact_joint_ = model_.joint_name[published_[static_cast<std::size_t>(joint)]];
   contact_link_ = model_.link_name[published_[static_cast<std::size_t>(joint)]];

@@ -231,6 +231,7 @@ void Pipeline::fillExternal() {
   record_.in_contact = external_->inContact();
   record_.contact_started = external_->contactStarted();
   record_.contact_ended = external_->contactEnded();
+  record_.contact_changed = external_->contactChanged();
   record_.contact_joint = external_->contactJoint();
   record_.contact_link = external_->contactLink();
 }

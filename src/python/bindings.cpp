@@ -51,17 +51,20 @@ struct PyModel {
 };
 
 PyModel modelFromString(const std::string& xml, bool floating_base,
-                        const std::vector<std::string>& keep_fixed_joints) {
+                        const std::vector<std::string>& keep_fixed_joints,
+                        bool accept_nonphysical_inertia) {
   PyModel m;
   m.xml = xml;
   m.options.floating_base = floating_base;
   m.options.keep_fixed_joints = keep_fixed_joints;
+  m.options.accept_nonphysical_inertia = accept_nonphysical_inertia;
   m.model = jle::modelFromUrdfString(xml, m.options);
   return m;
 }
 
 PyModel modelFromFile(const std::string& path, bool floating_base,
-                      const std::vector<std::string>& keep_fixed_joints) {
+                      const std::vector<std::string>& keep_fixed_joints,
+                      bool accept_nonphysical_inertia) {
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": cannot be read");
   std::ostringstream text;
@@ -70,6 +73,7 @@ PyModel modelFromFile(const std::string& path, bool floating_base,
   m.xml = text.str();
   m.options.floating_base = floating_base;
   m.options.keep_fixed_joints = keep_fixed_joints;
+  m.options.accept_nonphysical_inertia = accept_nonphysical_inertia;
   m.model = jle::modelFromUrdfFile(path, m.options);  // its errors name the file
   return m;
 }
@@ -314,6 +318,8 @@ class PyEstimator {
     }
     jle::ModelOptions options = jle::modelOptions(settings_);
     options.floating_base = options.floating_base || m.options.floating_base;
+    options.accept_nonphysical_inertia =
+        options.accept_nonphysical_inertia || m.options.accept_nonphysical_inertia;
     for (const std::string& j : m.options.keep_fixed_joints)
       if (std::find(options.keep_fixed_joints.begin(), options.keep_fixed_joints.end(), j) ==
           options.keep_fixed_joints.end())
@@ -592,10 +598,14 @@ void defineModel(py::module_& m) {
       .def(py::init(&modelFromFile), py::arg("path"), py::kw_only(),
            py::arg("floating_base") = false,
            py::arg("keep_fixed_joints") = std::vector<std::string>(),
-           "Reads a URDF file (errors name the file and the link or joint at fault).")
+           py::arg("accept_nonphysical_inertia") = false,
+           "Reads a URDF file (errors name the file and the link or joint at fault). "
+           "accept_nonphysical_inertia: keep an inertia that is not physical (identified "
+           "parameters), with a warning per violation, instead of refusing the model.")
       .def_static("from_string", &modelFromString, py::arg("xml"), py::kw_only(),
                   py::arg("floating_base") = false,
                   py::arg("keep_fixed_joints") = std::vector<std::string>(),
+                  py::arg("accept_nonphysical_inertia") = false,
                   "Parses a URDF document (e.g. the robot_description parameter).")
       .def_property_readonly("nq", [](const PyModel& p) { return p.model.nq; })
       .def_property_readonly("floating_base",

@@ -62,12 +62,15 @@ class RecordColumns {
     for (const jle::ContactEstimate& c : r.contacts) {
       put(contact_wrench_, c.force);
       put(contact_wrench_, c.moment);
+      contact_active_.push_back(c.active);
     }
     put(base_, r.base_force);
     put(base_, r.base_moment);
     in_contact_.push_back(r.in_contact);
     contact_started_.push_back(r.contact_started);
     contact_ended_.push_back(r.contact_ended);
+    contact_changed_.push_back(r.contact_changed);
+    contact_joint_.push_back(r.contact_joint);
     contact_link_.push_back(r.contact_link);
     planar_.push_back(r.planar);
   }
@@ -101,9 +104,12 @@ class RecordColumns {
     const auto c = static_cast<py::ssize_t>(contact_names_.size());
     out["contact_links"] = contact_names_;
     out["contact_wrench"] = Array({n, c, py::ssize_t(6)}, contact_wrench_.data());
+    out["contact_active"] = flags(contact_active_, {n, c});
     out["in_contact"] = flags(in_contact_, {n});
     out["contact_started"] = flags(contact_started_, {n});
+    out["contact_changed"] = flags(contact_changed_, {n});
     out["contact_ended"] = flags(contact_ended_, {n});
+    out["contact_joint"] = contact_joint_;
     out["contact_link"] = contact_link_;
     out["base_residual"] = Array({n, py::ssize_t(6)}, base_.data());
     out["planar"] = flags(planar_, {n});
@@ -155,13 +161,13 @@ class RecordColumns {
   std::vector<std::string> joints_, links_;
   std::size_t nq_, inputs_, plates_, per_covariance_;
   std::size_t count_ = 0;
-  std::vector<std::string> contact_names_, contact_link_;
+  std::vector<std::string> contact_names_, contact_joint_, contact_link_;
   std::vector<jle::Stamp> stamps_;
   std::vector<double> wrench_, covariance_, coordinates_, residual_, cop_, plate_wrench_,
       plate_scalars_, contact_wrench_, base_;
   std::vector<double> per_joint_[kPerJoint];
   std::vector<char> input_used_, input_stale_, plate_contact_, plate_stale_, in_contact_,
-      contact_started_, contact_ended_, planar_;
+      contact_active_, contact_started_, contact_changed_, contact_ended_, planar_;
 };
 
 }  // namespace jle_python

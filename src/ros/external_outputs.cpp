@@ -17,6 +17,17 @@ void toWrenchMessage(const ContactEstimate& contact, Stamp stamp,
   msg.wrench.torque.z = contact.moment.z();
 }
 
+void toContactMessage(const LoadsRecord& record, joint_load_estimator::Contact& msg) {
+  msg.header.stamp = toRosTime(record.stamp);
+  msg.in_contact = record.in_contact;
+  msg.joint = record.contact_joint;
+  msg.link = record.contact_link;
+  msg.contacts.clear();
+  if (!record.in_contact) return;
+  for (const ContactEstimate& c : record.contacts)
+    if (c.active) msg.contacts.push_back(c.link);
+}
+
 void ExternalOutputs::advertise(ros::NodeHandle& private_nh, const LoadsRecord& record) {
   enabled_ = !record.external_effort.empty();
   if (!enabled_) return;
@@ -35,20 +46,11 @@ void ExternalOutputs::publish(const LoadsRecord& record) {
     wrench_pubs_[k].publish(wrench_msg_);
   }
   in_contact_ = record.in_contact;
-  // The contact's joint is re-evaluated at every sample: an event when it changes.
-  const bool changed =
-      record.in_contact && !record.contact_started && record.contact_joint != joint_;
-  if (!record.contact_started && !record.contact_ended && !changed) return;
+  if (!isContactEvent(record)) return;
   if (record.contact_started) ++contacts_;
   joint_ = record.contact_joint;
   link_ = record.contact_link;
-  contact_msg_.header.stamp = toRosTime(record.stamp);
-  contact_msg_.in_contact = record.in_contact;
-  contact_msg_.joint = record.contact_joint;
-  contact_msg_.link = record.contact_link;
-  contact_msg_.contacts.clear();
-  for (const ContactEstimate& c : record.contacts)
-    if (c.active && record.in_contact) contact_msg_.contacts.push_back(c.link);
+  toContactMessage(record, contact_msg_);
   contact_pub_.publish(contact_msg_);
 }
 

@@ -196,6 +196,7 @@ class Outputs : public jle::LoadsSink {
   std::vector<std::string> external_topics_;
   std::string contact_topic_;
   geometry_msgs::WrenchStamped wrench_;
+  joint_load_estimator::Contact contact_;
   double* writeExternal(const jle::LoadsRecord& record, double* row);
   // t, the 7 numbers per joint, the effort sigmas: the .sto row; `csv`: then the kinematics
   // (--kinematics) and the motor efforts. Returns the end of what it wrote.
@@ -340,13 +341,9 @@ void Outputs::writeExternalMessages(const jle::LoadsRecord& record) {
     jle::toWrenchMessage(record.contacts[k], record.stamp, wrench_);
     bag_->write(external_topics_[k], wrench_.header.stamp, wrench_);
   }
-  if (contact_topic_.empty() || !(record.contact_started || record.contact_ended)) return;
-  joint_load_estimator::Contact contact;
-  contact.header.stamp = jle::toRosTime(record.stamp);
-  contact.in_contact = record.contact_started;
-  contact.joint = record.contact_joint;
-  contact.link = record.contact_link;
-  bag_->write(contact_topic_, contact.header.stamp, contact);
+  if (contact_topic_.empty() || !jle::isContactEvent(record)) return;
+  jle::toContactMessage(record, contact_);
+  bag_->write(contact_topic_, contact_.header.stamp, contact_);
 }
 
 void Outputs::commit() {

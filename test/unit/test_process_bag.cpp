@@ -4,6 +4,7 @@
 // output), it must agree with the exact efforts make_example_bag computes from the
 // analytic trajectory (the whole chain, derivatives estimated from positions), and it
 // must refuse bad input with a message naming the culprit.
+#include <joint_load_estimator/Contact.h>
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -15,6 +16,8 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "tool_test.hpp"
+
+#include <jle_testing/panda_contacts.hpp>
 
 #include <gtest/gtest.h>
 
@@ -30,6 +33,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -593,6 +597,141 @@ TEST_F(ProcessBagTest, StaticTransformsWrittenLateHoldFromTheStart) {
 // as an identified parameter set may give it): refused by default naming the link and
 // the violation; accepted with --accept-nonphysical-inertia or the setting
 // accept_nonphysical_inertia: true, with a warning naming them.
+// ------------------------------------------ external efforts: issue 40's contact scene
+
+// jle_testing::PandaContacts (three step contacts; efforts from KDL's RNE with external
+// forces, 0.1 N m of effort noise, 1e-4 rad of position noise) as a bag, through
+// process_bag with two contact links. Its ~contact events and ~external_wrench/<link>
+// against the scene's truth: each contact starts within 20 ms of its onset and none
+// elsewhere; from 20 ms into a contact the last event names its link, and its `contacts`
+// the configured contact acting (none for link 4's: no configured contact can load joint 4
+// alone); every event is a start, an end or a change of joint, never a repeat; and a
+// contact link's wrench is nonzero only while its contact acts (or is released).
+const char* const kContactConfig = R"(external_effort:
+  enabled: true
+  noise_multiple: 6.0
+  contacts:
+    - {link: panda_hand_tcp, point: [0.0, 0.05, 0.0], force_only: true}
+    - {link: panda_link5, point: [0.0, 0.08, -0.1], force_only: true}
+)";
+
+struct ContactEvent {
+  double t = 0.0;  // [s] from the bag's first stamp
+  bool in_contact = false;
+  std::string joint, link, contacts;  // contacts: space-separated
+};
+
+void writeContactScene(const std::string& bag_path, const jle_testing::PandaContacts& scene) {
+  rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+  std::mt19937 rng(40);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  sensor_msgs::JointState js;
+  for (int i = 1; i <= 7; ++i) js.name.push_back("panda_joint" + std::to_string(i));
+  js.position.resize(7);
+  const int n = static_cast<int>(jle_testing::PandaContacts::kDuration * 1000.0);
+  for (int k = 0; k < n; ++k) {
+    Eigen::VectorXd q, qd, qdd;
+    scene.state(k * 1e-3, q, qd, qdd);
+    js.effort = scene.efforts(k * 1e-3);
+    for (int i = 0; i < 7; ++i) js.position[i] = q[i] + 1e-4 * gauss(rng);
+    for (double& e : js.effort) e += 0.1 * gauss(rng);
+    js.header.stamp.fromNSec(1000000000000ULL + static_cast<std::uint64_t>(k) * 1000000ULL);
+    bag.write("/joint_states", js.header.stamp, js);
+  }
+}
+
+std::vector<ContactEvent> readContactEvents(rosbag::Bag& bag) {
+  std::vector<ContactEvent> events;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/est/contact"))) {
+    const auto msg = m.instantiate<joint_load_estimator::Contact>();
+    if (msg == nullptr) continue;
+    ContactEvent e;
+    e.t = (msg->header.stamp - ros::Time(1000.0)).toSec();
+    e.in_contact = msg->in_contact;
+    e.joint = msg->joint;
+    e.link = msg->link;
+    for (const std::string& c : msg->contacts) e.contacts += c + " ";
+    events.push_back(e);
+  }
+  return events;
+}
+
+TEST_F(ProcessBagTest, ContactEventsAndWrenchesFollowTheScene) {
+  const std::string urdf = kData + "/urdf/chains/panda_chain.urdf";
+  const jle_testing::PandaContacts scene(readFile(urdf));
+  writeContactScene(path("contacts.bag"), scene);
+  writeFile(path("contacts.yaml"), kContactConfig);
+  const Result r = run(std::string(JLE_PROCESS_BAG) + " --bag " + quote(path("contacts.bag")) +
+                       " --urdf " + quote(urdf) + " --config " + quote(path("contacts.yaml")) +
+                       " --output " + quote(path("contacts_out.bag")) + " --topic-prefix /est");
+  ASSERT_EQ(r.status, 0) << r.output;
+  rosbag::Bag bag(path("contacts_out.bag"), rosbag::bagmode::Read);
+  const std::vector<ContactEvent> events = readContactEvents(bag);
+  ASSERT_FALSE(events.empty());
+  for (const ContactEvent& e : events)
+    std::printf("contact event %.3f s: %s %s (%s) [%s]\n", e.t, e.in_contact ? "in" : "out",
+                e.joint.c_str(), e.link.c_str(), e.contacts.c_str());
+  const auto acting = [&](double t) {  // the scene contact acting or released at t, -1 none
+    for (std::size_t c = 0; c < scene.contacts.size(); ++c)
+      if (t >= scene.contacts[c].t_on && t < scene.contacts[c].t_off + 0.15)
+        return static_cast<int>(c);
+    return -1;
+  };
+  const char* const expected_contacts[3] = {"panda_hand_tcp ", "", "panda_link5 "};
+  std::vector<int> starts(scene.contacts.size(), 0);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const ContactEvent& e = events[i];
+    const bool was = i > 0 && events[i - 1].in_contact;
+    if (e.in_contact && was) {
+      EXPECT_NE(e.joint, events[i - 1].joint) << "a repeated event at " << e.t;
+    }
+    if (!e.in_contact) {
+      EXPECT_TRUE(was) << "an end without a start at " << e.t;
+    }
+    if (!e.in_contact || was) continue;
+    const int c = acting(e.t);
+    ASSERT_GE(c, 0) << "a contact started at " << e.t << " s, in free motion";
+    EXPECT_LE(e.t - scene.contacts[c].t_on, 0.020) << scene.contacts[c].link;
+    ++starts[c];
+  }
+  for (std::size_t c = 0; c < scene.contacts.size(); ++c) {
+    EXPECT_EQ(starts[c], 1) << scene.contacts[c].link;
+    // From 20 ms into the contact to its end, the state the last event set.
+    for (double t = scene.contacts[c].t_on + 0.02; t < scene.contacts[c].t_off; t += 0.01) {
+      const ContactEvent* last = nullptr;
+      for (const ContactEvent& e : events)
+        if (e.t <= t + 1e-9) last = &e;
+      ASSERT_NE(last, nullptr);
+      EXPECT_TRUE(last->in_contact) << t;
+      EXPECT_EQ(last->link, scene.contacts[c].detected_link) << t;
+      EXPECT_EQ(last->contacts, expected_contacts[c]) << t;
+    }
+  }
+  // Each contact link's wrench: nonzero only while its own contact acts (or is released),
+  // and present from 20 ms into it.
+  const char* const links[2] = {"panda_hand_tcp", "panda_link5"};
+  const int scene_contact[2] = {0, 2};
+  for (int k = 0; k < 2; ++k) {
+    long messages = 0, phantom = 0, missing = 0;
+    for (const rosbag::MessageInstance& m :
+         rosbag::View(bag, rosbag::TopicQuery(std::string("/est/external_wrench/") + links[k]))) {
+      const auto w = m.instantiate<geometry_msgs::WrenchStamped>();
+      ASSERT_NE(w, nullptr);
+      ++messages;
+      const double t = (w->header.stamp - ros::Time(1000.0)).toSec();
+      const bool reported =
+          w->wrench.force.x != 0.0 || w->wrench.force.y != 0.0 || w->wrench.force.z != 0.0;
+      const jle_testing::StepContact& own = scene.contacts[scene_contact[k]];
+      if (reported && acting(t) != scene_contact[k]) ++phantom;
+      if (!reported && t >= own.t_on + 0.02 && t < own.t_off) ++missing;
+      EXPECT_EQ(w->header.frame_id, links[k]);
+    }
+    EXPECT_GT(messages, 4000) << links[k];
+    EXPECT_EQ(phantom, 0) << links[k];
+    EXPECT_EQ(missing, 0) << links[k];
+  }
+}
+
 TEST_F(ProcessBagTest, IdentifiedInertiaNeedsTheFlagOrTheSetting) {
   writeBag(path("in.bag"), makeMessages());
   writeFile(path("config.yaml"), kConfig);

@@ -20,6 +20,17 @@ namespace jle {
 void toWrenchMessage(const ContactEstimate& contact, Stamp stamp,
                      geometry_msgs::WrenchStamped& msg);
 
+/// Whether `record` is a contact event (~contact): its contact started, changed its joint
+/// or ended at this sample.
+inline bool isContactEvent(const LoadsRecord& record) {
+  return record.contact_started || record.contact_changed || record.contact_ended;
+}
+
+/// The contact event of `record` as a message: its stamp, whether in contact, the
+/// contact's joint and link, and the configured contacts whose wrench is reported
+/// (ContactEstimate::active) while in contact. The node and process_bag publish it.
+void toContactMessage(const LoadsRecord& record, joint_load_estimator::Contact& msg);
+
 class ExternalOutputs {
  public:
   /// Advertises on `private_nh` for the record's contacts; nothing when `record` has no
