@@ -10,9 +10,6 @@
 
 #include <jle_testing/random_models.hpp>
 
-#include "legacy_filter.hpp"
-#include "legacy_passes.hpp"
-
 #include <benchmark/benchmark.h>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
@@ -49,9 +46,8 @@ States randomStates(int nq) {
 
 // What a pass computes: kLocal all 6-D joint wrenches over the segment-frame kinematics
 // (what KDL's recursive Newton-Euler computes, plus the 5 components it drops), kWorld
-// with every segment's world pose as well (forwardKinematics), kLegacy the passes as
-// they were before the leaner ones (legacy_passes.hpp, world poses included).
-enum class Pass { kLocal, kWorld, kLegacy };
+// with every segment's world pose as well (forwardKinematics).
+enum class Pass { kLocal, kWorld };
 
 template <typename Scalar>
 void coreLoads(benchmark::State& state, const std::string& file, Pass pass = Pass::kLocal) {
@@ -76,10 +72,6 @@ void coreLoads(benchmark::State& state, const std::string& file, Pass pass = Pas
         jle::forwardKinematics(model, data, q[k], qd[k], qdd[k], g);
         jle::inverseDynamics(model, data);
         break;
-      case Pass::kLegacy:
-        jle_legacy::forwardKinematics(model, data, q[k], qd[k], qdd[k], g);
-        jle_legacy::inverseDynamics(model, data);
-        break;
     }
     benchmark::DoNotOptimize(data.moment.data());
     benchmark::ClobberMemory();
@@ -90,9 +82,6 @@ void coreLoads(benchmark::State& state, const std::string& file, Pass pass = Pas
 
 void coreDoubleWorld(benchmark::State& state, const std::string& file) {
   coreLoads<double>(state, file, Pass::kWorld);
-}
-void legacyDouble(benchmark::State& state, const std::string& file) {
-  coreLoads<double>(state, file, Pass::kLegacy);
 }
 
 void coreDouble(benchmark::State& state, const std::string& file) {
@@ -203,13 +192,10 @@ void kdlChain(benchmark::State& state, const std::string& file, const std::strin
 
 // The filter bank per sample, per filter type and channel count (state.range(0)): 6, 7
 // (the arms' joints), 19 (7 joints and two wrench inputs), 50. Sampled every 1 ms, so
-// the gains settle and the steady per-sample cost is what is measured. Bank is the
-// package's DifferentiatorBank or the frozen one of legacy_filter.hpp; Config its
-// configuration type.
-template <typename Bank, typename Config>
-void runBank(benchmark::State& state, const Config& c) {
+// the gains settle and the steady per-sample cost is what is measured.
+void runBank(benchmark::State& state, const jle::DifferentiatorConfig& c) {
   const int channels = static_cast<int>(state.range(0));
-  Bank bank(c, channels);
+  jle::DifferentiatorBank bank(c, channels);
   // The samples made beforehand (4096, cycled on a continuous time axis): the loop
   // times the filter, not the signal's sin.
   const int n = 4096;
@@ -229,11 +215,10 @@ void runBank(benchmark::State& state, const Config& c) {
 // "kalman_cj" is the default (constant-jerk Kalman, config.hpp); "kalman_ca" constant
 // acceleration (q = 1e3); "savitzky_golay_9" causal, order 2; "finite_difference" 3 points;
 // "adaptive" the bank of Kalman filters with its defaults.
-template <typename Config>
-Config filterConfig(const std::string& name) {
-  Config c;
-  using Type = decltype(c.type);
-  using Kalman = decltype(c.kalman_model);
+jle::DifferentiatorConfig filterConfig(const std::string& name) {
+  jle::DifferentiatorConfig c;
+  using Type = jle::DifferentiatorType;
+  using Kalman = jle::KalmanModel;
   if (name == "kalman_ca") {
     c.kalman_model = Kalman::kConstantAcceleration;
     c.process_noise = 1e3;
@@ -248,25 +233,21 @@ Config filterConfig(const std::string& name) {
 }
 
 void filterBank(benchmark::State& state, const std::string& name) {
-  runBank<jle::DifferentiatorBank>(state, filterConfig<jle::DifferentiatorConfig>(name));
+  runBank(state, filterConfig(name));
 }
 // The Kalman smoother (differentiator/lag 0.1 s: 100 samples at 1 kHz), the defaults
 // otherwise: its cost beside filterBank/kalman_cj's in the same run.
 void smootherBank(benchmark::State& state) {
   jle::DifferentiatorConfig c;
   c.lag = 0.1;
-  runBank<jle::DifferentiatorBank>(state, c);
+  runBank(state, c);
 }
 // The adaptive smoother (type adaptive, lag 0.1 s), its other keys' defaults.
 void adaptiveSmootherBank(benchmark::State& state) {
   jle::DifferentiatorConfig c;
   c.type = jle::DifferentiatorType::kAdaptive;
   c.lag = 0.1;
-  runBank<jle::DifferentiatorBank>(state, c);
-}
-void legacyFilterBank(benchmark::State& state, const std::string& name) {
-  runBank<jle_legacy_filter::DifferentiatorBank>(
-      state, filterConfig<jle_legacy_filter::DifferentiatorConfig>(name));
+  runBank(state, c);
 }
 
 // Scaling: random serial chains and random trees of n moving joints (seeded), all 6-D
@@ -457,7 +438,6 @@ BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/pa
 #define JLE_PASSES(name, file)                    \
   BENCHMARK_CAPTURE(coreDouble, name, file);      \
   BENCHMARK_CAPTURE(coreDoubleWorld, name, file); \
-  BENCHMARK_CAPTURE(legacyDouble, name, file);    \
   BENCHMARK_CAPTURE(fullStep, name, file);        \
   BENCHMARK_CAPTURE(fullStepSmoother, name, file)
 JLE_PASSES(panda_chain, "/urdf/chains/panda_chain.urdf");
@@ -479,9 +459,8 @@ BENCHMARK_CAPTURE(coreKinematicsOnly, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreDynamicsOnly, talos, "/urdf/talos_reduced.urdf");
 BENCHMARK_CAPTURE(coreKinematicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(coreDynamicsOnly, panda_chain, "/urdf/chains/panda_chain.urdf");
-#define JLE_FILTER(name)                                                        \
-  BENCHMARK_CAPTURE(filterBank, name, #name)->Arg(6)->Arg(7)->Arg(19)->Arg(50); \
-  BENCHMARK_CAPTURE(legacyFilterBank, name, #name)->Arg(6)->Arg(7)->Arg(19)->Arg(50)
+#define JLE_FILTER(name) \
+  BENCHMARK_CAPTURE(filterBank, name, #name)->Arg(6)->Arg(7)->Arg(19)->Arg(50)
 JLE_FILTER(kalman_cj);
 JLE_FILTER(kalman_ca);
 JLE_FILTER(savitzky_golay_9);

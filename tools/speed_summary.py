@@ -78,19 +78,15 @@ def main():
               f"per joint at 1000 / at 100 {growth:.2f} (<= {LINEAR_PER_JOINT}) "
               f"{'pass' if ok else 'FAIL'}")
 
-    print("\nBefore/after (legacy: the passes and the filter bank as they were, same binary):")
+    print("\nWith world poses (forwardKinematics) and the filter bank, CPU time per sample:")
     for model in [a for a, _ in ARMS] + ["panda", "talos"]:
-        new, old, world = cpu(f"coreDouble/{model}"), cpu(f"legacyDouble/{model}"), cpu(
-            f"coreDoubleWorld/{model}")
-        if new and old and world:
-            print(f"  {model:13s} loads: legacy {old:7.0f} ns, now {new:7.0f} ns ({new / old:.2f}x); "
-                  f"with world poses {world:7.0f} ns ({world / old:.2f}x)")
+        new, world = cpu(f"coreDouble/{model}"), cpu(f"coreDoubleWorld/{model}")
+        if new and world:
+            print(f"  {model:13s} loads {new:7.0f} ns; with world poses {world:7.0f} ns "
+                  f"({world / new:.2f}x)")
     for name in ("kalman_cj", "kalman_ca", "savitzky_golay_9", "finite_difference", "adaptive"):
-        cells = []
-        for ch in (6, 7, 19, 50):
-            new, old = cpu(f"filterBank/{name}/{ch}"), cpu(f"legacyFilterBank/{name}/{ch}")
-            if new and old:
-                cells.append(f"{ch:2d} ch {new:6.0f} ns ({new / old:.2f}x)")
+        cells = [f"{ch:2d} ch {cpu(f'filterBank/{name}/{ch}'):6.0f} ns" for ch in (6, 7, 19, 50)
+                 if cpu(f"filterBank/{name}/{ch}")]
         if cells:
             print(f"  filter {name:17s} " + ", ".join(cells))
 
