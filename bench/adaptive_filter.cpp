@@ -1,10 +1,11 @@
-// The adaptive differentiator (the default) against the old default (constant-jerk
-// Kalman, q = 1e4, r = 1e-4 rad) and the best fixed constant-jerk Kalman filter of a grid
+// The adaptive differentiator (type adaptive) against a constant-jerk Kalman filter
+// (q = 1e4, r = 1e-4 rad) and the best fixed constant-jerk Kalman filter of a grid
 // of q, on Panda scenes of the ground truth: effort and q-ddot RMS errors against the
 // truth at the instants the samples were taken (JointReading.time: with receive-time
 // stamps the stamp errs), after a settling time, and the CPU time per sample of the
 // differentiator alone, as a ratio to the old default's in the same run.
 //   bench_adaptive_filter [DATA_DIR]
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
@@ -116,7 +117,15 @@ std::vector<SceneSpec> scenes() {
 
 }  // namespace
 
+const char* const kUsage =
+    "usage: bench_adaptive_filter [DATA_DIR]\n"
+    "The adaptive differentiator against a constant-jerk Kalman filter (q = 1e4) and the best\n"
+    "fixed one of a grid of q on Panda scenes of the ground truth: effort and q-ddot RMS\n"
+    "errors and the CPU time per sample. DATA_DIR: the package's test/data (default: the\n"
+    "source tree's).\n";
+
 int main(int argc, char** argv) {
+  if (jle::cli::answerHelpOrVersion(argc, argv, "bench_adaptive_filter", kUsage)) return 0;
   const std::string data = argc > 1 ? argv[1] : JLE_BENCH_DATA;
   const jle::Model<double> model = jle::modelFromUrdfFile(data + "/urdf/chains/panda_chain.urdf");
   const std::vector<double> grid = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e8};

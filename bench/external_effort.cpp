@@ -27,6 +27,8 @@
 #include <jle_testing/contact_scene.hpp>
 #include <jle_testing/panda_contacts.hpp>
 
+#include "benchmark_main.hpp"
+
 #include <benchmark/benchmark.h>
 #include <kdl/chain.hpp>
 #include <kdl/chainexternalwrenchestimator.hpp>
@@ -432,16 +434,19 @@ int frictionTable() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* const usage =
+      "usage: bench_external_effort [--table [--quick] | --friction | Google Benchmark options]\n"
+      "--table: the external wrench's error at poses inside the Panda's limits, ours against\n"
+      "KDL's ChainExternalWrenchEstimator (docs/external_effort.md); --friction: unmodelled\n"
+      "friction against detection; otherwise the time per sample against KDL's (benchmark).\n";
   bool want_table = false, quick = false, friction = false;
   for (int i = 1; i < argc; ++i) {
     want_table = want_table || std::strcmp(argv[i], "--table") == 0;
     quick = quick || std::strcmp(argv[i], "--quick") == 0;
     friction = friction || std::strcmp(argv[i], "--friction") == 0;
   }
+  if (jle::cli::answerHelpOrVersion(argc, argv, "bench_external_effort", usage)) return 0;
   if (friction) return frictionTable();
   if (want_table) return table(quick);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  return 0;
+  return jle_bench::benchmarkMain(argc, argv, "bench_external_effort", usage);
 }

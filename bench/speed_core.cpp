@@ -10,6 +10,8 @@
 
 #include <jle_testing/random_models.hpp>
 
+#include "benchmark_main.hpp"
+
 #include <benchmark/benchmark.h>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
@@ -469,4 +471,11 @@ JLE_FILTER(adaptive);
 BENCHMARK(smootherBank)->Arg(6)->Arg(7)->Arg(19)->Arg(50);
 BENCHMARK(adaptiveSmootherBank)->Arg(6)->Arg(7)->Arg(19)->Arg(50);
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  const char* const usage =
+      "usage: bench_speed_core [Google Benchmark options, e.g. --benchmark_filter=REGEX]\n"
+      "The core against Orocos KDL on the same 256 random states, same run: the loads, the\n"
+      "full estimator step, the filter bank, scaling to 1000 joints (tools/speed.sh runs it;\n"
+      "tools/speed_summary.py prints the ratios).\n";
+  return jle_bench::benchmarkMain(argc, argv, "bench_speed_core", usage);
+}

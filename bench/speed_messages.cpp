@@ -10,6 +10,8 @@
 #include <joint_load_estimator/ros/conversions.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
+#include "benchmark_main.hpp"
+
 #include <benchmark/benchmark.h>
 #include <ros/serialization.h>
 
@@ -75,4 +77,11 @@ void nodeMessagePath(benchmark::State& state) {
 
 BENCHMARK(estimatorOnly);
 BENCHMARK(nodeMessagePath)->Arg(0)->Arg(1);
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  const char* const usage =
+      "usage: bench_speed_messages [Google Benchmark options, e.g. --benchmark_filter=REGEX]\n"
+      "The node's message path per joint state (jle::Pipeline, the record into a message and\n"
+      "its serialization), the immediate stream alone and both streams, beside the estimator\n"
+      "alone in the same run.\n";
+  return jle_bench::benchmarkMain(argc, argv, "bench_speed_messages", usage);
+}

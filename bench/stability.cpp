@@ -13,6 +13,7 @@
 #include "../test/unit/far_com.hpp"
 #include "../test/unit/stability_bounds.hpp"
 
+#include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
@@ -1107,9 +1108,16 @@ const char* kStaticFindings =
   the Kalman filters at 1 ms). Nothing accumulates.
 )";
 
+const char* const kUsage =
+    "usage: stability [--output PATH] [--quick]\n"
+    "Sweeps that push one parameter of the core or the filters to its extreme, each against a\n"
+    "quad-precision reference; writes the report (docs/stability.md, or PATH) and exits 1 if a\n"
+    "measurement exceeds test_stability's bound. --quick: fewer samples (for CI).\n";
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (jle::cli::answerHelpOrVersion(argc, argv, "stability", kUsage)) return 0;
   std::string output;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -1118,7 +1126,7 @@ int main(int argc, char** argv) {
     } else if (a == "--output" && k + 1 < argc) {
       output = argv[++k];
     } else {
-      std::cerr << "usage: stability [--output PATH] [--quick]\n";
+      std::cerr << kUsage;
       return 2;
     }
   }

@@ -150,20 +150,28 @@ inline const char* version() {
 #endif
 }
 
+/// --help/-h among the arguments prints `usage`, --version the program's name and
+/// version(); true when either was answered (the program then exits 0, doing nothing
+/// else). For every main(): the tools through runTool, the benchmarks and studies directly.
+inline bool answerHelpOrVersion(int argc, char** argv, const char* name, const char* usage) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::fputs(usage, stdout);
+      return true;
+    } else if (std::string(argv[i]) == "--version") {
+      std::printf("%s %s\n", name, version());
+      return true;
+    }
+  return false;
+}
+
 /// The main() of a tool: --help/-h prints `usage`, --version the tool's name and
 /// version(), each exiting 0 before anything else; then run(parse(argc, argv)). A
 /// UsageError exits 2 and any other error 1, each with one line on stderr that starts
 /// with the tool's name.
 template <typename Parse, typename Run>
 int runTool(int argc, char** argv, const char* name, const char* usage, Parse parse, Run run) {
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
-      std::fputs(usage, stdout);
-      return 0;
-    } else if (std::string(argv[i]) == "--version") {
-      std::printf("%s %s\n", name, version());
-      return 0;
-    }
+  if (answerHelpOrVersion(argc, argv, name, usage)) return 0;
   try {
     run(parse(argc, argv));
   } catch (const UsageError& e) {

@@ -3,12 +3,19 @@
 // numbers, one a line, for test_link_client to compare with its own run.
 #include "link_scenario.hpp"
 
+#include <joint_load_estimator/command_line.hpp>
+
 #include <cstdio>
 #include <exception>
 
 int main(int argc, char** argv) {
+  const char* const usage =
+      "usage: link_client PANDA_URDF\n"
+      "Runs the link scenario (a client compiled with other flags than the core library) and\n"
+      "prints its numbers, one a line, for test_link_client.\n";
+  if (jle::cli::answerHelpOrVersion(argc, argv, "link_client", usage)) return 0;
   if (argc != 2) {
-    std::fprintf(stderr, "usage: %s PANDA_URDF\n", argv[0]);
+    std::fputs(usage, stderr);
     return 2;
   }
   try {

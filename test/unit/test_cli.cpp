@@ -907,6 +907,33 @@ TEST_F(CliTest, EveryExecutableHasHelpAndVersion) {
   }
 }
 
+// Every benchmark, study and test program built beside the tools (bench/CMakeLists.txt
+// lists those built: JLE_STUDY_PROGRAMS) answers --help with its usage on stdout and exits
+// 0 at once: none runs its study, reads its arguments as data or reaches for ROS.
+TEST_F(CliTest, EveryStudyProgramAnswersHelp) {
+#ifdef JLE_STUDY_PROGRAMS
+  std::vector<std::string> programs;
+  for (std::size_t begin = 0, end;; begin = end + 1) {
+    end = std::string(JLE_STUDY_PROGRAMS).find('|', begin);
+    programs.push_back(std::string(JLE_STUDY_PROGRAMS).substr(begin, end - begin));
+    if (end == std::string::npos) break;
+  }
+  EXPECT_GE(programs.size(), 6u);  // accuracy, the benchmarks, the study, soak
+  for (const std::string& program : programs) {
+    const std::string name = fs::path(program).filename().string();
+    const Result r =
+        run("env", {"ROS_MASTER_URI=http://127.0.0.1:9", "timeout", "10", program, "--help"});
+    EXPECT_EQ(r.status, 0) << name << ": " << r.err;
+    EXPECT_EQ(r.err, "") << name;
+    EXPECT_EQ(r.out.compare(0, 7 + name.size(), "usage: " + name), 0)
+        << name << ": " << r.out.substr(0, 80);
+    EXPECT_LT(r.out.size(), 2000u) << name << " did more than print its usage";
+  }
+#else
+  GTEST_SKIP() << "no benchmark or study program is built (CATKIN_ENABLE_TESTING off)";
+#endif
+}
+
 // -------------------------------------------------------------------------- rviz_config
 
 // rviz_config on the UR5 (its meshes are in a package that is not installed): a Wrench
