@@ -7,6 +7,7 @@
 
 #include <mutex>
 #include <stdexcept>
+#include <string>
 
 namespace jle {
 namespace {
@@ -25,9 +26,11 @@ const char* modelName(KalmanModel model) {
   return model == KalmanModel::kConstantAcceleration ? "constant_acceleration" : "constant_jerk";
 }
 
-// The server's view of `settings`.
-joint_load_estimator::EstimatorConfig toConfig(const Settings& settings) {
+// The server's view of `settings`, with `status`, the answer to the last change.
+joint_load_estimator::EstimatorConfig toConfig(const Settings& settings,
+                                               const std::string& status) {
   joint_load_estimator::EstimatorConfig c;
+  c.status = status;
   const DifferentiatorConfig& d = settings.estimator.differentiator;
   c.differentiator_type = typeName(d.type);
   c.differentiator_kalman_model = modelName(d.kalman_model);
@@ -79,7 +82,8 @@ void EstimatorNode::setUpReconfigure() {
   reconfigure_ =
       std::make_unique<dynamic_reconfigure::Server<joint_load_estimator::EstimatorConfig>>(
           reconfigure_mutex_, ros::NodeHandle(private_nh_, "reconfigure"));
-  joint_load_estimator::EstimatorConfig current = toConfig(settings_);
+  reconfigure_status_ = "the settings at start";
+  joint_load_estimator::EstimatorConfig current = toConfig(settings_, reconfigure_status_);
   reconfigure_->updateConfig(current);  // the node's settings, not the .cfg's defaults
   reconfigure_->setCallback([this](joint_load_estimator::EstimatorConfig& config,
                                    std::uint32_t level) { onReconfigure(config, level); });
@@ -102,17 +106,25 @@ void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
     settings_.base_residual_threshold = next.base_residual_threshold;
     settings_.still_velocity = next.still_velocity;
     params_ = params;
-    if (kept && !same)
-      ROS_INFO("reconfigure: decimation %d, thresholds applied (filters kept)",
-               settings_.estimator.decimation);
-    else if (!kept)
-      ROS_WARN("reconfigure: differentiator '%s' applied: the filters restart",
-               typeName(settings_.estimator.differentiator.type));
+    if (!kept) {
+      reconfigure_status_ = std::string("applied: differentiator '") +
+                            typeName(settings_.estimator.differentiator.type) +
+                            "': the filters restart";
+      ROS_WARN("reconfigure: %s", reconfigure_status_.c_str());
+    } else if (!same) {
+      reconfigure_status_ = "applied: decimation " +
+                            std::to_string(settings_.estimator.decimation) +
+                            ", thresholds (filters kept)";
+      ROS_INFO("reconfigure: %s", reconfigure_status_.c_str());
+    } else {
+      reconfigure_status_ = "applied: nothing changed";
+    }
   } catch (const std::exception& e) {
-    // Refused whole: the server shows what is in force.
-    ROS_ERROR("reconfigure refused: %s", e.what());
+    // Refused whole: the server shows what is in force, and why in `status`.
+    reconfigure_status_ = std::string("refused: ") + e.what();
+    ROS_ERROR("reconfigure %s", reconfigure_status_.c_str());
   }
-  config = toConfig(settings_);
+  config = toConfig(settings_, reconfigure_status_);
 }
 
 }  // namespace jle

@@ -157,6 +157,7 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
   // 2. decimation 2: every second sample, the filters kept (arm2's loads exactly).
   dynamic_reconfigure::Config c = reconfigure({{"decimation", 2}}, {}, {});
   EXPECT_EQ(intValue(c, "decimation"), 2);
+  EXPECT_EQ(strValue(c, "status"), "applied: decimation 2, thresholds (filters kept)");
   std::size_t before = loads1_.size();
   send(100);
   EXPECT_NEAR(static_cast<double>(loads1_.size() - before), 50.0, 1.0);
@@ -171,6 +172,7 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
   c = reconfigure({{"decimation", 1}, {"differentiator_window", 7}}, {},
                   {{"differentiator_type", "savitzky_golay"}});
   EXPECT_EQ(strValue(c, "differentiator_type"), "savitzky_golay");
+  EXPECT_EQ(strValue(c, "status"), "applied: differentiator 'savitzky_golay': the filters restart");
   before = loads1_.size();
   const long first = sent_;
   send(100);
@@ -185,10 +187,13 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
   }
   EXPECT_EQ(differ, static_cast<int>(loads1_.size() - before));
 
-  // 4. A bad value is refused whole (order 7 > 5): the settings in force are kept and
-  // the node publishes on.
+  // 4. A bad value is refused whole (order 7 > 5): the settings in force are kept, the
+  // answer says why where a client reads it (the config's `status`), and the node
+  // publishes on.
   c = reconfigure({{"differentiator_order", 7}}, {}, {});
   EXPECT_EQ(intValue(c, "differentiator_order"), 2);
+  EXPECT_EQ(strValue(c, "status").rfind("refused: ", 0), 0u) << strValue(c, "status");
+  EXPECT_NE(strValue(c, "status").find("order"), std::string::npos) << strValue(c, "status");
   EXPECT_EQ(strValue(c, "differentiator_type"), "savitzky_golay");
   before = loads1_.size();
   send(20);

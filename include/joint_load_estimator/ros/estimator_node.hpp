@@ -188,6 +188,7 @@ class EstimatorNode {
   XmlRpc::XmlRpcValue params_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, held by updateConfig() too
   std::unique_ptr<dynamic_reconfigure::Server<joint_load_estimator::EstimatorConfig>> reconfigure_;
+  std::string reconfigure_status_;  // ~reconfigure's `status`: the answer to the last change
 };
 
 }  // namespace jle
