@@ -84,6 +84,7 @@ endif()
 target_compile_definitions(test_settings PRIVATE
   JLE_TEST_CONFIG="${PROJECT_SOURCE_DIR}/test/config"
   JLE_DEFAULT_YAML="${PROJECT_SOURCE_DIR}/config/default.yaml"
+  JLE_RECONFIGURE_CFG="${PROJECT_SOURCE_DIR}/cfg/Estimator.cfg"
   JLE_README="${PROJECT_SOURCE_DIR}/README.md")
 # savings.planar: the planar 3x3 path against the 6x6 one and the paper's planar foot.
 jle_add_unit_test(test_planar unit/test_planar.cpp)

@@ -6,6 +6,8 @@
 
 #include <joint_load_estimator/config.hpp>
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -75,5 +77,24 @@ Settings parseSettings(const ParamValue& params);
 /// string). Throws SettingsError naming the file or saying what is wrong.
 ParamValue parseYaml(const std::string& text);
 ParamValue loadYaml(const std::string& path);
+
+/// The names of the settings' choices, as config/default.yaml, the reader and
+/// ~reconfigure (cfg/Estimator.cfg, checked against these by test_settings) spell them:
+/// the one table of each.
+template <typename Enum>
+struct Named {
+  const char* name;
+  Enum value;
+};
+extern const std::array<Named<DifferentiatorType>, 4> kDifferentiatorTypes;
+extern const std::array<Named<KalmanModel>, 2> kKalmanModels;
+extern const std::array<Named<StalePolicy>, 3> kStalePolicies;
+/// The name of `value` in `table`.
+template <typename Enum, std::size_t N>
+const char* nameOf(const std::array<Named<Enum>, N>& table, Enum value) {
+  for (const Named<Enum>& n : table)
+    if (n.value == value) return n.name;
+  return "?";
+}
 
 }  // namespace jle

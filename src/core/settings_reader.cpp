@@ -10,7 +10,33 @@
 #include <utility>
 
 namespace jle {
+
+const std::array<Named<DifferentiatorType>, 4> kDifferentiatorTypes = {
+    {{"finite_difference", DifferentiatorType::kFiniteDifference},
+     {"savitzky_golay", DifferentiatorType::kSavitzkyGolay},
+     {"kalman", DifferentiatorType::kKalman},
+     {"adaptive", DifferentiatorType::kAdaptive}}};
+const std::array<Named<KalmanModel>, 2> kKalmanModels = {
+    {{"constant_jerk", KalmanModel::kConstantJerk},
+     {"constant_acceleration", KalmanModel::kConstantAcceleration}}};
+const std::array<Named<StalePolicy>, 3> kStalePolicies = {
+    {{"hold", StalePolicy::kHold}, {"zero", StalePolicy::kZero}, {"stop", StalePolicy::kStop}}};
+
 namespace {
+
+// The other choices' names (the filters' are in the header: ~reconfigure shares them).
+const std::array<Named<PlanarMode>, 3> kPlanarModes = {
+    {{"auto", PlanarMode::kAuto}, {"on", PlanarMode::kOn}, {"off", PlanarMode::kOff}}};
+const std::array<Named<StampRegularize>, 2> kStampRegularize = {
+    {{"auto", StampRegularize::kAuto}, {"off", StampRegularize::kOff}}};
+const std::array<Named<ExternalMethod>, 2> kExternalMethods = {
+    {{"observer", ExternalMethod::kObserver}, {"residual", ExternalMethod::kResidual}}};
+const std::array<Named<Precision>, 2> kPrecisions = {
+    {{"double", Precision::kDouble}, {"float", Precision::kFloat}}};
+const std::array<Named<MeasuredVelocity>, 3> kMeasuredVelocities = {
+    {{"auto", MeasuredVelocity::kAuto},
+     {"always", MeasuredVelocity::kAlways},
+     {"never", MeasuredVelocity::kNever}}};
 
 using Type = ParamValue::Type;
 
@@ -28,12 +54,6 @@ double toNumber(const ParamValue& v, const std::string& key) {
 void valueOf(const ParamValue& v, int& out) { out = v.asInt(); }
 void valueOf(const ParamValue& v, bool& out) { out = v.asBool(); }
 void valueOf(const ParamValue& v, std::string& out) { out = v.asString(); }
-
-template <typename Enum>
-using Choices = std::initializer_list<std::pair<const char*, Enum>>;
-
-const Choices<StalePolicy> kStalePolicies = {
-    {"hold", StalePolicy::kHold}, {"zero", StalePolicy::kZero}, {"stop", StalePolicy::kStop}};
 
 // Maps the keys of one struct onto settings, remembering which were used so that the
 // rest can be reported as unknown. A key that is absent leaves its setting alone (its
@@ -91,26 +111,27 @@ class Section {
       out[i] = toNumber(v[static_cast<std::size_t>(i)], name(key) + "[" + std::to_string(i) + "]");
     return true;
   }
-  // One of the names of `options`, mapped to its value.
-  template <typename Enum>
-  void read(const std::string& key, Enum& out, Choices<Enum> options) {
+  // One of the names of `options` (a table of settings_reader.hpp), mapped to its value.
+  template <typename Enum, std::size_t N>
+  void read(const std::string& key, Enum& out, const std::array<Named<Enum>, N>& options) {
     if (!has(key)) return;
     std::string text, names;
     read(key, text);
-    for (const auto& o : options) {
-      if (text == o.first) {
-        out = o.second;
+    for (const Named<Enum>& o : options) {
+      if (text == o.name) {
+        out = o.value;
         return;
       }
-      names += std::string(names.empty() ? "" : ", ") + o.first;
+      names += std::string(names.empty() ? "" : ", ") + o.name;
     }
     throw SettingsError("parameter '" + name(key) + "' is '" + text + "'; expected one of " +
                         names);
   }
   // As above, or a boolean: rosparam reads YAML 1.1, where a bare on/off is one; take
   // it as meant (true: `on`, false: `off`).
-  template <typename Enum>
-  void read(const std::string& key, Enum& out, Choices<Enum> options, Enum on, Enum off) {
+  template <typename Enum, std::size_t N>
+  void read(const std::string& key, Enum& out, const std::array<Named<Enum>, N>& options, Enum on,
+            Enum off) {
     if (!has(key) || get(key).type() != Type::kBool) return read(key, out, options);
     bool value = false;
     read(key, value);
@@ -160,11 +181,7 @@ class Section {
 };
 
 void readDifferentiator(Section& s, DifferentiatorConfig& c) {
-  s.read("type", c.type,
-         {{"finite_difference", DifferentiatorType::kFiniteDifference},
-          {"savitzky_golay", DifferentiatorType::kSavitzkyGolay},
-          {"kalman", DifferentiatorType::kKalman},
-          {"adaptive", DifferentiatorType::kAdaptive}});
+  s.read("type", c.type, kDifferentiatorTypes);
   s.read("window", c.window);
   s.read("order", c.order);
   if (s.has("delay")) {
@@ -177,9 +194,7 @@ void readDifferentiator(Section& s, DifferentiatorConfig& c) {
     else
       wrongType(s.name("delay"), d, "an integer or \"centred\"");
   }
-  s.read("kalman_model", c.kalman_model,
-         {{"constant_acceleration", KalmanModel::kConstantAcceleration},
-          {"constant_jerk", KalmanModel::kConstantJerk}});
+  s.read("kalman_model", c.kalman_model, kKalmanModels);
   s.read("process_noise", c.process_noise);
   s.read("measurement_noise", c.measurement_noise);
   s.read("lag", c.lag);
@@ -199,14 +214,11 @@ void readSavings(Section& s, Savings& v) {
                 {"republish_unchanged", &v.republish_unchanged}});
   s.read<double>(
       {{"static_velocity", &v.static_velocity}, {"static_acceleration", &v.static_acceleration}});
-  s.read("planar", v.planar,
-         {{"auto", PlanarMode::kAuto}, {"on", PlanarMode::kOn}, {"off", PlanarMode::kOff}},
-         PlanarMode::kOn, PlanarMode::kOff);
+  s.read("planar", v.planar, kPlanarModes, PlanarMode::kOn, PlanarMode::kOff);
 }
 
 void readStamps(Section& s, StampSettings& v) {
-  s.read("regularize", v.regularize,
-         {{"auto", StampRegularize::kAuto}, {"off", StampRegularize::kOff}}, StampRegularize::kAuto,
+  s.read("regularize", v.regularize, kStampRegularize, StampRegularize::kAuto,
          StampRegularize::kOff);
   s.read("jump_confirm", v.jump_confirm);
 }
@@ -239,8 +251,7 @@ void readContact(Section& s, ContactLinkConfig& c) {
 
 void readExternalEffort(Section& s, ExternalEffortConfig& e) {
   s.read("enabled", e.enabled);
-  s.read("method", e.method,
-         {{"observer", ExternalMethod::kObserver}, {"residual", ExternalMethod::kResidual}});
+  s.read("method", e.method, kExternalMethods);
   s.read<double>({{"observer_cutoff", &e.observer_cutoff},
                   {"effort_noise", &e.effort_noise},
                   {"damping", &e.damping},
@@ -314,12 +325,8 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("inline_callbacks", n.inline_callbacks);
   s.read("decimation", n.estimator.decimation);
   s.read("gravity", n.estimator.gravity_world.data(), 3);
-  s.read("precision", n.estimator.precision,
-         {{"double", Precision::kDouble}, {"float", Precision::kFloat}});
-  s.read("measured_velocity", n.estimator.measured_velocity,
-         {{"auto", MeasuredVelocity::kAuto},
-          {"always", MeasuredVelocity::kAlways},
-          {"never", MeasuredVelocity::kNever}});
+  s.read("precision", n.estimator.precision, kPrecisions);
+  s.read("measured_velocity", n.estimator.measured_velocity, kMeasuredVelocities);
   s.read("body_mass", n.body_mass);
   s.read("base_residual_threshold", n.base_residual_threshold);
   s.read("still_velocity", n.still_velocity);

@@ -4,6 +4,7 @@
 // (parseSettings, which checks it); the decimation and the thresholds apply in place,
 // a new differentiator restarts the filters (Pipeline::retune).
 #include <joint_load_estimator/ros/estimator_node.hpp>
+#include <joint_load_estimator/settings_reader.hpp>
 
 #include <mutex>
 #include <stdexcept>
@@ -12,19 +13,7 @@
 namespace jle {
 namespace {
 
-const char* typeName(DifferentiatorType type) {
-  switch (type) {
-    case DifferentiatorType::kFiniteDifference: return "finite_difference";
-    case DifferentiatorType::kSavitzkyGolay: return "savitzky_golay";
-    case DifferentiatorType::kKalman: return "kalman";
-    case DifferentiatorType::kAdaptive: return "adaptive";
-  }
-  return "kalman";
-}
-
-const char* modelName(KalmanModel model) {
-  return model == KalmanModel::kConstantAcceleration ? "constant_acceleration" : "constant_jerk";
-}
+const char* typeName(DifferentiatorType type) { return nameOf(kDifferentiatorTypes, type); }
 
 // The server's view of `settings`, with `status`, the answer to the last change.
 joint_load_estimator::EstimatorConfig toConfig(const Settings& settings,
@@ -33,7 +22,7 @@ joint_load_estimator::EstimatorConfig toConfig(const Settings& settings,
   c.status = status;
   const DifferentiatorConfig& d = settings.estimator.differentiator;
   c.differentiator_type = typeName(d.type);
-  c.differentiator_kalman_model = modelName(d.kalman_model);
+  c.differentiator_kalman_model = nameOf(kKalmanModels, d.kalman_model);
   c.differentiator_process_noise = d.process_noise;
   c.differentiator_measurement_noise = d.measurement_noise;
   c.differentiator_window = d.window;

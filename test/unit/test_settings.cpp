@@ -463,6 +463,55 @@ TEST(SettingsReader, TypesNamesAndUnknownKeysAreRefusedNamingTheKey) {
 // ---------------------------------------------------------------------------------------
 // The documentation states the defaults of config.hpp.
 
+// One table of names (settings_reader.hpp): every name reads back as its value, the
+// reader refuses another naming them all, and ~reconfigure's enumerations
+// (cfg/Estimator.cfg, Python: it cannot include the table) list the same names in order.
+std::vector<std::string> quotedNamesAfter(const std::string& text, const std::string& from,
+                                          const std::string& to) {
+  const std::size_t begin = text.find(from), end = text.find(to, begin);
+  std::vector<std::string> names;
+  if (begin == std::string::npos || end == std::string::npos) return names;
+  const std::string part = text.substr(begin, end - begin);
+  const std::regex quoted("\"([a-z_]+)\"");
+  for (auto it = std::sregex_iterator(part.begin(), part.end(), quoted);
+       it != std::sregex_iterator(); ++it)
+    names.push_back((*it)[1]);
+  return names;
+}
+
+TEST(SettingsNames, OneTableForTheReaderAndReconfigure) {
+  std::vector<std::string> types, models;
+  for (const auto& n : jle::kDifferentiatorTypes) {
+    types.push_back(n.name);
+    const Settings s = parseText(std::string("differentiator: {type: ") + n.name + "}\n");
+    EXPECT_EQ(s.estimator.differentiator.type, n.value) << n.name;
+    EXPECT_STREQ(jle::nameOf(jle::kDifferentiatorTypes, n.value), n.name);
+  }
+  for (const auto& n : jle::kKalmanModels) {
+    models.push_back(n.name);
+    const Settings s = parseText(std::string("differentiator: {kalman_model: ") + n.name + "}\n");
+    EXPECT_EQ(s.estimator.differentiator.kalman_model, n.value) << n.name;
+  }
+  for (const auto& n : jle::kStalePolicies) {
+    const Settings s = parseText(
+        std::string("wrenches: [{topic: ft, link: panda_hand, stale_policy: ") + n.name + "}]\n");
+    EXPECT_EQ(s.estimator.wrenches.at(0).stale_policy, n.value) << n.name;
+  }
+  try {
+    parseText("differentiator: {type: butterworth}\n");
+    ADD_FAILURE() << "an unknown differentiator was accepted";
+  } catch (const jle::SettingsError& e) {
+    for (const std::string& t : types) EXPECT_NE(std::string(e.what()).find(t), std::string::npos);
+  }
+  std::ifstream in(JLE_RECONFIGURE_CFG);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string cfg = text.str();
+  EXPECT_EQ(quotedNamesAfter(cfg, "types = gen.enum(", "\"differentiator/type\")"), types);
+  EXPECT_EQ(quotedNamesAfter(cfg, "models = gen.enum(", "\"differentiator/kalman_model\")"),
+            models);
+}
+
 TEST(SettingsDocs, DefaultYamlIsSettingsDefaults) {
   expectSame(parseFile(JLE_DEFAULT_YAML), Settings{});
   // And parsing nothing is Settings{}: the reader writes no default of its own.
