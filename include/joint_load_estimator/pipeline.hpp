@@ -47,6 +47,12 @@ enum class Outcome : std::uint8_t {
   /// (yet) a confirmed jump of time, a wrench or plate ahead of the joint states by more
   /// than its timeout, or stamp 0 on a stream that has had stamps
   kRogueStamp,
+  /// A value no joint or sensor of the model produces (Settings::plausibility): a position
+  /// beyond its URDF limits or moving faster than its joint can, a wrench beyond the
+  /// bound; dropped before it reaches a filter
+  kImplausible,
+  /// Loads that are not finite: not published, the filters restarted
+  kNonFinite,
   kCount
 };
 
@@ -95,6 +101,23 @@ class FrameSource {
   virtual bool lookup(const std::string& target, const std::string& frame, Stamp stamp,
                       Eigen::Isometry3d& X_target_frame, std::string& error) = 0;
 };
+
+/// Why a record's loads are not to be trusted: LoadsRecord::status holds these bits, 0
+/// (kTrusted) when none applies. The node's JointLoads.status carries the same bits.
+enum LoadsStatus : std::uint8_t {
+  kTrusted = 0,
+  /// Within plausibility/settle_time after the filters (re)started (a start, a jump of
+  /// time, a gap, a retune, a confirmed jump of a position): the filters are settling.
+  kSettling = 1,
+  /// A needed wrench input or force plate was stale at the sample (its stale_policy
+  /// applied: held, read as zero).
+  kStaleInput = 2,
+  /// An effort beyond plausibility/effort_factor times its joint's URDF effort limit.
+  kImplausibleLoad = 4,
+};
+
+/// The bits of `status` in words ("settling, stale input"); "trusted" for 0.
+std::string describeStatus(std::uint8_t status);
 
 /// A wrench input (settings.wrenches[k]) as it entered one published sample.
 struct InputRecord {
@@ -162,7 +185,8 @@ struct LoadsRecord {
   /// link frame, about its origin) [N, N m], zero when the inputs explain the motion (a
   /// check of the model and the inputs). Zero for a fixed base.
   Eigen::Vector3d base_force = Eigen::Vector3d::Zero(), base_moment = Eigen::Vector3d::Zero();
-  bool planar = false;  ///< computed by the planar 3x3 path (savings.planar)
+  bool planar = false;             ///< computed by the planar 3x3 path (savings.planar)
+  std::uint8_t status = kTrusted;  ///< LoadsStatus bits: why the loads are not to be trusted
 };
 
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints,
@@ -328,6 +352,8 @@ class Pipeline {
     LoadsRecord record;
     std::vector<LoadsRecord> drained;
     std::size_t drained_next = 0;
+    double settle_from = 0.0;  // estimator time the filters last (re)started
+    bool restarted = true;     // the next sample starts the filters
   };
   // One joint sample entering the filters: its time, stamp and measured efforts.
   struct Sample {
@@ -362,6 +388,17 @@ class Pipeline {
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord(const Estimator& estimator, LoadsRecord& rec);
   void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
+  std::uint8_t statusOf(const Estimator& estimator, double settle_from,
+                        const LoadsRecord& rec) const;
+  static bool finiteLoads(const LoadsRecord& rec);
+  // Plausibility at the door (Settings::plausibility); false with problem_ set.
+  bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
+                           const std::vector<double>& position);
+  const std::vector<double>& plausibleVelocities(const std::vector<std::string>& names,
+                                                 const std::vector<double>& velocity);
+  bool plausibleWrench(InputKind kind, const std::string& topic, const Eigen::Vector3d& force,
+                       const Eigen::Vector3d& moment);
+  void restartFilters();
   void setUpExternal();
   void fillExternal();
   void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
@@ -411,6 +448,13 @@ class Pipeline {
   bool any_needed_ = false;  // the loads need at least one coordinate
   bool jumped_ = false;
   Stamp jump_from_ = 0, jump_to_ = 0;
+  // Plausibility: per coordinate its joint's segment (limits), the joint states refused
+  // in a row for moving too fast, and the velocities with the implausible ones as NaN.
+  std::vector<int> coordinate_segment_;
+  int implausible_run_ = 0;
+  std::vector<double> velocity_checked_;
+  double settle_from_ = 0.0;  // estimator time the immediate stream's filters (re)started
+  bool restarted_ = true;     // the next sample starts them
 };
 
 }  // namespace jle

@@ -180,7 +180,8 @@ void EstimatorNode::report(Outcome outcome) {
   if (last != 0.0 && now - last < kThrottle) return;
   last = now;
   // What no later message repairs is an error; order, staleness, a missing pose are not.
-  if (outcome == Outcome::kInvalid || outcome == Outcome::kWaiting || outcome == Outcome::kFrame)
+  if (outcome == Outcome::kInvalid || outcome == Outcome::kWaiting || outcome == Outcome::kFrame ||
+      outcome == Outcome::kNonFinite)
     ROS_ERROR("%s", pipeline_->problem().c_str());
   else
     ROS_WARN("%s", pipeline_->problem().c_str());
@@ -362,9 +363,13 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, inputs);
   else if (!stale.empty())
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale wrench inputs: " + stale);
+  else if (published > 0 && pipeline_->record().status != kTrusted)
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "loads not trusted: " + describeStatus(pipeline_->record().status));
   else
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "publishing");
   diagnoseLevel(status, published);  // what stops the loads comes first
+  status.add("last loads", describeStatus(pipeline_->record().status));
   external_outputs_.diagnose(status);
   status.add("mean latency [s]", latency_count_ ? latency_sum_ / latency_count_ : 0.0);
   status.add("max latency [s]", latency_max_);
@@ -433,6 +438,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("dropped: invalid", c.count(Outcome::kInvalid) + exceptions_);
   status.add("dropped: stamp order", c.count(Outcome::kOrder));
   status.add("dropped: rogue stamp", c.count(Outcome::kRogueStamp));
+  status.add("dropped: implausible", c.count(Outcome::kImplausible));
+  status.add("not published: non-finite loads", c.count(Outcome::kNonFinite));
   status.add("dropped: unresolved frame", c.count(Outcome::kFrame) + c.count(Outcome::kNoBasePose));
   status.add("dropped: no base pose", c.count(Outcome::kNoBasePose));
   status.add("not used: no needed joint", c.count(Outcome::kNoJoint));

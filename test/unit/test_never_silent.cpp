@@ -1,0 +1,302 @@
+// Never silently wrong (README): what jle::Pipeline does with values no robot produces
+// (a finite absurd position, a glitch inside the limits, an absurd wrench, loads that are
+// not finite) and how every record says whether it can be trusted (LoadsRecord::status:
+// settling after the filters start, a stale input, an implausible load). References: a
+// clean run of the same messages without the bad one (the loads after it must be equal),
+// the URDF's limits, and the stamps at which the filters started.
+#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/urdf_reader.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <vector>
+
+namespace {
+
+using jle::Outcome;
+using jle::Stamp;
+
+const std::string kData = JLE_TEST_DATA;
+constexpr Stamp kStart = 1700000000123456789;  // [ns]
+constexpr Stamp kMs = 1000000;
+const std::vector<double> kNone;
+
+jle::Model<double> ur5() { return jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf"); }
+
+// Joint i: 0.5 sin(w_i t + i), 0.3-1.0 Hz, within the UR5's limits and speeds.
+double q(int i, double t) { return 0.5 * std::sin(2.0 * M_PI * (0.3 + 0.14 * i) * t + i); }
+
+std::vector<double> positions(double t) {
+  std::vector<double> p(6);
+  for (int i = 0; i < 6; ++i) p[static_cast<std::size_t>(i)] = q(i, t);
+  return p;
+}
+
+// The stamps and efforts of the immediate stream's published records.
+using Loads = std::map<Stamp, std::vector<double>>;
+
+// Joint states k = 0..n-1 at 1 kHz; `change` may replace sample k's positions (a glitch)
+// and says whether to send it at all.
+Loads run(jle::Pipeline& p, const jle::Model<double>& model, int n,
+          const std::function<bool(int, std::vector<double>&)>& change,
+          std::vector<Outcome>* outcomes = nullptr) {
+  Loads out;
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> position = positions(1e-3 * k);
+    if (!change(k, position)) continue;
+    const Stamp stamp = kStart + k * kMs;
+    const Outcome o = p.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone);
+    if (outcomes) outcomes->push_back(o);
+    if (o == Outcome::kPublished) out[p.record().stamp] = p.record().effort;
+    while (p.takeDrained()) out[p.record().stamp] = p.record().effort;
+  }
+  return out;
+}
+
+// Every record of `got` equal to the clean run's at the same stamp within 1e-9, and the
+// clean run's records all there but the glitch's own stamp.
+void expectSameAsClean(const Loads& got, const Loads& clean, Stamp glitch) {
+  std::size_t compared = 0;
+  for (const auto& [stamp, effort] : clean) {
+    if (stamp == glitch) continue;
+    const auto it = got.find(stamp);
+    ASSERT_NE(it, got.end()) << "missing the record of " << stamp;
+    for (std::size_t i = 0; i < effort.size(); ++i)
+      EXPECT_NEAR(it->second[i], effort[i], 1e-9) << "stamp " << stamp << " joint " << i;
+    ++compared;
+  }
+  EXPECT_GT(compared, 400u);
+}
+
+}  // namespace
+
+// A finite absurd position (1e300, 100 rad) or a glitch inside the limits (+3 rad for one
+// sample, faster than the joint can move) is refused at the door, counted, and named; it
+// never reaches a filter: every later load equals the loads of the same stream without it.
+TEST(NeverSilent, AbsurdAndGlitchedPositionsAreRefusedAndPoisonNothing) {
+  const jle::Model<double> model = ur5();
+  const jle::Settings settings;
+  // The reference: the stream without the bad sample, whose loads are those of a clean
+  // filter (no sample 300).
+  jle::Pipeline clean(model, settings, nullptr);
+  const Loads reference = run(clean, model, 600, [](int k, std::vector<double>&) { return k != 300; });
+  for (const double bad : {1e300, 100.0, q(1, 0.3) + 3.0}) {
+    SCOPED_TRACE("joint 1 at " + std::to_string(bad));
+    jle::Pipeline p(model, settings, nullptr);
+    std::vector<Outcome> outcomes;
+    const Loads got = run(
+        p, model, 600,
+        [&](int k, std::vector<double>& position) {
+          if (k == 300) position[1] = bad;
+          return true;
+        },
+        &outcomes);
+    EXPECT_EQ(outcomes[300], Outcome::kImplausible);
+    EXPECT_EQ(p.counters().count(jle::InputKind::kJointState, Outcome::kImplausible), 1);
+    EXPECT_EQ(p.counters().resets, 0);
+    expectSameAsClean(got, reference, kStart + 300 * kMs);
+    for (const auto& [stamp, effort] : got)
+      for (double e : effort) ASSERT_TRUE(std::isfinite(e)) << stamp;
+  }
+  // The message names the joint, the value and the bound.
+  jle::Pipeline p(model, settings, nullptr);
+  run(p, model, 10, [](int, std::vector<double>&) { return true; });
+  std::vector<double> position = positions(0.01);
+  position[2] = 100.0;
+  EXPECT_EQ(p.onJointState(kStart + 10 * kMs, kStart + 10 * kMs, model.coordinate_names, position,
+                           kNone, kNone),
+            Outcome::kImplausible);
+  EXPECT_NE(p.problem().find("joint 'elbow_joint' is 100, beyond its URDF limits [-3.14159, "
+                             "3.14159]"),
+            std::string::npos)
+      << p.problem();
+}
+
+// A position that really moved at once (an encoder re-zeroed, a joint that slipped) is
+// refused until stamps/jump_confirm joint states agree with it; then it is taken, the
+// filters restart from it and the records say they are settling.
+TEST(NeverSilent, AConfirmedJumpRestartsTheFiltersAndIsFlaggedSettling) {
+  const jle::Model<double> model = ur5();
+  const jle::Settings settings;
+  jle::Pipeline p(model, settings, nullptr);
+  std::vector<Outcome> outcomes;
+  std::map<Stamp, std::uint8_t> status;
+  for (int k = 0; k < 400; ++k) {
+    std::vector<double> position = positions(1e-3 * k);
+    if (k >= 200) position[0] += 1.0;  // from sample 200 on
+    const Stamp stamp = kStart + k * kMs;
+    outcomes.push_back(
+        p.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone));
+    if (outcomes.back() == Outcome::kPublished) status[stamp] = p.record().status;
+  }
+  const int confirm = settings.stamps.jump_confirm;
+  for (int k = 200; k < 200 + confirm - 1; ++k) EXPECT_EQ(outcomes[k], Outcome::kImplausible) << k;
+  EXPECT_NE(outcomes[200 + confirm - 1], Outcome::kImplausible);
+  // Settling for settle_time from the restart, trusted after.
+  const double settle = settings.plausibility.settle_time;
+  int settling = 0, trusted_after = 0;
+  for (const auto& [stamp, s] : status) {
+    const double since = 1e-9 * static_cast<double>(stamp - (kStart + (200 + confirm - 1) * kMs));
+    if (since < 0.0) continue;
+    if (since < settle - 1.5e-3) {
+      EXPECT_TRUE(s & jle::kSettling) << since;
+      ++settling;
+    } else if (since > settle + 1.5e-3) {
+      EXPECT_EQ(s, jle::kTrusted) << since;
+      ++trusted_after;
+    }
+  }
+  EXPECT_GT(settling, 10);
+  EXPECT_GT(trusted_after, 100);
+}
+
+// Every start of the filters (the first samples, a jump back of time) flags the records
+// of the next settle_time as settling, in both streams; the others are trusted.
+TEST(NeverSilent, RecordsAfterEveryStartAreFlaggedSettling) {
+  const jle::Model<double> model = ur5();
+  const jle::Settings settings;
+  jle::Pipeline p(model, settings, nullptr);
+  const double settle = settings.plausibility.settle_time;
+  std::vector<std::pair<double, std::uint8_t>> immediate, smoothed;  // time since start
+  const auto feed = [&](Stamp start, int k) {
+    const Stamp stamp = start + k * kMs;
+    const Outcome o =
+        p.onJointState(stamp, stamp, model.coordinate_names, positions(1e-3 * k), kNone, kNone);
+    if (o == Outcome::kPublished)
+      immediate.emplace_back(1e-9 * static_cast<double>(p.record().stamp - start),
+                             p.record().status);
+    if (p.smoothedPublished())
+      smoothed.emplace_back(1e-9 * static_cast<double>(p.smoothedRecord().stamp - start),
+                            p.smoothedRecord().status);
+  };
+  for (int k = 0; k < 500; ++k) feed(kStart, k);
+  const Stamp back = kStart - 10000 * kMs;  // time jumps back: the filters restart
+  for (int k = 0; k < 1000; ++k) feed(back, k);
+  ASSERT_EQ(p.counters().resets, 1);
+  for (const auto* stream : {&immediate, &smoothed}) {
+    int settling = 0, trusted = 0;
+    for (const auto& [since, s] : *stream) {
+      // Relative to the first sample of each timeline; the filter's first estimate comes a
+      // few samples (warm-up) or the lag later.
+      if (since < settle) {
+        EXPECT_TRUE(s & jle::kSettling) << since;
+        ++settling;
+      } else if (since > settle + 0.01) {
+        EXPECT_FALSE(s & jle::kSettling) << since;
+        trusted += s == jle::kTrusted;
+      }
+    }
+    EXPECT_GT(trusted, 400);
+    if (stream == &immediate) EXPECT_GT(settling, 60);  // both starts
+  }
+  EXPECT_EQ(jle::describeStatus(jle::kSettling | jle::kStaleInput), "settling, stale input");
+  EXPECT_EQ(jle::describeStatus(jle::kTrusted), "trusted");
+}
+
+// A dead force/torque input no longer enters the loads (default stale_policy zero): the
+// loads are those without it, flagged stale input; with hold, it is held for max_hold
+// past its timeout, then zero, flagged throughout.
+TEST(NeverSilent, ADeadWrenchInputIsDroppedAndFlagged) {
+  const jle::Model<double> model = ur5();
+  for (const jle::StalePolicy policy : {jle::StalePolicy::kZero, jle::StalePolicy::kHold}) {
+    jle::Settings settings;
+    jle::WrenchInputConfig ft;
+    ft.name = "ft";
+    ft.link = "tool0";
+    if (policy == jle::StalePolicy::kHold) ft.stale_policy = policy;
+    ft.max_hold = 0.2;
+    settings.estimator.wrenches.push_back(ft);
+    jle::WrenchTopicSettings topic;
+    topic.topic = "ft";
+    settings.wrenches.push_back(topic);
+    jle::Settings bare;
+    jle::Pipeline p(model, settings, nullptr), without(model, bare, nullptr);
+    EXPECT_EQ(jle::WrenchInputConfig().stale_policy, jle::StalePolicy::kZero);
+    std::map<Stamp, std::pair<double, std::uint8_t>> got;
+    std::map<Stamp, double> reference;
+    for (int k = 0; k < 1500; ++k) {
+      const Stamp stamp = kStart + k * kMs;
+      if (k < 500)  // the sensor dies at 0.5 s
+        p.onWrench(0, stamp, stamp, "tool0", Eigen::Vector3d(0, 0, -40), Eigen::Vector3d::Zero());
+      const std::vector<double> position = positions(1e-3 * k);
+      if (p.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone) ==
+          Outcome::kPublished)
+        got[stamp] = {p.record().effort[1], p.record().status};
+      if (without.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone) ==
+          Outcome::kPublished)
+        reference[stamp] = without.record().effort[1];
+    }
+    const double timeout = ft.timeout;
+    for (const auto& [stamp, value] : got) {
+      const double t = 1e-3 * static_cast<double>((stamp - kStart) / kMs);
+      if (t < 0.1 || (t > 0.499 && t < 0.499 + timeout)) continue;  // settling; not yet stale
+      const bool stale = t > 0.499 + timeout + 1e-3;
+      EXPECT_EQ((value.second & jle::kStaleInput) != 0, stale) << t;
+      const bool zero =
+          stale && (policy == jle::StalePolicy::kZero || t > 0.499 + timeout + ft.max_hold + 0.06);
+      if (zero)  // the filtered wrench has decayed: the loads without it
+        EXPECT_NEAR(value.first, reference.at(stamp), 1e-6) << t;
+      else if (t > 0.2)  // the 40 N on the tool in the loads
+        EXPECT_GT(std::abs(value.first - reference.at(stamp)), 5.0) << t;
+    }
+  }
+}
+
+// A wrench no sensor reads (1e300 N; beyond plausibility/max_force) is refused, named and
+// counted; an effort beyond effort_factor times its URDF limit flags the record.
+TEST(NeverSilent, AbsurdWrenchesAreRefusedAndImplausibleLoadsFlagged) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  jle::WrenchInputConfig ft;
+  ft.name = "ft";
+  ft.link = "tool0";
+  settings.estimator.wrenches.push_back(ft);
+  jle::WrenchTopicSettings topic;
+  topic.topic = "ft";
+  settings.wrenches.push_back(topic);
+  jle::Pipeline p(model, settings, nullptr);
+  EXPECT_EQ(p.onWrench(0, kStart, kStart, "tool0", Eigen::Vector3d(0, 0, 1e300),
+                       Eigen::Vector3d::Zero()),
+            Outcome::kImplausible);
+  EXPECT_NE(p.problem().find("wrench 'ft': |force| 1e+300 N"), std::string::npos) << p.problem();
+  EXPECT_EQ(p.counters().count(jle::InputKind::kWrench, Outcome::kImplausible), 1);
+  // 3000 N at the tool: the shoulder's effort is far beyond 3 x its 150 N m.
+  std::uint8_t last = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Stamp stamp = kStart + k * kMs;
+    EXPECT_EQ(p.onWrench(0, stamp, stamp, "tool0", Eigen::Vector3d(3000, 0, 0),
+                         Eigen::Vector3d::Zero()),
+              Outcome::kUsed);
+    if (p.onJointState(stamp, stamp, model.coordinate_names, positions(1e-3 * k), kNone, kNone) ==
+        Outcome::kPublished)
+      last = p.record().status;
+  }
+  EXPECT_TRUE(last & jle::kImplausibleLoad);
+  EXPECT_FALSE(last & jle::kSettling);
+}
+
+// Loads that are not finite are never published: the filters restart, the message is
+// counted 'non-finite loads', and the loads come back finite. (The door is opened wide
+// here so that an absurd position reaches the filters.)
+TEST(NeverSilent, NonFiniteLoadsAreNeverPublished) {
+  const jle::Model<double> model = ur5();
+  jle::Settings settings;
+  settings.plausibility.position_margin = 1e308;
+  jle::Pipeline p(model, settings, nullptr);
+  int published_after = 0;
+  for (int k = 0; k < 400; ++k) {
+    std::vector<double> position = positions(1e-3 * k);
+    if (k == 200) position[1] = 1e300;
+    const Stamp stamp = kStart + k * kMs;
+    const Outcome o = p.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone);
+    if (o != Outcome::kPublished) continue;
+    for (double e : p.record().effort) ASSERT_TRUE(std::isfinite(e)) << k;
+    published_after += k > 200;
+  }
+  EXPECT_GE(p.counters().count(jle::InputKind::kJointState, Outcome::kNonFinite), 1);
+  EXPECT_GT(published_after, 150);
+}
