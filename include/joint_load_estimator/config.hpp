@@ -339,12 +339,16 @@ struct SmoothedStreamSettings {
 /// silently wrong"): a finite absurd value must not reach the filters.
 struct PlausibilityConfig {
   /// [rad or m] >= 0: a position beyond its joint's URDF limits by more than this is
-  /// refused (the message dropped, counted 'implausible').
-  double position_margin = 0.1;
-  /// >= 1: a position moving from the last sample faster than this times its joint's
-  /// URDF velocity limit (max_velocity where the URDF has none) is refused, unless
-  /// stamps/jump_confirm joint states in a row agree with it: then the filters restart
-  /// from it. Measured velocities beyond it are not used (as a non-finite one).
+  /// refused (the message dropped, counted 'implausible'). 1: a recording a little
+  /// beyond its URDF's limits (a calibration offset, a simulated trajectory) is taken;
+  /// what no joint reaches (100 rad, 1e300) is not.
+  double position_margin = 1.0;
+  /// [rad or m] >= 0, and >= 1: a position moving from the last sample by more than
+  /// step_margin plus velocity_factor times its joint's URDF velocity limit (max_velocity
+  /// where the URDF has none) times the interval is refused, unless stamps/jump_confirm
+  /// joint states in a row agree with it: then the filters restart from it. Measured
+  /// velocities beyond velocity_factor times the limit are not used (as a non-finite one).
+  double step_margin = 0.1;
   double velocity_factor = 3.0;
   double max_velocity = 100.0;  ///< [rad/s or m/s] > 0, where the URDF gives no limit
   /// [N], [N m] > 0: a wrench or plate reading whose force or moment is larger is refused.

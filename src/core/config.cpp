@@ -216,6 +216,7 @@ void validate(const Settings& settings) {
 
 void validate(const PlausibilityConfig& p) {
   nonNegative("plausibility/position_margin", p.position_margin);
+  nonNegative("plausibility/step_margin", p.step_margin);
   if (!(p.velocity_factor >= 1.0) || !std::isfinite(p.velocity_factor))
     fail("plausibility/velocity_factor",
          "must be finite and >= 1, it is " + number(p.velocity_factor));

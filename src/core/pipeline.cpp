@@ -790,7 +790,7 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
     if (dt <= 0.0 || !joints_.received(c) || too_fast) continue;
     const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
     const double step = std::abs(q - joints_.q()[static_cast<std::size_t>(c)]);
-    if (step <= p.velocity_factor * limit * dt + p.position_margin) continue;
+    if (step <= p.velocity_factor * limit * dt + p.step_margin) continue;
     too_fast = true;
     std::snprintf(text, sizeof text,
                   ": position of joint '%s' moved %.6g in %.6g s, beyond plausibility/"

@@ -368,6 +368,7 @@ Settings parseSettings(const ParamValue& params) {
   s.readMap("plausibility", [&](Section& m) {
     PlausibilityConfig& p = n.plausibility;
     m.read<double>({{"position_margin", &p.position_margin},
+                    {"step_margin", &p.step_margin},
                     {"velocity_factor", &p.velocity_factor},
                     {"max_velocity", &p.max_velocity},
                     {"max_force", &p.max_force},

@@ -83,7 +83,8 @@ TEST(NeverSilent, AbsurdAndGlitchedPositionsAreRefusedAndPoisonNothing) {
   // The reference: the stream without the bad sample, whose loads are those of a clean
   // filter (no sample 300).
   jle::Pipeline clean(model, settings, nullptr);
-  const Loads reference = run(clean, model, 600, [](int k, std::vector<double>&) { return k != 300; });
+  const Loads reference =
+      run(clean, model, 600, [](int k, std::vector<double>&) { return k != 300; });
   for (const double bad : {1e300, 100.0, q(1, 0.3) + 3.0}) {
     SCOPED_TRACE("joint 1 at " + std::to_string(bad));
     jle::Pipeline p(model, settings, nullptr);
@@ -191,7 +192,9 @@ TEST(NeverSilent, RecordsAfterEveryStartAreFlaggedSettling) {
       }
     }
     EXPECT_GT(trusted, 400);
-    if (stream == &immediate) EXPECT_GT(settling, 60);  // both starts
+    if (stream == &immediate) {
+      EXPECT_GT(settling, 60);  // both starts
+    }
   }
   EXPECT_EQ(jle::describeStatus(jle::kSettling | jle::kStaleInput), "settling, stale input");
   EXPECT_EQ(jle::describeStatus(jle::kTrusted), "trusted");
@@ -238,10 +241,11 @@ TEST(NeverSilent, ADeadWrenchInputIsDroppedAndFlagged) {
       EXPECT_EQ((value.second & jle::kStaleInput) != 0, stale) << t;
       const bool zero =
           stale && (policy == jle::StalePolicy::kZero || t > 0.499 + timeout + ft.max_hold + 0.06);
-      if (zero)  // the filtered wrench has decayed: the loads without it
+      if (zero) {  // the filtered wrench has decayed: the loads without it
         EXPECT_NEAR(value.first, reference.at(stamp), 1e-6) << t;
-      else if (t > 0.2)  // the 40 N on the tool in the loads
+      } else if (t > 0.2) {  // the 40 N on the tool in the loads
         EXPECT_GT(std::abs(value.first - reference.at(stamp)), 5.0) << t;
+      }
     }
   }
 }
@@ -259,18 +263,18 @@ TEST(NeverSilent, AbsurdWrenchesAreRefusedAndImplausibleLoadsFlagged) {
   topic.topic = "ft";
   settings.wrenches.push_back(topic);
   jle::Pipeline p(model, settings, nullptr);
-  EXPECT_EQ(p.onWrench(0, kStart, kStart, "tool0", Eigen::Vector3d(0, 0, 1e300),
-                       Eigen::Vector3d::Zero()),
-            Outcome::kImplausible);
+  EXPECT_EQ(
+      p.onWrench(0, kStart, kStart, "tool0", Eigen::Vector3d(0, 0, 1e300), Eigen::Vector3d::Zero()),
+      Outcome::kImplausible);
   EXPECT_NE(p.problem().find("wrench 'ft': |force| 1e+300 N"), std::string::npos) << p.problem();
   EXPECT_EQ(p.counters().count(jle::InputKind::kWrench, Outcome::kImplausible), 1);
   // 3000 N at the tool: the shoulder's effort is far beyond 3 x its 150 N m.
   std::uint8_t last = 0;
   for (int k = 0; k < 200; ++k) {
     const Stamp stamp = kStart + k * kMs;
-    EXPECT_EQ(p.onWrench(0, stamp, stamp, "tool0", Eigen::Vector3d(3000, 0, 0),
-                         Eigen::Vector3d::Zero()),
-              Outcome::kUsed);
+    EXPECT_EQ(
+        p.onWrench(0, stamp, stamp, "tool0", Eigen::Vector3d(3000, 0, 0), Eigen::Vector3d::Zero()),
+        Outcome::kUsed);
     if (p.onJointState(stamp, stamp, model.coordinate_names, positions(1e-3 * k), kNone, kNone) ==
         Outcome::kPublished)
       last = p.record().status;
