@@ -346,14 +346,21 @@ class Pipeline {
     bool stamped = false;
   };
   // The smoothed stream: its estimator, its record, and its loads drained by a reset.
+  // When a stream's filters last (re)started: at the first sample after a reset (a
+  // start, a jump of time, a restart for non-finite loads), or at the first of a warm-up
+  // (a gap or a retune restarts them inside the estimator).
+  struct Settle {
+    double from = 0.0;      // estimator time [s] of that sample
+    bool restarted = true;  // the next sample taken starts the filters
+    bool warming = false;   // the last sample taken was a warm-up one
+  };
   struct Stream {
     Stream(const Model<double>& model, const EstimatorConfig& config) : estimator(model, config) {}
     Estimator estimator;
     LoadsRecord record;
     std::vector<LoadsRecord> drained;
     std::size_t drained_next = 0;
-    double settle_from = 0.0;  // estimator time the filters last (re)started
-    bool restarted = true;     // the next sample starts the filters
+    Settle settle;
   };
   // One joint sample entering the filters: its time, stamp and measured efforts.
   struct Sample {
@@ -390,6 +397,7 @@ class Pipeline {
   void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
   std::uint8_t statusOf(const Estimator& estimator, double settle_from,
                         const LoadsRecord& rec) const;
+  static void noteStart(Settle& settle, SampleStatus status, double t);
   static bool finiteLoads(const LoadsRecord& rec);
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
   bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
@@ -453,8 +461,7 @@ class Pipeline {
   std::vector<int> coordinate_segment_;
   int implausible_run_ = 0;
   std::vector<double> velocity_checked_;
-  double settle_from_ = 0.0;  // estimator time the immediate stream's filters (re)started
-  bool restarted_ = true;     // the next sample starts them
+  Settle settle_;  // the immediate stream's
 };
 
 }  // namespace jle

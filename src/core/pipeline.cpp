@@ -298,8 +298,8 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
-  restarted_ = true;
-  if (smoothed_) smoothed_->restarted = true;
+  settle_.restarted = true;
+  if (smoothed_) smoothed_->settle.restarted = true;
   implausible_run_ = 0;
   if (external_) external_->reset();
   clock_.reset();
@@ -495,12 +495,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   const double t = relative(clock_.add(stamp));
   const SampleStatus status =
       estimator_.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
-  if (status == SampleStatus::kWarmingUp ||
-      (restarted_ && status != SampleStatus::kDuplicate && status != SampleStatus::kOutOfOrder &&
-       status != SampleStatus::kNonFinite)) {
-    settle_from_ = t;  // the filters (re)start: the settling time counts from here
-    restarted_ = false;
-  }
+  noteStart(settle_, status, t);
   switch (status) {
     case SampleStatus::kDuplicate:
     case SampleStatus::kOutOfOrder: return order(status);
@@ -534,16 +529,13 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
   Stream& stream = *smoothed_;
   Estimator& e = stream.estimator;
   const SampleStatus status = e.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
-  if (status == SampleStatus::kWarmingUp || stream.restarted) {
-    stream.settle_from = t;
-    stream.restarted = false;
-  }
+  noteStart(stream.settle, status, t);
   smoothed_published_ = status == SampleStatus::kPublished &&
                         !(e.lastWasReused() && !settings_.estimator.savings.republish_unchanged);
   if (smoothed_published_) fillRecord(e, stream.record);
   if (smoothed_published_ && !finiteLoads(stream.record)) {  // counted by the immediate stream
     e.reset();
-    stream.restarted = true;
+    stream.settle.restarted = true;
     smoothed_published_ = false;
   }
 }
@@ -700,7 +692,7 @@ void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
   }
   fillSideOutputs(estimator, rec);
   rec.status =
-      statusOf(estimator, &estimator == &estimator_ ? settle_from_ : smoothed_->settle_from, rec);
+      statusOf(estimator, &estimator == &estimator_ ? settle_.from : smoothed_->settle.from, rec);
   if (external_ && &rec == &record_) fillExternal();
 }
 
@@ -720,6 +712,18 @@ std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
   return status;
 }
 
+void Pipeline::noteStart(Settle& settle, SampleStatus status, double t) {
+  if (status == SampleStatus::kDuplicate || status == SampleStatus::kOutOfOrder ||
+      status == SampleStatus::kNonFinite)
+    return;  // not taken
+  // The settling time counts from the filters' first sample, not from their first
+  // estimate: the warm-up (or the smoother's lag) is part of it.
+  const bool warming = status == SampleStatus::kWarmingUp;
+  if (settle.restarted || (warming && !settle.warming)) settle.from = t;
+  settle.restarted = false;
+  settle.warming = warming;
+}
+
 bool Pipeline::finiteLoads(const LoadsRecord& rec) {
   for (std::size_t i = 0; i < rec.effort.size(); ++i)
     if (!std::isfinite(rec.effort[i]) || !rec.force[i].allFinite() || !rec.moment[i].allFinite())
@@ -733,8 +737,8 @@ void Pipeline::restartFilters() {
   drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
-  restarted_ = true;
-  if (smoothed_) smoothed_->restarted = true;
+  settle_.restarted = true;
+  if (smoothed_) smoothed_->settle.restarted = true;
   ring_count_ = 0;
   last_stamp_ = 0;
 }
@@ -755,12 +759,14 @@ bool Pipeline::plausibleWrench(InputKind kind, const std::string& input,
                                const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
   (void)kind;
   const PlausibilityConfig& p = settings_.plausibility;
-  if (force.norm() <= p.max_force && moment.norm() <= p.max_moment) return true;
+  // stableNorm: the norm of (0, 0, 1e300) is 1e300, not the inf of its square's root.
+  const double f = force.stableNorm(), m = moment.stableNorm();
+  if (f <= p.max_force && m <= p.max_moment) return true;
   char text[160];
   std::snprintf(text, sizeof text,
                 ": |force| %.6g N, |moment| %.6g N m beyond plausibility/max_force %.6g N or "
                 "max_moment %.6g N m: dropped",
-                force.norm(), moment.norm(), p.max_force, p.max_moment);
+                f, m, p.max_force, p.max_moment);
   problem_ = input + text;
   return false;
 }
@@ -883,7 +889,6 @@ bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation
   validate(next);  // throws naming the key, changing nothing
   if (!sameDifferentiator(differentiator, estimator_.config().differentiator)) drainSmoother();
   const bool kept = estimator_.retune(differentiator, decimation);
-  if (!kept) restarted_ = true;
   if (smoothed_)  // its own filter kept; the decimation is the node's
     smoothed_->estimator.retune(smoothed_->estimator.config().differentiator, decimation);
   settings_.estimator.differentiator = differentiator;
