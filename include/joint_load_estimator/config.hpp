@@ -359,6 +359,10 @@ struct PlausibilityConfig {
   /// [s] >= 0: the records of the first this-many seconds after the filters (re)start (a
   /// start, a jump of time, a gap, a retune) are flagged settling.
   double settle_time = 0.05;
+  /// [rad or m] >= 0: a mimic joint's published position farther than this from what its
+  /// leader's (in the same message) gives contradicts the model: counted and warned (the
+  /// model's value is used).
+  double mimic_tolerance = 0.01;
 };
 
 struct Settings {

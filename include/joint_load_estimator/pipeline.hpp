@@ -82,6 +82,9 @@ struct PipelineCounters {
   /// Estimator::addJointSample takes its velocity filter's prediction; the loads are
   /// computed)
   long nonfinite_velocities = 0;
+  /// joint states with a mimic joint's position contradicting its leader's (beyond
+  /// plausibility/mimic_tolerance; the model's value is used)
+  long mimic_contradictions = 0;
 
   long received(InputKind kind) const;
   long count(InputKind kind, Outcome outcome) const {
@@ -263,6 +266,9 @@ class Pipeline {
   const std::string& nonFiniteEffort() const { return nonfinite_effort_; }
   /// The first joint of the last joint state whose velocity was not finite, or empty.
   const std::string& nonFiniteVelocity() const { return nonfinite_velocity_; }
+  /// The last joint state's first mimic joint whose position contradicts its leader's, in
+  /// words ("joint 'b' is 0.5, its leader 'a' gives 0.3"), or empty.
+  const std::string& mimicContradiction() const { return mimic_contradiction_; }
   /// The first coordinate the computed loads need that has had no position yet, or empty.
   const std::string& missingJoint() const;
   /// The topics of the inputs with stale_policy stop that were stale at the last joint
@@ -406,7 +412,9 @@ class Pipeline {
                                                  const std::vector<double>& velocity);
   bool plausibleWrench(InputKind kind, const std::string& topic, const Eigen::Vector3d& force,
                        const Eigen::Vector3d& moment);
-  void restartFilters();
+  // The filters start again from the next sample. drain: the smoother's pending samples
+  // are published first (their state is good); else they are dropped (poisoned).
+  void restartFilters(bool drain);
   void setUpExternal();
   void fillExternal();
   void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
@@ -453,6 +461,7 @@ class Pipeline {
   std::vector<Sample> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;
   std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
+  std::string mimic_contradiction_;
   bool any_needed_ = false;  // the loads need at least one coordinate
   bool jumped_ = false;
   Stamp jump_from_ = 0, jump_to_ = 0;

@@ -226,6 +226,7 @@ void validate(const PlausibilityConfig& p) {
   if (!(p.effort_factor >= 1.0) || !std::isfinite(p.effort_factor))
     fail("plausibility/effort_factor", "must be finite and >= 1, it is " + number(p.effort_factor));
   nonNegative("plausibility/settle_time", p.settle_time);
+  nonNegative("plausibility/mimic_tolerance", p.mimic_tolerance);
 }
 
 }  // namespace jle

@@ -153,8 +153,8 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     : settings_(checkedSettings(model, settings)),
       frames_(frames),
       estimator_(model, settings_.estimator),
-      joints_(estimator_.model(),
-              publishedSegments(estimator_.model(), settings_.estimator.joints)),
+      joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints),
+              settings_.plausibility.mimic_tolerance),
       wrenches_(settings_.estimator.wrenches.size()),
       plates_(settings_.estimator.plates.size()),
       clock_(settings_.stamps.regularize == StampRegularize::kAuto),
@@ -425,6 +425,16 @@ void Pipeline::mapJointState(const std::vector<std::string>& names,
     nonfinite_velocity_ = names[bad];
     ++counters_.nonfinite_velocities;
   }
+  mimic_contradiction_.clear();
+  if (joints_.mimicContradiction() >= 0) {
+    const std::size_t i = static_cast<std::size_t>(joints_.mimicContradiction());
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "' is %.6g, but its leader makes it %.6g (URDF <mimic>): ", position[i],
+                  joints_.mimicExpected());
+    mimic_contradiction_ = "mimic joint '" + names[i] + text + "the model's value is used";
+    ++counters_.mimic_contradictions;
+  }
   if (unknown < 0) {
     unknown_joint_.clear();
     return;
@@ -443,6 +453,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   unknown_joint_.clear();
   nonfinite_effort_.clear();
   nonfinite_velocity_.clear();
+  mimic_contradiction_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
   jumped_ = false;
   // Neither a sample nor a time: its stamp and clock are not the stream's.
@@ -515,7 +526,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
     return count(kind, Outcome::kUnchanged);
   fillRecord(estimator_, record_);
   if (!finiteLoads(record_)) {
-    restartFilters();
+    restartFilters(false);  // what made them not finite is in the filters' state
     return fail(kind, Outcome::kNonFinite,
                 settings_.joint_states_topic + ": the loads at " + seconds(stamp) +
                     " are not finite: not published, the filters restart");
@@ -731,16 +742,15 @@ bool Pipeline::finiteLoads(const LoadsRecord& rec) {
   return rec.base_force.allFinite() && rec.base_moment.allFinite();
 }
 
-void Pipeline::restartFilters() {
-  // What made the loads not finite is in the filters' state: they start again (the wrench
-  // and plate buffers, raw readings, are kept).
-  drainSmoother();
+void Pipeline::restartFilters(bool drain) {
+  // The wrench and plate readings are forgotten too (Estimator::reset): the next ones
+  // refill them.
+  if (drain) drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
   settle_.restarted = true;
   if (smoothed_) smoothed_->settle.restarted = true;
-  ring_count_ = 0;
-  last_stamp_ = 0;
+  ring_count_ = 0;  // the stamps of the samples the filters held; the stamps' order stays
 }
 
 std::string describeStatus(std::uint8_t status) {
@@ -813,7 +823,7 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   if (++implausible_run_ < settings_.stamps.jump_confirm) return false;
   implausible_run_ = 0;
   problem_.clear();
-  restartFilters();
+  restartFilters(true);  // the samples before the jump are good
   return true;
 }
 
@@ -939,11 +949,12 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   jumped_ = false;
   if (!zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, "wrench '" + topic + "'" + kZeroStamp);
-  if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
-    return count(kind, Outcome::kImplausible);
+  // The stamps first, as for a joint state: the clock is followed whatever the values.
   const Outcome timeline = checkInputStamp(
       kind, "wrench '" + topic + "'", settings_.estimator.wrenches[ix(k)].timeout, stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
+  if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
+    return count(kind, Outcome::kImplausible);
   if (!resolveWrenchFrame(k, frame, stamp)) return count(kind, Outcome::kFrame);
   const WrenchInput& input = wrenches_[ix(k)];
   // The sensor's offset is in its own frame and sign: removed before anything else.
@@ -994,8 +1005,6 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
   if (!force.allFinite() || !moment.allFinite())
     return fail(kind, Outcome::kInvalid,
                 "force plate '" + name + "': non-finite force or torque: dropped");
-  if (!plausibleWrench(kind, "force plate '" + name + "'", force, moment))
-    return count(kind, Outcome::kImplausible);
   const PlateTopicSettings& configured = settings_.force_plates[ix(k)];
   const std::string& frame = configured.frame.empty() ? frame_id : configured.frame;
   if (frame.empty() && !configured.pose_configured)
@@ -1008,6 +1017,8 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
   const Outcome timeline = checkInputStamp(kind, "force plate '" + name + "'",
                                            settings_.estimator.plates[ix(k)].timeout, stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
+  if (!plausibleWrench(kind, "force plate '" + name + "'", force, moment))
+    return count(kind, Outcome::kImplausible);
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
   const double t = relative(stamp);
   if (smoothed_) smoothed_->estimator.addPlateSample(k, t, force, moment);  // the same order

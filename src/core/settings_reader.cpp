@@ -374,7 +374,8 @@ Settings parseSettings(const ParamValue& params) {
                     {"max_force", &p.max_force},
                     {"max_moment", &p.max_moment},
                     {"effort_factor", &p.effort_factor},
-                    {"settle_time", &p.settle_time}});
+                    {"settle_time", &p.settle_time},
+                    {"mimic_tolerance", &p.mimic_tolerance}});
   });
   s.readMap("external_effort", [&](Section& m) { readExternalEffort(m, n.external_effort); });
   s.readMap("differentiator",

@@ -218,6 +218,15 @@ void checkInertia(const LinkDesc& link, const ModelOptions& options,
     warnings.push_back(violation + nonphysicalNote(link.name));
   };
   if (link.mass < 0.0) fail(what + ": negative mass " + std::to_string(link.mass));
+  if (link.mass == 0.0 && !link.inertia.isZero(0.0)) {
+    // Taken as given (its moments enter the loads), but no body turns without weight: a
+    // CAD export's placeholder, or a mass left out.
+    std::ostringstream os;
+    os << what << ": mass 0 with a nonzero inertia (ixx " << link.inertia(0, 0) << ", iyy "
+       << link.inertia(1, 1) << ", izz " << link.inertia(2, 2)
+       << " kg m^2): taken as given; give the link its mass, or zero its inertia";
+    warnings.push_back(os.str());
+  }
   Eigen::SelfAdjointEigenSolver<Matrix3> eig(link.inertia, Eigen::EigenvaluesOnly);
   const Vector3 l = eig.eigenvalues();  // ascending
   // Relative tolerance: the URDFs we read print their inertias with 6 to 9 digits.

@@ -16,6 +16,17 @@ constexpr double kSilence = 1.0;
 // subscriber (in a queue of the same process or of TCP) is replaced by a new one.
 constexpr std::size_t kLoadsPool = 8;
 
+// Under use_sim_time, ros::Time::now() is 0 until the first /clock message: a stamp 0
+// cannot be replaced by the clock (every one reads as a duplicate of the last), and a
+// jump of time the clock shows is not seen. Said by wall time: ROS_*_THROTTLE counts by
+// ros::Time, which stands still at 0.
+const char* const kNoClock =
+    "use_sim_time is true but no /clock message has come (ros::Time::now() is 0): a joint "
+    "state stamped 0 cannot take the clock's time and jumps of time go unseen; publish "
+    "/clock (rosbag play --clock) or set use_sim_time false";
+
+bool noClock() { return ros::Time::isSimTime() && ros::Time::now().isZero(); }
+
 }  // namespace
 
 EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
@@ -68,6 +79,19 @@ EstimatorNode::~EstimatorNode() {
 Model<double> EstimatorNode::loadModel() {
   std::string urdf;
   const std::string param = nh_.resolveName(settings_.robot_description);
+  // Not set yet: a launch file whose robot_state_publisher or xacro step comes later, a
+  // description loaded by hand. Waited for (said every 5 s), never taken for an error.
+  ros::WallTime said;
+  while (!nh_.hasParam(settings_.robot_description) && ros::ok()) {
+    if (said.isZero() || (ros::WallTime::now() - said).toSec() >= 5.0) {
+      said = ros::WallTime::now();
+      ROS_WARN("waiting for the parameter '%s' (robot_description): not set yet", param.c_str());
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  if (!ros::ok())
+    throw SettingsError("shut down while waiting for the parameter '" + param +
+                        "' (robot_description)");
   if (!nh_.getParam(settings_.robot_description, urdf))
     throw SettingsError("parameter '" + param +
                         "' (robot_description) is not set or is not a string");
@@ -168,6 +192,9 @@ void EstimatorNode::report(Outcome outcome) {
                       "%s: velocity of joint '%s' is not finite: that velocity is not used "
                       "(the velocity filter's prediction instead)",
                       settings_.joint_states_topic.c_str(), pipeline_->nonFiniteVelocity().c_str());
+  if (!pipeline_->mimicContradiction().empty())
+    ROS_WARN_THROTTLE(kThrottle, "%s: %s", settings_.joint_states_topic.c_str(),
+                      pipeline_->mimicContradiction().c_str());
   // A gripper's own joint states are normal: said once, counted in the diagnostics.
   if (outcome == Outcome::kNoJoint) {
     ROS_INFO_ONCE("%s (counted under 'not used: no needed joint')", pipeline_->problem().c_str());
@@ -207,6 +234,14 @@ void EstimatorNode::onJointState(const JointStateEvent& event) {
   queue_wait_max_ = std::max(queue_wait_max_, queue_wait);
   ++queue_wait_count_;
   const sensor_msgs::JointState& msg = *event.getConstMessage();
+  if (received.isZero() && ros::Time::isSimTime()) {
+    static double said = 0.0;  // wall time [s]; callbacks are serialized (callbacks_mutex_)
+    const double wall = ros::WallTime::now().toSec();
+    if (wall - said >= kThrottle) {
+      said = wall;
+      ROS_WARN("%s", kNoClock);
+    }
+  }
   try {
     applyPendingBias();
     const Outcome outcome = feed(*pipeline_, msg, received);
@@ -407,6 +442,8 @@ void EstimatorNode::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& s
   else if (last_joint_outcome_ == Outcome::kStale)
     status.summary(DiagnosticStatus::ERROR,
                    "not publishing: input '" + pipeline_->stoppingInputs() + "' stale");
+  else if (noClock())
+    status.summary(DiagnosticStatus::WARN, "use_sim_time without /clock");
   else if (published == 0)
     status.summary(DiagnosticStatus::WARN, "no loads published yet");
 }
@@ -448,6 +485,7 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("messages with unknown joints", c.unknown_joints);
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
   status.add("velocities not used: non-finite", c.nonfinite_velocities);
+  status.add("mimic joints contradicting their leader", c.mimic_contradictions);
   status.add("joints with measured velocities", pipeline_->velocitiesUsed());
   status.add("not published: stale input", c.count(Outcome::kStale));
   status.add("time jumps back", c.backJumps());

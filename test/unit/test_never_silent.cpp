@@ -340,3 +340,45 @@ TEST(NeverSilent, NonFiniteLoadsAreNeverPublished) {
   std::printf("flagged implausible %d, worst late difference %.3g N m\n", flagged, worst_late);
   EXPECT_LT(worst_late, 1e-9);
 }
+
+// A mimic joint published with a value its leader (in the same message) does not give:
+// counted, named with both values, and the model's value used (the loads equal those of
+// the same messages without the mimic joint); within mimic_tolerance it is not counted.
+TEST(NeverSilent, AMimicJointContradictingItsLeaderIsCountedAndNamed) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/panda.urdf");
+  ASSERT_EQ(model.nq, 8);  // panda_finger_joint2 mimics panda_finger_joint1
+  const jle::Settings settings;
+  jle::Pipeline p(model, settings, nullptr), without(model, settings, nullptr);
+  std::vector<std::string> names = model.coordinate_names;
+  names.push_back("panda_finger_joint2");
+  int compared = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double t = 1e-3 * k;
+    std::vector<double> position(8);
+    for (int i = 0; i < 7; ++i) position[static_cast<std::size_t>(i)] = 0.3 * std::sin(t + i);
+    position[3] -= 1.5;  // panda_joint4 lies in [-3.07, -0.07]
+    position[5] += 1.5;  // panda_joint6 in [-0.02, 3.75]
+    position[7] = 0.02;  // finger 1
+    const Stamp stamp = kStart + k * kMs;
+    const Outcome reference =
+        without.onJointState(stamp, stamp, model.coordinate_names, position, kNone, kNone);
+    // Finger 2 contradicts from sample 100 on (0.035 against 0.02: 0.015 beyond the
+    // tolerance, 0.01), agrees within it before (0.025: 0.005).
+    position.push_back(k < 100 ? 0.025 : 0.035);
+    const Outcome o = p.onJointState(stamp, stamp, names, position, kNone, kNone);
+    ASSERT_EQ(o, reference) << k;
+    EXPECT_EQ(p.mimicContradiction().empty(), k < 100) << k;
+    if (o == Outcome::kPublished) {
+      for (std::size_t i = 0; i < p.record().effort.size(); ++i)
+        EXPECT_EQ(p.record().effort[i], without.record().effort[i]) << k;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 150);
+  EXPECT_EQ(p.counters().mimic_contradictions, 100);
+  EXPECT_EQ(without.counters().mimic_contradictions, 0);
+  EXPECT_NE(p.mimicContradiction().find("mimic joint 'panda_finger_joint2' is 0.035, but its "
+                                        "leader makes it 0.02"),
+            std::string::npos)
+      << p.mimicContradiction();
+}
