@@ -79,19 +79,6 @@ EstimatorNode::~EstimatorNode() {
 Model<double> EstimatorNode::loadModel() {
   std::string urdf;
   const std::string param = nh_.resolveName(settings_.robot_description);
-  // Not set yet: a launch file whose robot_state_publisher or xacro step comes later, a
-  // description loaded by hand. Waited for (said every 5 s), never taken for an error.
-  ros::WallTime said;
-  while (!nh_.hasParam(settings_.robot_description) && ros::ok()) {
-    if (said.isZero() || (ros::WallTime::now() - said).toSec() >= 5.0) {
-      said = ros::WallTime::now();
-      ROS_WARN("waiting for the parameter '%s' (robot_description): not set yet", param.c_str());
-    }
-    ros::WallDuration(0.1).sleep();
-  }
-  if (!ros::ok())
-    throw SettingsError("shut down while waiting for the parameter '" + param +
-                        "' (robot_description)");
   if (!nh_.getParam(settings_.robot_description, urdf))
     throw SettingsError("parameter '" + param +
                         "' (robot_description) is not set or is not a string");
