@@ -4,6 +4,7 @@
 
 #include <joint_load_estimator/model.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,11 @@ class JointStateMap {
   const std::vector<double>& qd() const { return qd_; }
   /// Whether coordinate k has had a position.
   bool received(int k) const { return received_[static_cast<std::size_t>(k)] != 0; }
+  /// Whether coordinate k had a position in a message since the last clearFresh(): not,
+  /// its position is held from an earlier message (another publisher's, an older one).
+  bool fresh(int k) const { return fresh_[static_cast<std::size_t>(k)] != 0; }
+  /// A sample was taken: every coordinate is held until a message sets it again.
+  void clearFresh() { std::fill(fresh_.begin(), fresh_.end(), 0); }
   /// Index of the first coordinate with no position received yet, or -1 if none.
   int firstMissing() const;
   /// Latest measured effort per published joint (NaN until one is received).
@@ -73,7 +79,7 @@ class JointStateMap {
   double mimic_expected_ = 0.0;
   std::vector<std::string> published_joint_names_;
   std::vector<double> q_, qd_;
-  std::vector<char> received_;
+  std::vector<char> received_, fresh_;
   std::vector<double> effort_;
   // Cached binding of the last layout of names: per message index, the coordinate
   // (-1: none: a mimic or unknown), the published joint (-1: none) and whether known.

@@ -85,6 +85,9 @@ struct PipelineCounters {
   /// joint states with a mimic joint's position contradicting its leader's (beyond
   /// plausibility/mimic_tolerance; the model's value is used)
   long mimic_contradictions = 0;
+  /// samples taken with a coordinate the loads need held from an earlier message (joint
+  /// states split over publishers, each message a sample: README "Never silently wrong")
+  long held_samples = 0;
 
   long received(InputKind kind) const;
   long count(InputKind kind, Outcome outcome) const {
@@ -404,6 +407,7 @@ class Pipeline {
   std::uint8_t statusOf(const Estimator& estimator, double settle_from,
                         const LoadsRecord& rec) const;
   static void noteStart(Settle& settle, SampleStatus status, double t);
+  void countHeld();
   static bool finiteLoads(const LoadsRecord& rec);
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
   bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,

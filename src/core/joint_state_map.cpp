@@ -11,6 +11,7 @@ JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>&
       q_(static_cast<std::size_t>(model.nq), 0.0),
       qd_(static_cast<std::size_t>(model.nq), std::numeric_limits<double>::quiet_NaN()),
       received_(static_cast<std::size_t>(model.nq), 0),
+      fresh_(static_cast<std::size_t>(model.nq), 0),
       effort_(published_segments.size(), std::numeric_limits<double>::quiet_NaN()) {
   mimic_tolerance_ = mimic_tolerance;
   for (int s : model.moving_segments) {
@@ -69,6 +70,7 @@ int JointStateMap::update(const std::vector<std::string>& names,
       qd_[static_cast<std::size_t>(k)] =
           !velocity.empty() && std::isfinite(velocity[i]) ? velocity[i] : kNone;
       received_[static_cast<std::size_t>(k)] = 1;
+      fresh_[static_cast<std::size_t>(k)] = 1;
     }
     const int j = published_of_[i];
     if (j >= 0 && !effort.empty())

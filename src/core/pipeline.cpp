@@ -519,6 +519,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   last_taken_clock_ = last_clock_;
   if (clock_back_ > 0) --clock_back_;
   remember(t, stamp, has_effort);
+  countHeld();
   if (smoothed_) sampleSmoothed(t, base);
   if (status == SampleStatus::kStale) return staleProblem();
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
@@ -721,6 +722,15 @@ std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
         p.effort_factor * m.effort_limit[static_cast<std::size_t>(rec.segment[i])])
       status |= kImplausibleLoad;
   return status;
+}
+
+void Pipeline::countHeld() {
+  // A needed coordinate no message since the last sample set: this sample holds it.
+  bool held = false;
+  for (int k = 0; k < model().nq && !held; ++k)
+    held = estimator_.coordinateNeeded(k) && !joints_.fresh(k);
+  counters_.held_samples += held ? 1 : 0;
+  joints_.clearFresh();
 }
 
 void Pipeline::noteStart(Settle& settle, SampleStatus status, double t) {

@@ -642,6 +642,7 @@ py::dict counters(const jle::Pipeline& p) {
   out["nonfinite_efforts"] = c.nonfinite_efforts;
   out["nonfinite_velocities"] = c.nonfinite_velocities;
   out["mimic_contradictions"] = c.mimic_contradictions;
+  out["held_samples"] = c.held_samples;
   return out;
 }
 

@@ -488,6 +488,11 @@ void BagProcessor::printDrops() const {
   if (c.forward_jumps)
     drops += (drops.empty() ? "" : ", ") + std::to_string(c.forward_jumps) + " time jumps forward";
   if (!drops.empty()) std::fprintf(stderr, "process_bag: not used: %s\n", drops.c_str());
+  if (c.held_samples)
+    std::fprintf(stderr,
+                 "process_bag: %ld samples held a joint from an earlier message (joint states "
+                 "split over publishers)\n",
+                 c.held_samples);
 }
 
 }  // namespace

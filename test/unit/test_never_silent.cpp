@@ -382,3 +382,31 @@ TEST(NeverSilent, AMimicJointContradictingItsLeaderIsCountedAndNamed) {
             std::string::npos)
       << p.mimicContradiction();
 }
+
+// Joint states split over two publishers, stamps 2 ms apart: each message is still a
+// sample of its own (merging them is not done yet), and every sample that holds the other
+// publisher's joints is counted; one publisher of every joint holds none.
+TEST(NeverSilent, SamplesHoldingASplitPublishersJointsAreCounted) {
+  const jle::Model<double> model = ur5();
+  const jle::Settings settings;
+  jle::Pipeline split(model, settings, nullptr), whole(model, settings, nullptr);
+  const std::vector<std::string> arm(model.coordinate_names.begin(),
+                                     model.coordinate_names.begin() + 3),
+      wrist(model.coordinate_names.begin() + 3, model.coordinate_names.end());
+  for (int k = 0; k < 200; ++k) {
+    const Stamp stamp = kStart + 10 * k * kMs;
+    const std::vector<double> p = positions(0.01 * k), p2 = positions(0.01 * k + 0.002);
+    split.onJointState(stamp, stamp, arm, {p.begin(), p.begin() + 3}, kNone, kNone);
+    split.onJointState(stamp + 2 * kMs, stamp + 2 * kMs, wrist, {p2.begin() + 3, p2.end()}, kNone,
+                       kNone);
+    whole.onJointState(stamp, stamp, model.coordinate_names, p, kNone, kNone);
+  }
+  const jle::PipelineCounters& c = split.counters();
+  using jle::InputKind;
+  const long taken = c.count(InputKind::kJointState, Outcome::kUsed) +
+                     c.count(InputKind::kJointState, Outcome::kPublished);
+  EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kWaiting), 1);  // the first arm message
+  EXPECT_EQ(taken, 399);
+  EXPECT_EQ(c.held_samples, taken - 1);  // all but the first, which had both
+  EXPECT_EQ(whole.counters().held_samples, 0);
+}
