@@ -47,7 +47,12 @@ struct WrenchInputConfig {
   double sign = 1.0;     ///< +1: the load on the robot (F/T sensor); -1: the load the robot applies
                          ///< (force plate)
   double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale
-  StalePolicy stale_policy = StalePolicy::kHold;
+  /// What a stale input reads as: zero by default (a dead sensor's last reading no longer
+  /// enters the loads); the records it enters are flagged (LoadsRecord::status).
+  StalePolicy stale_policy = StalePolicy::kZero;
+  /// [s] >= 0, with stale_policy hold: how long past its timeout the last reading is
+  /// held; zero after that.
+  double max_hold = 1.0;
   /// Non-empty: the input is a force/torque sensor mounted at this FIXED joint of the
   /// URDF (kept as its own segment; `link` must be empty or the joint's child link). It
   /// measures the joint wrench: what the proximal side (the joint's parent link) exerts
@@ -330,6 +335,36 @@ struct SmoothedStreamSettings {
 
 /// Every setting of the node and of the offline front ends (process_bag), with the
 /// parameter names of config/default.yaml (README, "Parameters").
+/// What an input may be before it is refused at the door (Pipeline; README "Never
+/// silently wrong"): a finite absurd value must not reach the filters.
+struct PlausibilityConfig {
+  /// [rad or m] >= 0: a position beyond its joint's URDF limits by more than this is
+  /// refused (the message dropped, counted 'implausible'). 1: a recording a little
+  /// beyond its URDF's limits (a calibration offset, a simulated trajectory) is taken;
+  /// what no joint reaches (100 rad, 1e300) is not.
+  double position_margin = 1.0;
+  /// [rad or m] >= 0, and >= 1: a position moving from the last sample by more than
+  /// step_margin plus velocity_factor times its joint's URDF velocity limit (max_velocity
+  /// where the URDF has none) times the interval is refused, unless stamps/jump_confirm
+  /// joint states in a row agree with it: then the filters restart from it. Measured
+  /// velocities beyond velocity_factor times the limit are not used (as a non-finite one).
+  double step_margin = 0.1;
+  double velocity_factor = 3.0;
+  double max_velocity = 100.0;  ///< [rad/s or m/s] > 0, where the URDF gives no limit
+  /// [N], [N m] > 0: a wrench or plate reading whose force or moment is larger is refused.
+  double max_force = 1e5, max_moment = 1e4;
+  /// >= 1: an effort beyond this times its joint's URDF effort limit flags the record
+  /// implausible.
+  double effort_factor = 3.0;
+  /// [s] >= 0: the records of the first this-many seconds after the filters (re)start (a
+  /// start, a jump of time, a gap, a retune) are flagged settling.
+  double settle_time = 0.05;
+  /// [rad or m] >= 0: a mimic joint's published position farther than this from what its
+  /// leader's (in the same message) gives contradicts the model: counted and warned (the
+  /// model's value is used).
+  double mimic_tolerance = 0.01;
+};
+
 struct Settings {
   std::string robot_description = "robot_description";  ///< parameter holding the URDF
   std::string joint_states_topic = "joint_states";
@@ -357,6 +392,7 @@ struct Settings {
   /// Floating base: a residual force above this fraction (> 0) of the total weight is a
   /// diagnostic warning.
   double base_residual_threshold = 0.1;
+  PlausibilityConfig plausibility;
   /// ~calibrate_bias: the robot is still while every estimated |q-dot| stays below this.
   double still_velocity = 0.02;  ///< [rad/s or m/s], > 0
   /// YAML file of the sensor biases: loaded at start if it exists, written by
@@ -392,6 +428,8 @@ void validate(const EstimatorConfig& config);
 
 /// The smoothed stream's estimator settings: `estimator` with the smoothed stream's filter.
 EstimatorConfig smoothedEstimatorConfig(const Settings& settings);
+
+void validate(const PlausibilityConfig& config);
 
 /// Checks `settings`: validate(settings.estimator), the front end's own settings, and
 /// that wrenches and force_plates pair with estimator.wrenches and estimator.plates.

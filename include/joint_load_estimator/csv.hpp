@@ -212,8 +212,10 @@ struct LoadColumnLayout {
   /// external@LINK.fx, .fy, .fz, .mx, .my, .mz for each contact LINK (link frame, moment
   /// about its origin), after the external_effort columns.
   std::vector<std::string> contacts;
-  /// Force plates: plate@NAME.contact, .cop_x, .cop_y, .cop_z for each NAME, last.
+  /// Force plates: plate@NAME.contact, .cop_x, .cop_y, .cop_z for each NAME.
   std::vector<std::string> plates;
+  /// `status` last: the record's LoadsStatus bits (0: trusted; process_bag).
+  bool status = false;
 };
 
 /// Header of a joint-load file (joint_loads, process_bag; docs/joint_loads.md), in this

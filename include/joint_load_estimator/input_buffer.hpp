@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace jle {
@@ -27,8 +28,10 @@ class InputBuffer {
 
   InputBuffer() = default;
   /// timeout [s]: a joint sample later than the newest sample by more than this finds the
-  /// input stale; policy: what is read then (StalePolicy).
-  InputBuffer(double timeout, StalePolicy policy);
+  /// input stale; policy: what is read then (StalePolicy); max_hold [s]: with the hold
+  /// policy, how long past the timeout the last value is held (zero after that).
+  InputBuffer(double timeout, StalePolicy policy,
+              double max_hold = std::numeric_limits<double>::infinity());
 
   /// A sample at time t [s]. Dropped (false) unless t is newer than the newest held and
   /// everything is finite.
@@ -39,16 +42,19 @@ class InputBuffer {
   /// Whether a joint sample at time t [s] finds the input stale: no sample, or the newest
   /// older than the timeout.
   bool staleAt(double t) const;
-  /// interpolate(t), or zero where staleAt(t) and the policy is kZero.
+  /// interpolate(t), or zero where zeroAt(t).
   Vector6 valueAt(double t) const;
+  /// Whether the input reads as zero at t: stale under the kZero policy, or held past
+  /// max_hold under kHold.
+  bool zeroAt(double t) const;
   /// At the joint sample t [s]: valueAt(t) into out[0..6) and stale() updated. An input
   /// that no computed segment needs (needed false) is not read: out is left as it is and
   /// the input is not stale.
   void resample(double t, bool needed, double* out);
   /// Whether the input was stale at the last resample() (true after a reset).
   bool stale() const { return stale_; }
-  /// Stale under the kZero policy: the input reads as zero.
-  bool zeroed() const { return stale_ && zero_when_stale_; }
+  /// At the last resample(): the input read as zero (zeroAt).
+  bool zeroed() const { return zeroed_; }
   /// Stale under the kStop policy: no loads may be published.
   bool stopped() const { return stale_ && stop_when_stale_; }
   /// Forgets every sample (a backward jump of time).
@@ -63,8 +69,10 @@ class InputBuffer {
   int ring(int k) const { return (head_ - 1 - k + 2 * kHistory) % kHistory; }
 
   double timeout_ = 0.1;
-  bool zero_when_stale_ = false;  // StalePolicy::kZero
-  bool stop_when_stale_ = false;  // StalePolicy::kStop
+  bool zero_when_stale_ = false;                               // StalePolicy::kZero
+  bool stop_when_stale_ = false;                               // StalePolicy::kStop
+  double max_hold_ = std::numeric_limits<double>::infinity();  // StalePolicy::kHold
+  bool zeroed_ = false;
   std::vector<double> times_;
   std::vector<Vector6> values_;
   int head_ = 0;

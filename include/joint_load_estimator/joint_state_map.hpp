@@ -4,6 +4,7 @@
 
 #include <joint_load_estimator/model.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -15,16 +16,25 @@ namespace jle {
 /// stream of messages with one layout costs string comparisons and no allocation.
 class JointStateMap {
  public:
-  /// `published_segments` as publishedSegments() returns them.
-  JointStateMap(const Model<double>& model, const std::vector<int>& published_segments);
+  /// `published_segments` as publishedSegments() returns them; mimic_tolerance [rad or m]:
+  /// how far a mimic joint's published position may be from its leader's (in the same
+  /// message) times its multiplier plus its offset before it contradicts the model.
+  JointStateMap(const Model<double>& model, const std::vector<int>& published_segments,
+                double mimic_tolerance = 0.01);
 
   /// Takes a message's names and positions (same size, checked by the caller), its
   /// velocities and its efforts (each empty, or the same size; a non-finite one is taken
-  /// as none: NaN). Mimic joints are ignored (a mimic follows its leader). Returns the
-  /// index in `names` of the first joint the model does not have, or -1 if there is none
-  /// (the others are still taken).
+  /// as none: NaN). Mimic joints are ignored (a mimic follows its leader); one whose
+  /// position contradicts its leader's in the same message is noted (mimicContradiction).
+  /// Returns the index in `names` of the first joint the model does not have, or -1 if
+  /// there is none (the others are still taken).
   int update(const std::vector<std::string>& names, const std::vector<double>& position,
              const std::vector<double>& velocity, const std::vector<double>& effort);
+  /// The index in the last update()'s `names` of the first mimic joint whose position is
+  /// more than mimic_tolerance from what its leader's gives (mimicExpected()), or -1.
+  int mimicContradiction() const { return mimic_contradiction_; }
+  /// What the model gives that mimic joint: multiplier times its leader's plus offset.
+  double mimicExpected() const { return mimic_expected_; }
 
   /// The index in `names` of the first name that an earlier entry of `names` has too,
   /// or -1 if every name is there once. Binds the layout (no cost for the same layout
@@ -42,6 +52,11 @@ class JointStateMap {
   const std::vector<double>& qd() const { return qd_; }
   /// Whether coordinate k has had a position.
   bool received(int k) const { return received_[static_cast<std::size_t>(k)] != 0; }
+  /// Whether coordinate k had a position in a message since the last clearFresh(): not,
+  /// its position is held from an earlier message (another publisher's, an older one).
+  bool fresh(int k) const { return fresh_[static_cast<std::size_t>(k)] != 0; }
+  /// A sample was taken: every coordinate is held until a message sets it again.
+  void clearFresh() { std::fill(fresh_.begin(), fresh_.end(), 0); }
   /// Index of the first coordinate with no position received yet, or -1 if none.
   int firstMissing() const;
   /// Latest measured effort per published joint (NaN until one is received).
@@ -49,12 +64,22 @@ class JointStateMap {
 
  private:
   void bind(const std::vector<std::string>& names);
+  void checkMimics(const std::vector<double>& position);
 
   std::vector<std::string> coordinate_names_;
   std::vector<std::string> moving_joint_names_;  // every moving joint, mimics included
+  // Per moving joint: its coordinate, and for a mimic its multiplier and offset (leader
+  // false); per layout entry, the moving joint of a mimic (-1: none).
+  std::vector<int> moving_coordinate_;
+  std::vector<char> moving_is_mimic_;
+  std::vector<double> moving_multiplier_, moving_offset_;
+  std::vector<int> mimic_of_;
+  double mimic_tolerance_ = 0.01;
+  int mimic_contradiction_ = -1;
+  double mimic_expected_ = 0.0;
   std::vector<std::string> published_joint_names_;
   std::vector<double> q_, qd_;
-  std::vector<char> received_;
+  std::vector<char> received_, fresh_;
   std::vector<double> effort_;
   // Cached binding of the last layout of names: per message index, the coordinate
   // (-1: none: a mimic or unknown), the published joint (-1: none) and whether known.

@@ -74,6 +74,11 @@ struct Model {
   /// friction term of the motor effort (friction.hpp).
   std::vector<Scalar> damping;
   std::vector<Scalar> friction;
+  /// The URDF joint's <limit>: position bounds [rad or m] of a revolute or prismatic
+  /// joint (-inf, inf where absent: a continuous joint, no <limit>), velocity [rad/s or
+  /// m/s] and effort [N m or N] limits (inf where absent or not positive). What a joint
+  /// can do: the inputs' plausibility (Pipeline) and the loads' are checked against them.
+  std::vector<double> lower_limit, upper_limit, velocity_limit, effort_limit;
   std::vector<Scalar> mass;          ///< lumped mass [kg]
   std::vector<Vector3> com;          ///< lumped centre of mass in the segment frame [m]
   std::vector<Matrix3> inertia_com;  ///< lumped inertia about the com, segment axes [kg m^2]
@@ -222,6 +227,10 @@ struct Model {
       out.offset.push_back(static_cast<Other>(offset[i]));
       out.damping.push_back(static_cast<Other>(damping[i]));
       out.friction.push_back(static_cast<Other>(friction[i]));
+      out.lower_limit.push_back(lower_limit[i]);
+      out.upper_limit.push_back(upper_limit[i]);
+      out.velocity_limit.push_back(velocity_limit[i]);
+      out.effort_limit.push_back(effort_limit[i]);
       out.mass.push_back(static_cast<Other>(mass[i]));
       out.com.push_back(com[i].template cast<Other>());
       out.inertia_com.push_back(inertia_com[i].template cast<Other>());

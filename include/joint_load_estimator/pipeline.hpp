@@ -47,6 +47,12 @@ enum class Outcome : std::uint8_t {
   /// (yet) a confirmed jump of time, a wrench or plate ahead of the joint states by more
   /// than its timeout, or stamp 0 on a stream that has had stamps
   kRogueStamp,
+  /// A value no joint or sensor of the model produces (Settings::plausibility): a position
+  /// beyond its URDF limits or moving faster than its joint can, a wrench beyond the
+  /// bound; dropped before it reaches a filter
+  kImplausible,
+  /// Loads that are not finite: not published, the filters restarted
+  kNonFinite,
   kCount
 };
 
@@ -76,6 +82,12 @@ struct PipelineCounters {
   /// Estimator::addJointSample takes its velocity filter's prediction; the loads are
   /// computed)
   long nonfinite_velocities = 0;
+  /// joint states with a mimic joint's position contradicting its leader's (beyond
+  /// plausibility/mimic_tolerance; the model's value is used)
+  long mimic_contradictions = 0;
+  /// samples taken with a coordinate the loads need held from an earlier message (joint
+  /// states split over publishers, each message a sample: README "Never silently wrong")
+  long held_samples = 0;
 
   long received(InputKind kind) const;
   long count(InputKind kind, Outcome outcome) const {
@@ -95,6 +107,23 @@ class FrameSource {
   virtual bool lookup(const std::string& target, const std::string& frame, Stamp stamp,
                       Eigen::Isometry3d& X_target_frame, std::string& error) = 0;
 };
+
+/// Why a record's loads are not to be trusted: LoadsRecord::status holds these bits, 0
+/// (kTrusted) when none applies. The node's JointLoads.status carries the same bits.
+enum LoadsStatus : std::uint8_t {
+  kTrusted = 0,
+  /// Within plausibility/settle_time after the filters (re)started (a start, a jump of
+  /// time, a gap, a retune, a confirmed jump of a position): the filters are settling.
+  kSettling = 1,
+  /// A needed wrench input or force plate was stale at the sample (its stale_policy
+  /// applied: held, read as zero).
+  kStaleInput = 2,
+  /// An effort beyond plausibility/effort_factor times its joint's URDF effort limit.
+  kImplausibleLoad = 4,
+};
+
+/// The bits of `status` in words ("settling, stale input"); "trusted" for 0.
+std::string describeStatus(std::uint8_t status);
 
 /// A wrench input (settings.wrenches[k]) as it entered one published sample.
 struct InputRecord {
@@ -163,7 +192,8 @@ struct LoadsRecord {
   /// link frame, about its origin) [N, N m], zero when the inputs explain the motion (a
   /// check of the model and the inputs). Zero for a fixed base.
   Eigen::Vector3d base_force = Eigen::Vector3d::Zero(), base_moment = Eigen::Vector3d::Zero();
-  bool planar = false;  ///< computed by the planar 3x3 path (savings.planar)
+  bool planar = false;             ///< computed by the planar 3x3 path (savings.planar)
+  std::uint8_t status = kTrusted;  ///< LoadsStatus bits: why the loads are not to be trusted
 };
 
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints,
@@ -240,6 +270,9 @@ class Pipeline {
   const std::string& nonFiniteEffort() const { return nonfinite_effort_; }
   /// The first joint of the last joint state whose velocity was not finite, or empty.
   const std::string& nonFiniteVelocity() const { return nonfinite_velocity_; }
+  /// The last joint state's first mimic joint whose position contradicts its leader's, in
+  /// words ("joint 'b' is 0.5, its leader 'a' gives 0.3"), or empty.
+  const std::string& mimicContradiction() const { return mimic_contradiction_; }
   /// The first coordinate the computed loads need that has had no position yet, or empty.
   const std::string& missingJoint() const;
   /// The topics of the inputs with stale_policy stop that were stale at the last joint
@@ -323,12 +356,21 @@ class Pipeline {
     bool stamped = false;
   };
   // The smoothed stream: its estimator, its record, and its loads drained by a reset.
+  // When a stream's filters last (re)started: at the first sample after a reset (a
+  // start, a jump of time, a restart for non-finite loads), or at the first of a warm-up
+  // (a gap or a retune restarts them inside the estimator).
+  struct Settle {
+    double from = 0.0;      // estimator time [s] of that sample
+    bool restarted = true;  // the next sample taken starts the filters
+    bool warming = false;   // the last sample taken was a warm-up one
+  };
   struct Stream {
     Stream(const Model<double>& model, const EstimatorConfig& config) : estimator(model, config) {}
     Estimator estimator;
     LoadsRecord record;
     std::vector<LoadsRecord> drained;
     std::size_t drained_next = 0;
+    Settle settle;
   };
   // One joint sample entering the filters: its time, stamp and measured efforts.
   struct Sample {
@@ -363,6 +405,21 @@ class Pipeline {
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord(const Estimator& estimator, LoadsRecord& rec);
   void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
+  std::uint8_t statusOf(const Estimator& estimator, double settle_from,
+                        const LoadsRecord& rec) const;
+  static void noteStart(Settle& settle, SampleStatus status, double t);
+  void countHeld();
+  static bool finiteLoads(const LoadsRecord& rec);
+  // Plausibility at the door (Settings::plausibility); false with problem_ set.
+  bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
+                           const std::vector<double>& position);
+  const std::vector<double>& plausibleVelocities(const std::vector<std::string>& names,
+                                                 const std::vector<double>& velocity);
+  bool plausibleWrench(InputKind kind, const std::string& topic, const Eigen::Vector3d& force,
+                       const Eigen::Vector3d& moment);
+  // The filters start again from the next sample. drain: the smoother's pending samples
+  // are published first (their state is good); else they are dropped (poisoned).
+  void restartFilters(bool drain);
   void setUpExternal();
   void fillExternal();
   void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
@@ -409,9 +466,16 @@ class Pipeline {
   std::vector<Sample> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;
   std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
+  std::string mimic_contradiction_;
   bool any_needed_ = false;  // the loads need at least one coordinate
   bool jumped_ = false;
   Stamp jump_from_ = 0, jump_to_ = 0;
+  // Plausibility: per coordinate its joint's segment (limits), the joint states refused
+  // in a row for moving too fast, and the velocities with the implausible ones as NaN.
+  std::vector<int> coordinate_segment_;
+  int implausible_run_ = 0;
+  std::vector<double> velocity_checked_;
+  Settle settle_;  // the immediate stream's
 };
 
 }  // namespace jle

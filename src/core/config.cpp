@@ -70,6 +70,7 @@ void validateWrench(const WrenchInputConfig& w, std::size_t k) {
   if (!(w.sign == 1.0 || w.sign == -1.0))
     fail(element("wrenches", k, "sign"), "must be +1 or -1, it is " + number(w.sign));
   positive(element("wrenches", k, "timeout"), w.timeout);
+  nonNegative(element("wrenches", k, "max_hold"), w.max_hold);
   nonNegative(element("wrenches", k, "force_noise"), w.force_noise);
   nonNegative(element("wrenches", k, "moment_noise"), w.moment_noise);
 }
@@ -210,6 +211,22 @@ void validate(const Settings& settings) {
          "must be a mass > 0 [kg], 0 (off) or -1 (the URDF's total mass), it is " + number(m));
   validateWrenchTopics(settings);
   validatePlateTopics(settings);
+  validate(settings.plausibility);
+}
+
+void validate(const PlausibilityConfig& p) {
+  nonNegative("plausibility/position_margin", p.position_margin);
+  nonNegative("plausibility/step_margin", p.step_margin);
+  if (!(p.velocity_factor >= 1.0) || !std::isfinite(p.velocity_factor))
+    fail("plausibility/velocity_factor",
+         "must be finite and >= 1, it is " + number(p.velocity_factor));
+  positive("plausibility/max_velocity", p.max_velocity);
+  positive("plausibility/max_force", p.max_force);
+  positive("plausibility/max_moment", p.max_moment);
+  if (!(p.effort_factor >= 1.0) || !std::isfinite(p.effort_factor))
+    fail("plausibility/effort_factor", "must be finite and >= 1, it is " + number(p.effort_factor));
+  nonNegative("plausibility/settle_time", p.settle_time);
+  nonNegative("plausibility/mimic_tolerance", p.mimic_tolerance);
 }
 
 }  // namespace jle

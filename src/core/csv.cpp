@@ -623,6 +623,7 @@ std::vector<std::string> jointLoadColumns(const std::vector<std::string>& joints
       names.push_back("external@" + link + "." + component);
   for (const std::string& plate : layout.plates)
     for (const char* column : kPlateOutputs) names.push_back(kPlatePrefix + plate + "." + column);
+  if (layout.status) names.push_back("status");
   return names;
 }
 

@@ -91,7 +91,7 @@ void Estimator::setUpWrenchInputs() {
                           link + "' is not a link of the model");
     }
     input.sign = c.sign;
-    input.samples = InputBuffer(c.timeout, c.stale_policy);
+    input.samples = InputBuffer(c.timeout, c.stale_policy, c.max_hold);
     inputs_.push_back(input);
   }
 }

@@ -3,13 +3,15 @@
 #include <joint_load_estimator/estimator.hpp>  // StalePolicy
 
 #include <cmath>
+#include <limits>
 
 namespace jle {
 
-InputBuffer::InputBuffer(double timeout, StalePolicy policy)
+InputBuffer::InputBuffer(double timeout, StalePolicy policy, double max_hold)
     : timeout_(timeout),
       zero_when_stale_(policy == StalePolicy::kZero),
       stop_when_stale_(policy == StalePolicy::kStop),
+      max_hold_(policy == StalePolicy::kHold ? max_hold : std::numeric_limits<double>::infinity()),
       times_(kHistory, 0.0),
       values_(kHistory, Vector6::Zero()) {}
 
@@ -39,17 +41,24 @@ InputBuffer::Vector6 InputBuffer::interpolate(double t) const {
 
 bool InputBuffer::staleAt(double t) const { return count_ == 0 || t - times_[ring(0)] > timeout_; }
 
+bool InputBuffer::zeroAt(double t) const {
+  if (!staleAt(t)) return false;
+  return zero_when_stale_ || count_ == 0 || t - times_[ring(0)] > timeout_ + max_hold_;
+}
+
 InputBuffer::Vector6 InputBuffer::valueAt(double t) const {
-  if (zero_when_stale_ && staleAt(t)) return Vector6::Zero();
+  if (zeroAt(t)) return Vector6::Zero();
   return interpolate(t);
 }
 
 void InputBuffer::resample(double t, bool needed, double* out) {
   if (!needed) {  // pruned away: never stale, never read
     stale_ = false;
+    zeroed_ = false;
     return;
   }
   stale_ = staleAt(t);
+  zeroed_ = zeroAt(t);
   const Vector6 value = valueAt(t);
   for (int j = 0; j < 6; ++j) out[j] = value[j];
 }
@@ -58,6 +67,7 @@ void InputBuffer::reset() {
   head_ = 0;
   count_ = 0;
   stale_ = true;
+  zeroed_ = !stop_when_stale_;
 }
 
 }  // namespace jle

@@ -5,14 +5,26 @@
 
 namespace jle {
 
-JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>& published_segments)
+JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>& published_segments,
+                             double mimic_tolerance)
     : coordinate_names_(model.coordinate_names),
       q_(static_cast<std::size_t>(model.nq), 0.0),
       qd_(static_cast<std::size_t>(model.nq), std::numeric_limits<double>::quiet_NaN()),
       received_(static_cast<std::size_t>(model.nq), 0),
+      fresh_(static_cast<std::size_t>(model.nq), 0),
       effort_(published_segments.size(), std::numeric_limits<double>::quiet_NaN()) {
-  for (int s : model.moving_segments)
-    moving_joint_names_.push_back(model.joint_name[static_cast<std::size_t>(s)]);
+  mimic_tolerance_ = mimic_tolerance;
+  for (int s : model.moving_segments) {
+    const std::size_t u = static_cast<std::size_t>(s);
+    moving_joint_names_.push_back(model.joint_name[u]);
+    const int c = model.coordinate[u];
+    moving_coordinate_.push_back(c);
+    // A mimic: a moving joint that is not its coordinate's own (named as its leader).
+    moving_is_mimic_.push_back(c >= 0 && model.coordinate_names[static_cast<std::size_t>(c)] !=
+                                             model.joint_name[u]);
+    moving_multiplier_.push_back(model.multiplier[u]);
+    moving_offset_.push_back(model.offset[u]);
+  }
   for (int s : published_segments)
     published_joint_names_.push_back(model.joint_name[static_cast<std::size_t>(s)]);
 }
@@ -23,6 +35,7 @@ void JointStateMap::bind(const std::vector<std::string>& names) {
   coordinate_of_.assign(n, -1);
   published_of_.assign(n, -1);
   known_.assign(n, 0);
+  mimic_of_.assign(n, -1);
   duplicate_ = -1;
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = 0; j < i && duplicate_ < 0; ++j)
@@ -31,8 +44,11 @@ void JointStateMap::bind(const std::vector<std::string>& names) {
       if (coordinate_names_[k] == names[i]) coordinate_of_[i] = static_cast<int>(k);
     for (std::size_t j = 0; j < published_joint_names_.size(); ++j)
       if (published_joint_names_[j] == names[i]) published_of_[i] = static_cast<int>(j);
-    for (const std::string& m : moving_joint_names_)
-      if (m == names[i]) known_[i] = 1;
+    for (std::size_t m = 0; m < moving_joint_names_.size(); ++m)
+      if (moving_joint_names_[m] == names[i]) {
+        known_[i] = 1;
+        if (moving_is_mimic_[m]) mimic_of_[i] = static_cast<int>(m);
+      }
     if (coordinate_of_[i] >= 0 || published_of_[i] >= 0) known_[i] = 1;
   }
 }
@@ -54,12 +70,34 @@ int JointStateMap::update(const std::vector<std::string>& names,
       qd_[static_cast<std::size_t>(k)] =
           !velocity.empty() && std::isfinite(velocity[i]) ? velocity[i] : kNone;
       received_[static_cast<std::size_t>(k)] = 1;
+      fresh_[static_cast<std::size_t>(k)] = 1;
     }
     const int j = published_of_[i];
     if (j >= 0 && !effort.empty())
       effort_[static_cast<std::size_t>(j)] = std::isfinite(effort[i]) ? effort[i] : kNone;
   }
+  checkMimics(position);
   return unknown;
+}
+
+void JointStateMap::checkMimics(const std::vector<double>& position) {
+  // Only against a leader in the same message: one from another publisher may be of
+  // another instant.
+  mimic_contradiction_ = -1;
+  for (std::size_t i = 0; i < mimic_of_.size() && mimic_contradiction_ < 0; ++i) {
+    const int m = mimic_of_[i];
+    if (m < 0) continue;
+    const std::size_t u = static_cast<std::size_t>(m);
+    const int leader = moving_coordinate_[u];
+    bool in_message = false;
+    for (int c : coordinate_of_) in_message = in_message || c == leader;
+    if (!in_message) continue;
+    const double expected =
+        moving_multiplier_[u] * q_[static_cast<std::size_t>(leader)] + moving_offset_[u];
+    if (std::abs(position[i] - expected) <= mimic_tolerance_) continue;
+    mimic_contradiction_ = static_cast<int>(i);
+    mimic_expected_ = expected;
+  }
 }
 
 int JointStateMap::duplicate(const std::vector<std::string>& names) {

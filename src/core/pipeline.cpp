@@ -65,6 +65,8 @@ const char* toString(Outcome outcome) {
     case Outcome::kUnchanged: return "unchanged";
     case Outcome::kNoJoint: return "no needed joint";
     case Outcome::kRogueStamp: return "rogue stamp";
+    case Outcome::kImplausible: return "implausible";
+    case Outcome::kNonFinite: return "non-finite loads";
     case Outcome::kCount: break;
   }
   return "?";
@@ -151,8 +153,8 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     : settings_(checkedSettings(model, settings)),
       frames_(frames),
       estimator_(model, settings_.estimator),
-      joints_(estimator_.model(),
-              publishedSegments(estimator_.model(), settings_.estimator.joints)),
+      joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints),
+              settings_.plausibility.mimic_tolerance),
       wrenches_(settings_.estimator.wrenches.size()),
       plates_(settings_.estimator.plates.size()),
       clock_(settings_.stamps.regularize == StampRegularize::kAuto),
@@ -192,6 +194,13 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     record_.inputs[k].frame = settings_.estimator.wrenches[k].link;
   record_.plates.resize(plates_.size());
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
+  coordinate_segment_.assign(static_cast<std::size_t>(m.nq), 0);
+  for (int s = 1; s < m.nsegments(); ++s) {  // the leader's joint: named as its coordinate
+    const int c = m.coordinate[static_cast<std::size_t>(s)];
+    if (c >= 0 && m.joint_name[static_cast<std::size_t>(s)] ==
+                      m.coordinate_names[static_cast<std::size_t>(c)])
+      coordinate_segment_[static_cast<std::size_t>(c)] = s;
+  }
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
     smoothed_ = std::make_unique<Stream>(model, smoothedEstimatorConfig(settings_));
@@ -290,6 +299,9 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
+  settle_.restarted = true;
+  if (smoothed_) smoothed_->settle.restarted = true;
+  implausible_run_ = 0;
   if (external_) external_->reset();
   clock_.reset();
   ring_count_ = 0;
@@ -414,6 +426,16 @@ void Pipeline::mapJointState(const std::vector<std::string>& names,
     nonfinite_velocity_ = names[bad];
     ++counters_.nonfinite_velocities;
   }
+  mimic_contradiction_.clear();
+  if (joints_.mimicContradiction() >= 0) {
+    const std::size_t i = static_cast<std::size_t>(joints_.mimicContradiction());
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "' is %.6g, but its leader makes it %.6g (URDF <mimic>): ", position[i],
+                  joints_.mimicExpected());
+    mimic_contradiction_ = "mimic joint '" + names[i] + text + "the model's value is used";
+    ++counters_.mimic_contradictions;
+  }
   if (unknown < 0) {
     unknown_joint_.clear();
     return;
@@ -432,6 +454,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   unknown_joint_.clear();
   nonfinite_effort_.clear();
   nonfinite_velocity_.clear();
+  mimic_contradiction_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
   jumped_ = false;
   // Neither a sample nor a time: its stamp and clock are not the stream's.
@@ -445,7 +468,8 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
     return fail(kind, Outcome::kRogueStamp, settings_.joint_states_topic + kZeroStamp);
   const Outcome timeline = checkJointStamp(stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
-  mapJointState(names, position, velocity, effort);
+  if (!plausibleJointState(stamp, names, position)) return count(kind, Outcome::kImplausible);
+  mapJointState(names, position, plausibleVelocities(names, velocity), effort);
   anchor(stamp);
   const std::string& missing = missingJoint();
   if (!missing.empty())
@@ -483,6 +507,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   const double t = relative(clock_.add(stamp));
   const SampleStatus status =
       estimator_.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
+  noteStart(settle_, status, t);
   switch (status) {
     case SampleStatus::kDuplicate:
     case SampleStatus::kOutOfOrder: return order(status);
@@ -495,23 +520,37 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   last_taken_clock_ = last_clock_;
   if (clock_back_ > 0) --clock_back_;
   remember(t, stamp, has_effort);
+  countHeld();
   if (smoothed_) sampleSmoothed(t, base);
   if (status == SampleStatus::kStale) return staleProblem();
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
   if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged)
     return count(kind, Outcome::kUnchanged);
   fillRecord(estimator_, record_);
+  if (!finiteLoads(record_)) {
+    restartFilters(false);  // what made them not finite is in the filters' state
+    return fail(kind, Outcome::kNonFinite,
+                settings_.joint_states_topic + ": the loads at " + seconds(stamp) +
+                    " are not finite: not published, the filters restart");
+  }
   return count(kind, Outcome::kPublished);
 }
 
 // The sample the immediate stream took, into the smoothed stream (the same checks passed:
 // the same time, positions, velocities and base pose).
 void Pipeline::sampleSmoothed(double t, const BasePose* base) {
-  Estimator& e = smoothed_->estimator;
+  Stream& stream = *smoothed_;
+  Estimator& e = stream.estimator;
   const SampleStatus status = e.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
+  noteStart(stream.settle, status, t);
   smoothed_published_ = status == SampleStatus::kPublished &&
                         !(e.lastWasReused() && !settings_.estimator.savings.republish_unchanged);
-  if (smoothed_published_) fillRecord(e, smoothed_->record);
+  if (smoothed_published_) fillRecord(e, stream.record);
+  if (smoothed_published_ && !finiteLoads(stream.record)) {  // counted by the immediate stream
+    e.reset();
+    stream.settle.restarted = true;
+    smoothed_published_ = false;
+  }
 }
 
 void Pipeline::drainSmoother() {
@@ -554,6 +593,7 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
     if (status != SampleStatus::kPublished) continue;
     if (estimator.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
     fillRecord(estimator, record);
+    if (!finiteLoads(record)) continue;  // never published
     return true;
   }
   return false;
@@ -664,7 +704,158 @@ void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
     rec.effort_stddev[i] = std::sqrt(estimator.effortVariance(segment));
   }
   fillSideOutputs(estimator, rec);
+  rec.status =
+      statusOf(estimator, &estimator == &estimator_ ? settle_.from : smoothed_->settle.from, rec);
   if (external_ && &rec == &record_) fillExternal();
+}
+
+std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
+                                const LoadsRecord& rec) const {
+  const PlausibilityConfig& p = settings_.plausibility;
+  std::uint8_t status = kTrusted;
+  if (estimator.stamp() < settle_from + p.settle_time) status |= kSettling;
+  for (const InputRecord& in : rec.inputs) status |= in.stale ? kStaleInput : 0;
+  for (std::size_t k = 0; k < rec.plates.size(); ++k)
+    if (rec.plates[k].stale && estimator.plateNeeded(static_cast<int>(k))) status |= kStaleInput;
+  const Model<double>& m = model();
+  for (std::size_t i = 0; i < rec.segment.size(); ++i)
+    if (std::abs(rec.effort[i]) >
+        p.effort_factor * m.effort_limit[static_cast<std::size_t>(rec.segment[i])])
+      status |= kImplausibleLoad;
+  return status;
+}
+
+void Pipeline::countHeld() {
+  // A needed coordinate no message since the last sample set: this sample holds it.
+  bool held = false;
+  for (int k = 0; k < model().nq && !held; ++k)
+    held = estimator_.coordinateNeeded(k) && !joints_.fresh(k);
+  counters_.held_samples += held ? 1 : 0;
+  joints_.clearFresh();
+}
+
+void Pipeline::noteStart(Settle& settle, SampleStatus status, double t) {
+  if (status == SampleStatus::kDuplicate || status == SampleStatus::kOutOfOrder ||
+      status == SampleStatus::kNonFinite)
+    return;  // not taken
+  // The settling time counts from the filters' first sample, not from their first
+  // estimate: the warm-up (or the smoother's lag) is part of it.
+  const bool warming = status == SampleStatus::kWarmingUp;
+  if (settle.restarted || (warming && !settle.warming)) settle.from = t;
+  settle.restarted = false;
+  settle.warming = warming;
+}
+
+bool Pipeline::finiteLoads(const LoadsRecord& rec) {
+  for (std::size_t i = 0; i < rec.effort.size(); ++i)
+    if (!std::isfinite(rec.effort[i]) || !rec.force[i].allFinite() || !rec.moment[i].allFinite())
+      return false;
+  return rec.base_force.allFinite() && rec.base_moment.allFinite();
+}
+
+void Pipeline::restartFilters(bool drain) {
+  // The wrench and plate readings are forgotten too (Estimator::reset): the next ones
+  // refill them.
+  if (drain) drainSmoother();
+  estimator_.reset();
+  if (smoothed_) smoothed_->estimator.reset();
+  settle_.restarted = true;
+  if (smoothed_) smoothed_->settle.restarted = true;
+  ring_count_ = 0;  // the stamps of the samples the filters held; the stamps' order stays
+}
+
+std::string describeStatus(std::uint8_t status) {
+  if (status == kTrusted) return "trusted";
+  std::string words;
+  const auto add = [&](std::uint8_t bit, const char* word) {
+    if (status & bit) words += (words.empty() ? "" : ", ") + std::string(word);
+  };
+  add(kSettling, "settling");
+  add(kStaleInput, "stale input");
+  add(kImplausibleLoad, "implausible load");
+  return words;
+}
+
+bool Pipeline::plausibleWrench(InputKind kind, const std::string& input,
+                               const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
+  (void)kind;
+  const PlausibilityConfig& p = settings_.plausibility;
+  // stableNorm: the norm of (0, 0, 1e300) is 1e300, not the inf of its square's root.
+  const double f = force.stableNorm(), m = moment.stableNorm();
+  if (f <= p.max_force && m <= p.max_moment) return true;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                ": |force| %.6g N, |moment| %.6g N m beyond plausibility/max_force %.6g N or "
+                "max_moment %.6g N m: dropped",
+                f, m, p.max_force, p.max_moment);
+  problem_ = input + text;
+  return false;
+}
+
+bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
+                                   const std::vector<double>& position) {
+  const PlausibilityConfig& p = settings_.plausibility;
+  const Model<double>& m = model();
+  const std::vector<int>& coordinate = joints_.coordinates();  // bound by checkJointState
+  const double dt = last_stamp_ != 0 ? 1e-9 * static_cast<double>(stamp - last_stamp_) : -1.0;
+  bool too_fast = false;
+  char text[256];
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const int c = coordinate[i];
+    if (c < 0) continue;
+    const std::size_t s =
+        static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(c)]);
+    const double q = position[i];
+    if (q < m.lower_limit[s] - p.position_margin || q > m.upper_limit[s] + p.position_margin) {
+      std::snprintf(text, sizeof text,
+                    ": position of joint '%s' is %.6g, beyond its URDF limits [%.6g, %.6g] by "
+                    "more than plausibility/position_margin %.3g: message dropped",
+                    names[i].c_str(), q, m.lower_limit[s], m.upper_limit[s], p.position_margin);
+      problem_ = settings_.joint_states_topic + text;
+      return false;
+    }
+    if (dt <= 0.0 || !joints_.received(c) || too_fast) continue;
+    const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
+    const double step = std::abs(q - joints_.q()[static_cast<std::size_t>(c)]);
+    if (step <= p.velocity_factor * limit * dt + p.step_margin) continue;
+    too_fast = true;
+    std::snprintf(text, sizeof text,
+                  ": position of joint '%s' moved %.6g in %.6g s, beyond plausibility/"
+                  "velocity_factor %.3g times its velocity limit %.6g: message dropped",
+                  names[i].c_str(), step, dt, p.velocity_factor, limit);
+    problem_ = settings_.joint_states_topic + text;
+  }
+  if (!too_fast) {
+    implausible_run_ = 0;
+    return true;
+  }
+  // The same jump in jump_confirm joint states in a row is the joint's own: taken, the
+  // filters restart from it.
+  if (++implausible_run_ < settings_.stamps.jump_confirm) return false;
+  implausible_run_ = 0;
+  problem_.clear();
+  restartFilters(true);  // the samples before the jump are good
+  return true;
+}
+
+const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<std::string>& names,
+                                                         const std::vector<double>& velocity) {
+  const PlausibilityConfig& p = settings_.plausibility;
+  const Model<double>& m = model();
+  const std::vector<int>& coordinate = joints_.coordinates();
+  bool any = false;
+  for (std::size_t i = 0; i < velocity.size() && i < coordinate.size(); ++i) {
+    if (coordinate[i] < 0 || !std::isfinite(velocity[i])) continue;
+    const std::size_t s =
+        static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(coordinate[i])]);
+    const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
+    if (std::abs(velocity[i]) <= p.velocity_factor * limit) continue;
+    if (!any) velocity_checked_ = velocity;  // same size after the first: no allocation
+    velocity_checked_[i] = kNaN;             // counted and named as a non-finite one
+    any = true;
+  }
+  (void)names;
+  return any ? velocity_checked_ : velocity;
 }
 
 void Pipeline::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) {
@@ -769,9 +960,12 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   jumped_ = false;
   if (!zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, "wrench '" + topic + "'" + kZeroStamp);
+  // The stamps first, as for a joint state: the clock is followed whatever the values.
   const Outcome timeline = checkInputStamp(
       kind, "wrench '" + topic + "'", settings_.estimator.wrenches[ix(k)].timeout, stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
+  if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
+    return count(kind, Outcome::kImplausible);
   if (!resolveWrenchFrame(k, frame, stamp)) return count(kind, Outcome::kFrame);
   const WrenchInput& input = wrenches_[ix(k)];
   // The sensor's offset is in its own frame and sign: removed before anything else.
@@ -834,6 +1028,8 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
   const Outcome timeline = checkInputStamp(kind, "force plate '" + name + "'",
                                            settings_.estimator.plates[ix(k)].timeout, stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
+  if (!plausibleWrench(kind, "force plate '" + name + "'", force, moment))
+    return count(kind, Outcome::kImplausible);
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
   const double t = relative(stamp);
   if (smoothed_) smoothed_->estimator.addPlateSample(k, t, force, moment);  // the same order

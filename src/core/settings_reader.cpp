@@ -281,6 +281,7 @@ void readWrench(Section& s, WrenchTopicSettings& w, WrenchInputConfig& input) {
   s.read("sign", input.sign);
   s.read("timeout", input.timeout);
   s.read("stale_policy", input.stale_policy, kStalePolicies);
+  s.read("max_hold", input.max_hold);
   s.read("force_noise", input.force_noise);
   s.read("moment_noise", input.moment_noise);
   input.name = w.topic;  // an input is named by its topic in the estimator's messages
@@ -371,6 +372,18 @@ Settings parseSettings(const ParamValue& params) {
   s.readMap("stamps", [&](Section& m) { readStamps(m, n.stamps); });
   s.readMap("uncertainty", [&](Section& m) { readUncertainty(m, n.estimator.uncertainty); });
   s.readMap("friction", [&](Section& m) { readFriction(m, n.friction); });
+  s.readMap("plausibility", [&](Section& m) {
+    PlausibilityConfig& p = n.plausibility;
+    m.read<double>({{"position_margin", &p.position_margin},
+                    {"step_margin", &p.step_margin},
+                    {"velocity_factor", &p.velocity_factor},
+                    {"max_velocity", &p.max_velocity},
+                    {"max_force", &p.max_force},
+                    {"max_moment", &p.max_moment},
+                    {"effort_factor", &p.effort_factor},
+                    {"settle_time", &p.settle_time},
+                    {"mimic_tolerance", &p.mimic_tolerance}});
+  });
   s.readMap("external_effort", [&](Section& m) { readExternalEffort(m, n.external_effort); });
   s.readMap("differentiator",
             [&](Section& m) { readDifferentiator(m, n.estimator.differentiator); });

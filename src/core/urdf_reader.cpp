@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -19,6 +20,7 @@ namespace {
 
 using Vector3 = Eigen::Vector3d;
 using Matrix3 = Eigen::Matrix3d;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct Pose {
   Matrix3 R = Matrix3::Identity();
@@ -48,6 +50,8 @@ struct JointDesc {
   std::string mimic_joint;
   double multiplier = 1.0, offset = 0.0;
   double damping = 0.0, friction = 0.0;  // <dynamics>
+  // <limit>: none where absent (or, for velocity and effort, 0 or less)
+  double lower = -kInf, upper = kInf, velocity = kInf, effort = kInf;
 };
 
 [[noreturn]] void fail(const std::string& what) { throw ModelError(what); }
@@ -173,6 +177,19 @@ JointDesc parseJoint(const tinyxml2::XMLElement* e) {
     joint.damping = number(d, "damping", what + " dynamics", false, 0.0);
     joint.friction = number(d, "friction", what + " dynamics", false, 0.0);
   }
+  if (const tinyxml2::XMLElement* l = e->FirstChildElement("limit")) {
+    if (joint.type == "revolute" || joint.type == "prismatic") {
+      joint.lower = number(l, "lower", what + " limit", false, -kInf);
+      joint.upper = number(l, "upper", what + " limit", false, kInf);
+      if (joint.lower > joint.upper)
+        fail(what + ": limit lower " + std::to_string(joint.lower) + " > upper " +
+             std::to_string(joint.upper) + where(l));
+    }
+    const double velocity = number(l, "velocity", what + " limit", false, 0.0);
+    const double effort = number(l, "effort", what + " limit", false, 0.0);
+    if (velocity > 0.0) joint.velocity = velocity;
+    if (effort > 0.0) joint.effort = effort;
+  }
   return joint;
 }
 
@@ -201,6 +218,15 @@ void checkInertia(const LinkDesc& link, const ModelOptions& options,
     warnings.push_back(violation + nonphysicalNote(link.name));
   };
   if (link.mass < 0.0) fail(what + ": negative mass " + std::to_string(link.mass));
+  if (link.mass == 0.0 && !link.inertia.isZero(0.0)) {
+    // Taken as given (its moments enter the loads), but no body turns without weight: a
+    // CAD export's placeholder, or a mass left out.
+    std::ostringstream os;
+    os << what << ": mass 0 with a nonzero inertia (ixx " << link.inertia(0, 0) << ", iyy "
+       << link.inertia(1, 1) << ", izz " << link.inertia(2, 2)
+       << " kg m^2): taken as given; give the link its mass, or zero its inertia";
+    warnings.push_back(os.str());
+  }
   Eigen::SelfAdjointEigenSolver<Matrix3> eig(link.inertia, Eigen::EigenvaluesOnly);
   const Vector3 l = eig.eigenvalues();  // ascending
   // Relative tolerance: the URDFs we read print their inertias with 6 to 9 digits.
@@ -253,6 +279,10 @@ struct Builder {
     parts.emplace_back();
     model.damping.push_back(0.0);
     model.friction.push_back(0.0);
+    model.lower_limit.push_back(-kInf);
+    model.upper_limit.push_back(kInf);
+    model.velocity_limit.push_back(kInf);
+    model.effort_limit.push_back(kInf);
     return static_cast<int>(model.parent.size()) - 1;
   }
 
@@ -341,6 +371,10 @@ struct Builder {
         model.axis[s] = joint.axis / norm;
         model.damping[s] = joint.damping;
         model.friction[s] = joint.friction;
+        model.lower_limit[s] = joint.lower;
+        model.upper_limit[s] = joint.upper;
+        model.velocity_limit[s] = joint.velocity;
+        model.effort_limit[s] = joint.effort;
       }
       place(child, s, Pose());
     }

@@ -518,6 +518,9 @@ py::dict PyEstimator::run(const Array& t, const Array& q, const py::list& wrench
     while (smoothed && p.flushSmoothed()) smoothed->add(p.smoothedRecord());
   }
   py::dict out = immediate.result(&secondsOf);
+  // "status" is what became of each joint state here (the documented key); the records'
+  // own status bits (trusted, settling, stale input, implausible load) move aside.
+  out["loads_status"] = py::object(out["status"]);
   out["status"] = status;
   out["smoothed"] = smoothed ? py::object(smoothed->result(&secondsOf)) : py::none();
   return out;
@@ -648,6 +651,8 @@ py::dict counters(const jle::Pipeline& p) {
   out["resets"] = c.resets;
   out["nonfinite_efforts"] = c.nonfinite_efforts;
   out["nonfinite_velocities"] = c.nonfinite_velocities;
+  out["mimic_contradictions"] = c.mimic_contradictions;
+  out["held_samples"] = c.held_samples;
   return out;
 }
 

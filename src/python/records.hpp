@@ -73,6 +73,7 @@ class RecordColumns {
     contact_joint_.push_back(r.contact_joint);
     contact_link_.push_back(r.contact_link);
     planar_.push_back(r.planar);
+    status_.push_back(r.status);
   }
 
   /// The columns; `seconds` turns a stamp [ns] into the `t` column [s].
@@ -113,6 +114,7 @@ class RecordColumns {
     out["contact_link"] = contact_link_;
     out["base_residual"] = Array({n, py::ssize_t(6)}, base_.data());
     out["planar"] = flags(planar_, {n});
+    out["status"] = py::array_t<std::uint8_t>(n, status_.data());
     return out;
   }
 
@@ -166,6 +168,7 @@ class RecordColumns {
   std::vector<double> wrench_, covariance_, coordinates_, residual_, cop_, plate_wrench_,
       plate_scalars_, contact_wrench_, base_;
   std::vector<double> per_joint_[kPerJoint];
+  std::vector<std::uint8_t> status_;
   std::vector<char> input_used_, input_stale_, plate_contact_, plate_stale_, in_contact_,
       contact_active_, contact_started_, contact_changed_, contact_ended_, planar_;
 };

@@ -127,6 +127,7 @@ void prepare(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
 
 void toMessage(const LoadsRecord& record, joint_load_estimator::JointLoads& msg) {
   msg.header.stamp = toRosTime(record.stamp);
+  msg.status = record.status;
   for (std::size_t i = 0; i < record.joint.size(); ++i) {
     geometry_msgs::Wrench& w = msg.wrench[i];
     w.force.x = record.force[i].x();

@@ -16,6 +16,17 @@ constexpr double kSilence = 1.0;
 // subscriber (in a queue of the same process or of TCP) is replaced by a new one.
 constexpr std::size_t kLoadsPool = 8;
 
+// Under use_sim_time, ros::Time::now() is 0 until the first /clock message: a stamp 0
+// cannot be replaced by the clock (every one reads as a duplicate of the last), and a
+// jump of time the clock shows is not seen. Said by wall time: ROS_*_THROTTLE counts by
+// ros::Time, which stands still at 0.
+const char* const kNoClock =
+    "use_sim_time is true but no /clock message has come (ros::Time::now() is 0): a joint "
+    "state stamped 0 cannot take the clock's time and jumps of time go unseen; publish "
+    "/clock (rosbag play --clock) or set use_sim_time false";
+
+bool noClock() { return ros::Time::isSimTime() && ros::Time::now().isZero(); }
+
 }  // namespace
 
 EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
@@ -168,6 +179,9 @@ void EstimatorNode::report(Outcome outcome) {
                       "%s: velocity of joint '%s' is not finite: that velocity is not used "
                       "(the velocity filter's prediction instead)",
                       settings_.joint_states_topic.c_str(), pipeline_->nonFiniteVelocity().c_str());
+  if (!pipeline_->mimicContradiction().empty())
+    ROS_WARN_THROTTLE(kThrottle, "%s: %s", settings_.joint_states_topic.c_str(),
+                      pipeline_->mimicContradiction().c_str());
   // A gripper's own joint states are normal: said once, counted in the diagnostics.
   if (outcome == Outcome::kNoJoint) {
     ROS_INFO_ONCE("%s (counted under 'not used: no needed joint')", pipeline_->problem().c_str());
@@ -180,7 +194,8 @@ void EstimatorNode::report(Outcome outcome) {
   if (last != 0.0 && now - last < kThrottle) return;
   last = now;
   // What no later message repairs is an error; order, staleness, a missing pose are not.
-  if (outcome == Outcome::kInvalid || outcome == Outcome::kWaiting || outcome == Outcome::kFrame)
+  if (outcome == Outcome::kInvalid || outcome == Outcome::kWaiting || outcome == Outcome::kFrame ||
+      outcome == Outcome::kNonFinite)
     ROS_ERROR("%s", pipeline_->problem().c_str());
   else
     ROS_WARN("%s", pipeline_->problem().c_str());
@@ -206,6 +221,14 @@ void EstimatorNode::onJointState(const JointStateEvent& event) {
   queue_wait_max_ = std::max(queue_wait_max_, queue_wait);
   ++queue_wait_count_;
   const sensor_msgs::JointState& msg = *event.getConstMessage();
+  if (received.isZero() && ros::Time::isSimTime()) {
+    static double said = 0.0;  // wall time [s]; callbacks are serialized (callbacks_mutex_)
+    const double wall = ros::WallTime::now().toSec();
+    if (wall - said >= kThrottle) {
+      said = wall;
+      ROS_WARN("%s", kNoClock);
+    }
+  }
   try {
     applyPendingBias();
     const Outcome outcome = feed(*pipeline_, msg, received);
@@ -362,9 +385,13 @@ void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, inputs);
   else if (!stale.empty())
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "stale wrench inputs: " + stale);
+  else if (published > 0 && pipeline_->record().status != kTrusted)
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "loads not trusted: " + describeStatus(pipeline_->record().status));
   else
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "publishing");
   diagnoseLevel(status, published);  // what stops the loads comes first
+  status.add("last loads", describeStatus(pipeline_->record().status));
   external_outputs_.diagnose(status);
   status.add("mean latency [s]", latency_count_ ? latency_sum_ / latency_count_ : 0.0);
   status.add("max latency [s]", latency_max_);
@@ -402,6 +429,8 @@ void EstimatorNode::diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& s
   else if (last_joint_outcome_ == Outcome::kStale)
     status.summary(DiagnosticStatus::ERROR,
                    "not publishing: input '" + pipeline_->stoppingInputs() + "' stale");
+  else if (noClock())
+    status.summary(DiagnosticStatus::WARN, "use_sim_time without /clock");
   else if (published == 0)
     status.summary(DiagnosticStatus::WARN, "no loads published yet");
 }
@@ -433,6 +462,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("dropped: invalid", c.count(Outcome::kInvalid) + exceptions_);
   status.add("dropped: stamp order", c.count(Outcome::kOrder));
   status.add("dropped: rogue stamp", c.count(Outcome::kRogueStamp));
+  status.add("dropped: implausible", c.count(Outcome::kImplausible));
+  status.add("not published: non-finite loads", c.count(Outcome::kNonFinite));
   status.add("dropped: unresolved frame", c.count(Outcome::kFrame) + c.count(Outcome::kNoBasePose));
   status.add("dropped: no base pose", c.count(Outcome::kNoBasePose));
   status.add("not used: no needed joint", c.count(Outcome::kNoJoint));
@@ -441,6 +472,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("messages with unknown joints", c.unknown_joints);
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
   status.add("velocities not used: non-finite", c.nonfinite_velocities);
+  status.add("mimic joints contradicting their leader", c.mimic_contradictions);
+  status.add("samples with a joint held from an earlier message", c.held_samples);
   status.add("joints with measured velocities", pipeline_->velocitiesUsed());
   status.add("not published: stale input", c.count(Outcome::kStale));
   status.add("time jumps back", c.backJumps());

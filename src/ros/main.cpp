@@ -2,12 +2,14 @@
 // robot_description. A bad configuration exits non-zero with the culprit named.
 // --help and --version print and exit 0 before ros::init (no master, no parameters).
 #include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/ros/estimator_node.hpp>
 
 #include <ros/ros.h>
 
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 namespace {
 
@@ -31,6 +33,26 @@ Options (handled before ROS starts):
 Exit status: 0 on shutdown; 1 a bad configuration or model (the culprit is named).
 )";
 
+// The robot_description parameter not set yet (a launch file whose xacro or
+// robot_state_publisher step comes later, a description loaded by hand): waited for,
+// said every 5 s, not taken for an error. Here, not in the node's constructor: a
+// nodelet's onInit must not block its manager (the nodelet refuses it at once).
+bool waitForRobotDescription(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
+  std::string name;
+  private_nh.param<std::string>("robot_description", name, jle::Settings().robot_description);
+  ros::WallTime said;
+  while (!nh.hasParam(name)) {
+    if (!ros::ok()) return false;
+    if (said.isZero() || (ros::WallTime::now() - said).toSec() >= 5.0) {
+      said = ros::WallTime::now();
+      ROS_WARN("waiting for the parameter '%s' (robot_description): not set yet",
+               nh.resolveName(name).c_str());
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -47,6 +69,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "joint_load_estimator");
   ros::NodeHandle nh, private_nh("~");
   try {
+    if (!waitForRobotDescription(nh, private_nh)) return 0;  // shut down while waiting
     jle::EstimatorNode node(nh, private_nh);
     ros::spin();
   } catch (const std::exception& e) {

@@ -9,6 +9,8 @@
 #include <joint_load_estimator/urdf_reader.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
 
+#include "bag_errors.hpp"
+
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/serialization.h>
 #include <rosbag/bag.h>
@@ -215,6 +217,7 @@ class BagProcessor {
   void run();
 
  private:
+  void process(rosbag::Bag& in);
   void checkTopics(const rosbag::Bag& in, rosbag::View& view);
   void smoothInputs(rosbag::View& view);
   void dispatch(const rosbag::MessageInstance& m);
@@ -246,15 +249,20 @@ class BagProcessor {
   // Each problem (problemKey) is said once (the node throttles), its count in the summary.
   std::unordered_set<std::size_t> said_;
   bool said_unknown_ = false;
+  bool said_mimic_ = false;
 };
 
 void BagProcessor::run() {
   rosbag::Bag in;
   try {
     in.open(options_.bag, rosbag::bagmode::Read);
+    process(in);
   } catch (const rosbag::BagException& e) {
-    throw std::runtime_error(options_.bag + ": " + e.what());
+    throw std::runtime_error(jle::bagReadError(options_.bag, e));
   }
+}
+
+void BagProcessor::process(rosbag::Bag& in) {
   std::vector<std::string> topics{joint_topic_, "/tf", "/tf_static"};
   topics.insert(topics.end(), wrench_topics_.begin(), wrench_topics_.end());
   topics.insert(topics.end(), plate_topics_.begin(), plate_topics_.end());
@@ -380,6 +388,11 @@ void BagProcessor::note(jle::Outcome outcome) {
     std::fprintf(stderr, "process_bag: warning: %s: joint '%s' is not in the model: ignored\n",
                  joint_topic_.c_str(), pipeline_.unknownJoint().c_str());
   }
+  if (!pipeline_.mimicContradiction().empty() && !said_mimic_) {
+    said_mimic_ = true;
+    std::fprintf(stderr, "process_bag: warning: %s: %s (further ones counted in the summary)\n",
+                 joint_topic_.c_str(), pipeline_.mimicContradiction().c_str());
+  }
   if (pipeline_.problem().empty()) return;
   // Without /tf nothing can resolve the frame later: a data error, as the usage says.
   if ((outcome == jle::Outcome::kFrame || outcome == jle::Outcome::kNoBasePose) && !have_tf_)
@@ -467,11 +480,19 @@ void BagProcessor::printDrops() const {
   if (c.unknown_joints)
     drops +=
         (drops.empty() ? "" : ", ") + std::to_string(c.unknown_joints) + " with unknown joints";
+  if (c.mimic_contradictions)
+    drops += (drops.empty() ? "" : ", ") + std::to_string(c.mimic_contradictions) +
+             " with a mimic joint contradicting its leader";
   if (c.backJumps())
     drops += (drops.empty() ? "" : ", ") + std::to_string(c.backJumps()) + " time jumps back";
   if (c.forward_jumps)
     drops += (drops.empty() ? "" : ", ") + std::to_string(c.forward_jumps) + " time jumps forward";
   if (!drops.empty()) std::fprintf(stderr, "process_bag: not used: %s\n", drops.c_str());
+  if (c.held_samples)
+    std::fprintf(stderr,
+                 "process_bag: %ld samples held a joint from an earlier message (joint states "
+                 "split over publishers)\n",
+                 c.held_samples);
 }
 
 }  // namespace

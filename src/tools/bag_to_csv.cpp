@@ -8,6 +8,8 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "bag_errors.hpp"
+
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -84,6 +86,7 @@ class Writer {
         *r++ = m.acceleration[i];
       }
     for (double e : m.motor_effort) *r++ = e;
+    *r++ = m.status;
     out_->writeRow(row_.data(), row_.size());
   }
 
@@ -113,6 +116,7 @@ class Writer {
     layout.effort_stddev = stddev_ > 0;
     layout.kinematics = o_.kinematics;
     layout.motor_effort = motor_ > 0;
+    layout.status = true;  // JointLoads.status, as process_bag --csv writes it
     const std::vector<std::string> header = jle::jointLoadColumns(names_, layout);
     row_.resize(header.size());
     out_ = std::make_unique<jle::CsvWriter>(o_.output);
@@ -140,20 +144,20 @@ class Writer {
 
 void run(const Options& o) {
   rosbag::Bag bag;
-  try {
-    bag.open(o.bag, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw std::runtime_error(o.bag + ": " + e.what());
-  }
   Writer writer(o);
   long index = 0;
-  for (const rosbag::MessageInstance& mi : rosbag::View(bag, rosbag::TopicQuery(o.topic))) {
-    const joint_load_estimator::JointLoads::ConstPtr m =
-        mi.instantiate<joint_load_estimator::JointLoads>();
-    if (!m)
-      throw std::runtime_error(o.bag + ": " + o.topic + " holds " + mi.getDataType() +
-                               ", not joint_load_estimator/JointLoads");
-    writer.write(*m, index++);
+  try {
+    bag.open(o.bag, rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& mi : rosbag::View(bag, rosbag::TopicQuery(o.topic))) {
+      const joint_load_estimator::JointLoads::ConstPtr m =
+          mi.instantiate<joint_load_estimator::JointLoads>();
+      if (!m)
+        throw std::runtime_error(o.bag + ": " + o.topic + " holds " + mi.getDataType() +
+                                 ", not joint_load_estimator/JointLoads");
+      writer.write(*m, index++);
+    }
+  } catch (const rosbag::BagException& e) {
+    throw std::runtime_error(jle::bagReadError(o.bag, e));
   }
   writer.commit(index);
 }

@@ -214,7 +214,7 @@ void Outputs::open(const jle::Pipeline& pipeline) {
   const std::size_t external =
       record.external_effort.empty() ? 0 : record.joint.size() + 1 + 6 * record.contacts.size();
   row_.resize(sto_columns_ +
-              (options.csv.empty() ? 0 : kinematics + record.motor_effort.size() + external));
+              (options.csv.empty() ? 0 : kinematics + record.motor_effort.size() + external + 1));
   if (!options.output.empty()) {
     bag_temporary_ = options.output + ".partial";
     bag_ = std::make_unique<rosbag::Bag>();
@@ -241,6 +241,7 @@ void Outputs::open(const jle::Pipeline& pipeline) {
     layout.kinematics = options.kinematics;
     layout.motor_effort = !record.motor_effort.empty();
     layout.external_effort = !record.external_effort.empty();
+    layout.status = true;
     if (layout.external_effort)
       for (const jle::ContactEstimate& c : record.contacts) layout.contacts.push_back(c.link);
     csv_ = std::make_unique<jle::CsvWriter>(options.csv);
@@ -264,11 +265,12 @@ void Outputs::openSmoothed(const jle::Pipeline& pipeline) {
   layout.effort_stddev = !record.effort_stddev.empty();
   layout.kinematics = options_.kinematics;
   layout.motor_effort = !record.motor_effort.empty();
+  layout.status = true;
   smoothed_csv_ = std::make_unique<jle::CsvWriter>(options_.smoothed_csv);
   smoothed_csv_->writeHeader(jle::jointLoadColumns(record.joint, layout));
   smoothed_row_.resize(1 + 7 * record.joint.size() + record.effort_stddev.size() +
                        (options_.kinematics ? 3 * record.joint.size() : 0) +
-                       record.motor_effort.size());
+                       record.motor_effort.size() + 1);
 }
 
 Outputs::~Outputs() {
@@ -295,9 +297,16 @@ double* Outputs::writeLoads(const jle::LoadsRecord& record, bool csv, double* ro
   return row;
 }
 
+namespace {
+double* writeStatus(const jle::LoadsRecord& record, double* row) {
+  *row++ = record.status;
+  return row;
+}
+}  // namespace
+
 void Outputs::writeSmoothed(const jle::LoadsRecord& record, long seq) {
   if (smoothed_csv_) {
-    double* end = writeLoads(record, true, smoothed_row_.data());
+    double* end = writeStatus(record, writeLoads(record, true, smoothed_row_.data()));
     assert(static_cast<std::size_t>(end - smoothed_row_.data()) == smoothed_row_.size());
     (void)end;
     smoothed_csv_->writeRow(smoothed_row_.data(), smoothed_row_.size());
@@ -312,7 +321,7 @@ void Outputs::writeSmoothed(const jle::LoadsRecord& record, long seq) {
 void Outputs::write(const jle::LoadsRecord& record, long seq) {
   if (!bag_ && !csv_ && !sto_) return;
   double* row = writeLoads(record, csv_ != nullptr, row_.data());
-  if (csv_) row = writeExternal(record, row);
+  if (csv_) row = writeStatus(record, writeExternal(record, row));
   assert(static_cast<std::size_t>(row - row_.data()) == (csv_ ? row_.size() : sto_columns_));
   if (csv_) csv_->writeRow(row_.data(), row_.size());
   if (sto_) sto_->writeRow(row_.data(), sto_columns_);

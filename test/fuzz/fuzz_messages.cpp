@@ -290,11 +290,20 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
     JLE_FUZZ_CHECK(shadow.last != 0 && stamp <= shadow.last);
     return;
   }
+  // A value no UR5 produces (beyond its limits, faster than it moves): dropped after the
+  // stamp checks, not taken, named.
+  if (outcome == Outcome::kImplausible) {
+    JLE_FUZZ_CHECK(!p.problem().empty());
+    return;
+  }
   JLE_FUZZ_CHECK(shadow.last == 0 || stamp > shadow.last);
   shadow.taken(stamp);
   if (outcome == Outcome::kPublished) {
     JLE_FUZZ_CHECK(p.record().stamp <= stamp);
     JLE_FUZZ_CHECK(p.record().effort.size() == p.record().joint.size());
+    for (std::size_t i = 0; i < p.record().effort.size(); ++i)  // never a non-finite load
+      JLE_FUZZ_CHECK(std::isfinite(p.record().effort[i]) && p.record().force[i].allFinite() &&
+                     p.record().moment[i].allFinite());
   }
   // The smoothed stream describes a sample taken on this timeline, at or before this one.
   if (p.smoothedPublished()) {
@@ -303,18 +312,31 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
   }
 }
 
-void checkWrenchOutcome(const jle::Pipeline& p, bool finite, const std::string& frame,
-                        jle::Stamp stamp, jle::Stamp clock, jle::Outcome outcome, Shadow& shadow) {
+void checkWrenchOutcome(const jle::Pipeline& p, const Eigen::Vector3d& force,
+                        const Eigen::Vector3d& moment, const std::string& frame, jle::Stamp stamp,
+                        jle::Stamp clock, jle::Outcome outcome, Shadow& shadow) {
   using jle::Outcome;
-  if (!finite) {
+  if (!force.allFinite() || !moment.allFinite()) {
     JLE_FUZZ_CHECK(outcome == Outcome::kInvalid);
     return;
   }
   const bool rogue = !Shadow::zero(shadow.wrench_stamped, stamp, clock) ||
                      (shadow.clockSeen(stamp, clock), shadow.wrenchRogue(stamp));
   JLE_FUZZ_CHECK(rogue == (outcome == Outcome::kRogueStamp));
-  if (rogue) JLE_FUZZ_CHECK(!p.problem().empty());
-  if (frame == "nowhere" && !rogue) JLE_FUZZ_CHECK(outcome == Outcome::kFrame);
+  if (rogue) {
+    JLE_FUZZ_CHECK(!p.problem().empty());
+    return;
+  }
+  // Beyond plausibility's bounds (the defaults: settingsFrom leaves them): dropped, named.
+  const jle::PlausibilityConfig bounds;
+  const bool implausible =
+      force.stableNorm() > bounds.max_force || moment.stableNorm() > bounds.max_moment;
+  JLE_FUZZ_CHECK(implausible == (outcome == Outcome::kImplausible));
+  if (implausible) {
+    JLE_FUZZ_CHECK(!p.problem().empty());
+    return;
+  }
+  if (frame == "nowhere") JLE_FUZZ_CHECK(outcome == Outcome::kFrame);
 }
 
 }  // namespace
@@ -343,7 +365,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       for (int i = 0; i < 3; ++i) mo[i] = in.value();
       const std::string frame = kind % 8 == 7 ? "tool0" : (kind & 8) ? "base_link" : "nowhere";
       const jle::Outcome outcome = p.onWrench(0, stamp, clock, frame, f, mo);
-      checkWrenchOutcome(p, f.allFinite() && mo.allFinite(), frame, stamp, clock, outcome, shadow);
+      checkWrenchOutcome(p, f, mo, frame, stamp, clock, outcome, shadow);
       continue;
     }
     decodeJointState(in, js);

@@ -508,6 +508,34 @@ def test_estimator_defaults_are_the_nodes(tmp_path):
         jle.Estimator(model, str(bad))
 
 
+def test_estimate_refuses_an_absurd_position_and_says_what_to_trust():
+    """Never silently wrong (README): a joint state with a position of 1e300 or one joint
+    3 rad off for one sample is refused (status "implausible") and changes no load (the
+    loads equal those of the same samples without it, to the bit); each record's status
+    bits (loads_status) say settling at the start, trusted after."""
+    model = jle.Model(PANDA)
+    t = 0.001 * np.arange(500)
+    q = 0.3 * np.sin(np.outer(t, np.arange(1, model.nq + 1)))
+    q[:, 3] -= 1.5  # panda_joint4 lies in [-3.07, -0.07]
+    q[:, 5] += 1.5  # panda_joint6 in [-0.02, 3.75]
+    q[:, 7] = 0.02  # the finger
+    bad = q.copy()
+    bad[200, 1] = 1e300
+    bad[300, 2] += 3.0
+    keep = [i for i in range(len(t)) if i not in (200, 300)]
+    clean = jle.estimate(jle.Estimator(model), t[keep], q[keep])
+    got = jle.estimate(jle.Estimator(model), t, bad)
+    assert got.status[200] == "implausible" and got.status[300] == "implausible"
+    assert sum(s == "implausible" for s in got.status) == 2
+    assert len(got) == len(clean) > 400
+    assert np.isfinite(got.effort).all()
+    assert np.array_equal(got.effort, clean.effort)
+    bits = np.asarray(got.loads_status)
+    assert len(bits) == len(got)
+    assert bits[0] & 1  # settling: the first records after the start
+    assert (bits[-300:] == 0).all()  # trusted
+
+
 def test_inverse_dynamics_releases_the_gil():
     """While a long batch runs in one thread, another keeps running Python: its longest
     pause is a fraction of the batch's time (with the GIL held it would be all of it)."""

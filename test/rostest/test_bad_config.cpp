@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -27,7 +28,11 @@ struct NodeRun {
 // Starts the node in namespace `ns` and collects its output until it exits, or until
 // its output contains `until` (then it is asked to stop with SIGINT, as by Ctrl-C), or
 // the time limit (then it is killed).
-NodeRun runNode(const std::string& ns, const std::string& until = "", double limit = 20.0) {
+// `trigger`, when the output first contains its first string, runs its second (a shell
+// command) once.
+using Trigger = std::pair<std::string, std::string>;
+NodeRun runNode(const std::string& ns, const std::string& until = "", double limit = 20.0,
+                const Trigger& trigger = {}) {
   NodeRun run;
   int fds[2];
   if (pipe(fds) != 0) {
@@ -50,7 +55,7 @@ NodeRun runNode(const std::string& ns, const std::string& until = "", double lim
   }
   close(fds[1]);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
-  bool signalled = false, eof = false;
+  bool signalled = false, eof = false, trigger_done = trigger.first.empty();
   while (!eof) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         end - std::chrono::steady_clock::now());
@@ -64,6 +69,10 @@ NodeRun runNode(const std::string& ns, const std::string& until = "", double lim
       break;
     }
     run.output.append(buffer, static_cast<std::size_t>(n));
+    if (!trigger_done && run.output.find(trigger.first) != std::string::npos) {
+      EXPECT_EQ(std::system(trigger.second.c_str()), 0) << trigger.second;
+      trigger_done = true;
+    }
     if (!signalled && !until.empty() && run.output.find(until) != std::string::npos) {
       kill(pid, SIGINT);
       signalled = true;
@@ -99,8 +108,21 @@ TEST(BadConfig, GoodConfigurationRuns) {
   EXPECT_NE(run.output.find("7 segments, 6 coordinates"), std::string::npos) << run.output;
 }
 
-TEST(BadConfig, MissingRobotDescription) {
-  expectRefused("/no_description", {"'/no_description/robot_description'", "is not set"});
+// No robot_description yet (a launch file that sets it later): the node waits, saying
+// which parameter, and starts once it is set (here by the test, from the UR5's file).
+TEST(BadConfig, MissingRobotDescriptionIsWaitedFor) {
+  const std::string set = std::string(
+                              "/usr/bin/python3 -c \"import rospy; rospy.set_param("
+                              "'/no_description/robot_description', open('") +
+                          JLE_TEST_DATA + "/urdf/chains/ur5_chain.urdf').read())\"";
+  const NodeRun run = runNode("/no_description", "7 segments, 6 coordinates", 30.0,
+                              {"waiting for the parameter", set});
+  ASSERT_TRUE(run.exited) << run.output;
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("waiting for the parameter '/no_description/robot_description'"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("7 segments, 6 coordinates"), std::string::npos) << run.output;
 }
 
 TEST(BadConfig, RobotDescriptionThatIsNotXml) {

@@ -120,6 +120,15 @@ geometry_msgs::WrenchStamped wild(const ros::Time& stamp) {
 
 const ros::Duration kTwoHours(7200.0);
 
+// A joint state 0.5 ms before the sample `js`, joint 1 at `q1`: used, it would be a
+// sample of its own (and a glitch in every filter).
+sensor_msgs::JointState joint1At(const sensor_msgs::JointState& js, double q1) {
+  sensor_msgs::JointState bad = js;
+  bad.header.stamp = js.header.stamp - ros::Duration(0.0005);
+  bad.position[1] = q1;
+  return bad;
+}
+
 const std::vector<Kind>& kinds() {
   static const std::vector<Kind> table = {
       {"DuplicateName", "a joint named twice, the second 0.5 rad off", "dropped: invalid",
@@ -177,6 +186,27 @@ const std::vector<Kind>& kinds() {
        }},
       {"WrenchStampedZero", "a wrench stamped 0 on a stamped input", "dropped: rogue stamp",
        [](sensor_msgs::JointState&, const HostileSend& send) { send.wrench(wild(ros::Time())); }},
+      // Never silently wrong (issue 39): values no UR5 produces.
+      {"AbsurdPosition", "a joint state with a position of 1e300 rad", "dropped: implausible",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.joint(joint1At(js, 1e300));
+       }},
+      {"PositionBeyondLimits", "a joint state with a position of 100 rad (limits 2 pi)",
+       "dropped: implausible",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.joint(joint1At(js, 100.0));
+       }},
+      {"GlitchedPosition", "a joint state with one joint 3 rad off for one sample",
+       "dropped: implausible",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         send.joint(joint1At(js, js.position[1] + 3.0));
+       }},
+      {"AbsurdWrench", "a wrench of 1e300 N", "dropped: implausible",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         geometry_msgs::WrenchStamped w = wild(js.header.stamp);
+         w.wrench.force.x = 1e300;
+         send.wrench(w);
+       }},
   };
   return table;
 }
@@ -280,6 +310,8 @@ void hostileStream(const std::vector<const Kind*>& cycle, const ros::Time& start
                                          "efforts not compared: non-finite",
                                          "dropped: rogue stamp",
                                          "dropped: stamp order",
+                                         "dropped: implausible",
+                                         "not published: non-finite loads",
                                          "time jumps back",
                                          "input '/hostile/joint_states': lost (header.seq gaps)"};
   for (const std::string& key : keys)

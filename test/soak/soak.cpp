@@ -2,12 +2,15 @@
 // through the node's message path (jle::Pipeline, with the default settings and a wrench
 // input), as fast as it runs, with bad messages mixed in every 50 samples: NaN
 // positions, a position array of the wrong length, a duplicate stamp, a backward stamp,
-// an unknown joint name, a NaN wrench and a backward wrench. Checks that
+// an unknown joint name, a NaN wrench, a backward wrench, and what no arm produces (a
+// position of 1e300 rad, one joint 3 rad off for one message, a wrench of 1e300 N).
+// Checks that
 //  - memory stays flat: VmRSS at 100% of the samples exceeds VmRSS at 10% by < 1 MB;
 //  - no good sample is lost: every good sample after the filter's warm-up is published
 //    (the warm-up happening once, at the start);
 //  - every bad message is counted under its own reason (the pipeline's counters), as
-//    many times as it was injected.
+//    many times as it was injected;
+//  - every load published is finite, and trusted once the filters have settled.
 // Prints the figures; exits 1 on a failed check. Usage: soak [SAMPLES (default 1000000)]
 #include <joint_load_estimator/command_line.hpp>
 #include <joint_load_estimator/pipeline.hpp>
@@ -36,10 +39,22 @@ long vmRssKb() {
   return -1;
 }
 
-enum Bad { kNan, kLength, kDuplicate, kBackward, kUnknown, kWrenchNan, kWrenchBackward, kKinds };
-const char* const kBadName[kKinds] = {"nan_position",   "wrong_length",  "duplicate_stamp",
-                                      "backward_stamp", "unknown_joint", "nan_wrench",
-                                      "backward_wrench"};
+enum Bad {
+  kNan,
+  kLength,
+  kDuplicate,
+  kBackward,
+  kUnknown,
+  kWrenchNan,
+  kWrenchBackward,
+  kAbsurd,
+  kGlitch,
+  kWrenchAbsurd,
+  kKinds
+};
+const char* const kBadName[kKinds] = {
+    "nan_position", "wrong_length",    "duplicate_stamp", "backward_stamp", "unknown_joint",
+    "nan_wrench",   "backward_wrench", "absurd_position", "glitch_3_rad",   "absurd_wrench"};
 
 }  // namespace
 
@@ -79,6 +94,7 @@ int main(int argc, char** argv) {
 
   long injected[kKinds] = {};
   long good = 0, published = 0, warming = 0, late_warming = 0, other = 0;
+  long nonfinite = 0, untrusted = 0;  // published loads: not finite; flagged after 1 s
   long rss_10 = -1;
   // The clock (the node's ros::Time::now()) goes on at the pace of the good samples; a
   // bad message's stamp is its own.
@@ -111,9 +127,12 @@ int main(int argc, char** argv) {
       s = message(stamp, names, position);
     }
     ++good;
-    if (s == Outcome::kPublished)
+    if (s == Outcome::kPublished) {
       ++published;
-    else if (s == Outcome::kUsed)
+      const jle::LoadsRecord& r = pipeline.record();
+      for (double e : r.effort) nonfinite += !std::isfinite(e);
+      untrusted += i > 1000 && r.status != jle::kTrusted;
+    } else if (s == Outcome::kUsed)
       (published == 0 ? warming : late_warming)++;
     else
       ++other;
@@ -121,7 +140,7 @@ int main(int argc, char** argv) {
     // The bad messages, after it.
     if (i % 50 != 10) continue;
     const jle::Stamp half = dt / 2;
-    switch ((i / 50) % 6) {
+    switch ((i / 50) % 9) {
       case 0: {  // a NaN position: refused before it reaches the filters
         ++injected[kNan];
         std::vector<double> p = position;
@@ -140,6 +159,24 @@ int main(int argc, char** argv) {
       case 3:
         ++injected[kBackward];
         message(stamp - half, names, position);
+        break;
+      case 6: {  // finite but absurd: refused at the door, counted implausible
+        ++injected[kAbsurd];
+        std::vector<double> p = position;
+        p[1] = 1e300;
+        message(stamp + half, names, p);
+        break;
+      }
+      case 7: {  // one joint 3 rad off for one message: faster than it can move
+        ++injected[kGlitch];
+        std::vector<double> p = position;
+        p[2] += 3.0;
+        message(stamp + half, names, p);
+        break;
+      }
+      case 8:
+        ++injected[kWrenchAbsurd];
+        pipeline.onWrench(0, stamp + half, now, frame, Eigen::Vector3d(0, 0, 1e300), m);
         break;
       case 4:
         ++injected[kWrenchNan];
@@ -165,7 +202,10 @@ int main(int argc, char** argv) {
       c.count(InputKind::kJointState, Outcome::kOrder) - injected[kDuplicate],
       c.unknown_joints,
       c.count(InputKind::kWrench, Outcome::kInvalid),
-      c.count(InputKind::kWrench, Outcome::kOrder)};
+      c.count(InputKind::kWrench, Outcome::kOrder),
+      c.count(InputKind::kJointState, Outcome::kImplausible) - injected[kGlitch],
+      c.count(InputKind::kJointState, Outcome::kImplausible) - injected[kAbsurd],
+      c.count(InputKind::kWrench, Outcome::kImplausible)};
 
   bool ok = true;
   auto expect = [&](bool cond, const char* what) {
@@ -187,8 +227,13 @@ int main(int argc, char** argv) {
          "warm-up is not a few samples, once, at the start");
   expect(published == good - warming, "a good sample was not published");
   expect(other == 0, "a good sample or wrench got another outcome");
-  expect(c.received(InputKind::kJointState) ==
-             good + injected[kNan] + injected[kLength] + injected[kDuplicate] + injected[kBackward],
+  std::printf("published loads not finite: %ld; flagged untrusted after 1 s: %ld\n", nonfinite,
+              untrusted);
+  expect(nonfinite == 0, "a published load is not finite");
+  expect(untrusted == 0, "a load after the filters settled is flagged untrusted");
+  expect(c.received(InputKind::kJointState) == good + injected[kNan] + injected[kLength] +
+                                                   injected[kDuplicate] + injected[kBackward] +
+                                                   injected[kAbsurd] + injected[kGlitch],
          "a joint state was not counted");
   for (int k = 0; k < kKinds; ++k)
     expect(injected[k] > 0 && counted[k] == injected[k], kBadName[k]);

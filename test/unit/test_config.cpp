@@ -95,13 +95,14 @@ TEST(Config, DefaultsAreTheNodes) {
   EXPECT_EQ(s.body_mass, 0.0);
   EXPECT_TRUE(s.estimator.joints.empty());
   EXPECT_TRUE(s.wrenches.empty() && s.force_plates.empty());
-  // Element defaults: an F/T sensor's load on the robot, held when stale; a plate
-  // zeroed when stale, 20 N of contact threshold.
+  // Element defaults: an F/T sensor's load on the robot, zeroed when stale (held only by
+  // choice, for max_hold); a plate zeroed when stale, 20 N of contact threshold.
   const jle::WrenchInputConfig w;
   const jle::WrenchTopicSettings wt;
   EXPECT_EQ(w.sign, 1.0);
   EXPECT_EQ(w.timeout, 0.1);
-  EXPECT_EQ(w.stale_policy, jle::StalePolicy::kHold);
+  EXPECT_EQ(w.stale_policy, jle::StalePolicy::kZero);
+  EXPECT_EQ(w.max_hold, 1.0);
   EXPECT_EQ(wt.force_threshold, 5.0);
   EXPECT_EQ(wt.moment_threshold, 0.5);
   const jle::PlateInputConfig p;

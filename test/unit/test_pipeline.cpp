@@ -364,17 +364,18 @@ TEST(Pipeline, StampZeroIsTheClockOnlyOnAStreamThatNeverHadStamps) {
   addWrenchInput(settings, "tool0");
   jle::Pipeline pipeline(model, settings, nullptr);
   const Eigen::Vector3d f(1.0, 2.0, 3.0), m(0.3, -0.2, 0.1);
-  // A live driver that stamps nothing: the clock (the reception time) stands in.
+  // A live driver that stamps nothing: the clock (the reception time) stands in. Every
+  // joint at 1 rad/s, which a UR5 can do (plausibility: its URDF's 3.15 rad/s).
   for (int k = 0; k < 4; ++k) {
     const Stamp clock = kStart + k * kMs;
     ASSERT_EQ(pipeline.onWrench(0, 0, clock, "tool0", f, m), Outcome::kUsed);
-    const std::vector<double> p(6, 0.1 * k);
+    const std::vector<double> p(6, 0.001 * k);
     const Outcome o = pipeline.onJointState(0, clock, model.coordinate_names, p, kNone, kNone);
-    ASSERT_EQ(o, k < 2 ? Outcome::kUsed : Outcome::kPublished);
+    ASSERT_EQ(o, k < 2 ? Outcome::kUsed : Outcome::kPublished) << k << ": " << pipeline.problem();
   }
   EXPECT_EQ(pipeline.record().stamp, kStart + (3 - pipeline.delaySamples()) * kMs);
   // Once a stream has had a stamp, a stamp 0 is dropped and counted, whatever the clock.
-  const std::vector<double> p(6, 0.5);
+  const std::vector<double> p(6, 0.005);
   EXPECT_EQ(pipeline.onJointState(kStart + 5 * kMs, kStart + 5 * kMs, model.coordinate_names, p,
                                   kNone, kNone),
             Outcome::kPublished);
@@ -724,8 +725,11 @@ TEST(Pipeline, SmootherDelayIsTheLagInSeconds) {
   for (int k = 0; k < 1500; ++k) {
     const Stamp step = k < 1000 ? static_cast<Stamp>(random.uniform(0.8, 1.2) * kMs) : 5 * kMs;
     stamp += k == 0 ? 0 : (k == 1 ? 1750000 : step);
+    // Within the UR5's limits for its 3.5 s (q() takes shoulder_pan beyond 2 pi at 2.7 s).
     std::vector<double> p(6);
-    for (int i = 0; i < 6; ++i) p[static_cast<std::size_t>(i)] = q(i, 1e-9 * (stamp - kStart));
+    for (int i = 0; i < 6; ++i)
+      p[static_cast<std::size_t>(i)] =
+          0.5 * std::sin(1e-9 * static_cast<double>(stamp - kStart) + i);
     sent.push_back(stamp);
     const auto take = [&]() {
       published.push_back(pipeline.record().stamp);

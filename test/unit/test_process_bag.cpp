@@ -292,6 +292,21 @@ void expectClose(double actual, double expected, const std::string& what) {
   EXPECT_NEAR(actual, expected, 1e-9 * std::max(1.0, std::abs(expected))) << what;
 }
 
+// The status column (last): the records of the first plausibility/settle_time (0.05 s)
+// after the start are settling (bit 1), every later one trusted (0): the wrench is fresh.
+void expectStatus(const Table& csv) {
+  ASSERT_FALSE(csv.rows.empty());
+  const double start = csv.rows.front()[0];
+  EXPECT_EQ(static_cast<int>(csv.rows.front().back()) & 1, 1);
+  int trusted = 0;
+  for (const std::vector<double>& row : csv.rows)
+    if (row[0] > start + 0.06) {
+      EXPECT_EQ(row.back(), 0.0) << "at " << row[0];
+      ++trusted;
+    }
+  EXPECT_GT(trusted, 50);
+}
+
 TEST_F(ProcessBagTest, CsvEqualsTheEstimatorDrivenWithTheSameMessages) {
   const Messages m = makeMessages();
   writeBag(path("in.bag"), m);
@@ -327,7 +342,8 @@ TEST_F(ProcessBagTest, CsvEqualsTheEstimatorDrivenWithTheSameMessages) {
                                            "panda_joint7.mx",
                                            "panda_joint7.my",
                                            "panda_joint7.mz",
-                                           "panda_joint7.effort"};
+                                           "panda_joint7.effort",
+                                           "status"};
   EXPECT_EQ(csv.header, header);
   // 300 samples, the first 10 fill the window, every second one is published.
   ASSERT_EQ(e.t.size(), 145u);
@@ -335,9 +351,10 @@ TEST_F(ProcessBagTest, CsvEqualsTheEstimatorDrivenWithTheSameMessages) {
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
     ASSERT_EQ(csv.rows[i].size(), header.size());
     expectClose(csv.rows[i][0], e.t[i], "t, row " + std::to_string(i));
-    for (std::size_t c = 1; c < header.size(); ++c)
+    for (std::size_t c = 1; c + 1 < header.size(); ++c)
       expectClose(csv.rows[i][c], e.values[i][c - 1], header[c] + ", row " + std::to_string(i));
   }
+  expectStatus(csv);
 }
 
 // The smoothed stream (on by default) against its estimator driven by hand: the same
@@ -353,16 +370,18 @@ TEST_F(ProcessBagTest, SmoothedCsvEqualsTheSmootherDrivenWithTheSameMessages) {
   EXPECT_NE(r.output.find("smoothed stream (lag 0.2 s)"), std::string::npos) << r.output;
   const Expected e = expectedLoads(m, true);
   const Table csv = readCsv(path("smoothed.csv"));
-  ASSERT_EQ(csv.header.size(), 22u);
+  ASSERT_EQ(csv.header.size(), 23u);
+  EXPECT_EQ(csv.header.back(), "status");
   // Every second of the 300 samples (decimation 2): all of them reach the smoothed
   // stream, the end of the bag included.
   ASSERT_EQ(e.t.size(), 150u);
   ASSERT_EQ(csv.rows.size(), e.t.size());
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
     expectClose(csv.rows[i][0], e.t[i], "t, row " + std::to_string(i));
-    for (std::size_t c = 1; c < csv.header.size(); ++c)
+    for (std::size_t c = 1; c + 1 < csv.header.size(); ++c)
       expectClose(csv.rows[i][c], e.values[i][c - 1], csv.header[c] + ", row " + std::to_string(i));
   }
+  expectStatus(csv);
 }
 
 TEST_F(ProcessBagTest, BagOutputHoldsTheLoadsAndTheMeasuredEfforts) {
@@ -457,7 +476,7 @@ Comparison compareWithExact(const std::string& csv_path, const std::string& bag_
     for (std::size_t col = 1; col < csv.header.size(); ++col) {
       const std::string& name = csv.header[col];
       const std::size_t dot = name.rfind('.');
-      if (name.substr(dot) != ".effort") continue;
+      if (dot == std::string::npos || name.substr(dot) != ".effort") continue;  // status
       const double truth = it->second.at(name.substr(0, dot));
       c.max_error = std::max(c.max_error, std::abs(row[col] - truth));
       c.max_effort = std::max(c.max_effort, std::abs(truth));
@@ -762,6 +781,42 @@ TEST_F(ProcessBagTest, IdentifiedInertiaNeedsTheFlagOrTheSetting) {
   EXPECT_TRUE(fs::exists(path("o.csv")));
 }
 
+// Never silently wrong (README): joint states no arm produces between the samples (a
+// position of 1e300 rad, one joint 3 rad off) are refused, counted and named; the loads
+// are those of the bag without them, to the bit, and the tool exits 0.
+TEST_F(ProcessBagTest, AbsurdAndGlitchedPositionsChangeNoLoad) {
+  const Messages m = makeMessages();
+  writeBag(path("clean.bag"), m);
+  Messages hostile = m;
+  const auto glitch = [&](int after, double q2) {  // panda_joint2 set to q2, 0.5 ms later
+    sensor_msgs::JointState js = m.joints[static_cast<std::size_t>(after)].second;
+    js.header.stamp += ros::Duration(0.0005);
+    for (std::size_t i = 0; i < js.name.size(); ++i)
+      if (js.name[i] == "panda_joint2") js.position[i] = q2;
+    hostile.joints.emplace_back(js.header.stamp, js);
+  };
+  glitch(100, 1e300);
+  glitch(200, position(1, 0.2) + 3.0);
+  writeBag(path("hostile.bag"), hostile);
+  writeFile(path("config.yaml"), kConfig);
+  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) +
+                           " --config " + quote(path("config.yaml"));
+  const Result clean =
+      run(tool + " --bag " + quote(path("clean.bag")) + " --csv " + quote(path("clean.csv")));
+  ASSERT_EQ(clean.status, 0) << clean.output;
+  const Result r =
+      run(tool + " --bag " + quote(path("hostile.bag")) + " --csv " + quote(path("hostile.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("position of joint 'panda_joint2' is 1e+300"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("2 implausible"), std::string::npos) << r.output;  // the summary
+  const Table a = readCsv(path("clean.csv")), b = readCsv(path("hostile.csv"));
+  EXPECT_EQ(b.header, a.header);
+  ASSERT_EQ(b.rows.size(), a.rows.size());
+  ASSERT_GT(a.rows.size(), 100u);
+  for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(b.rows[i], a.rows[i]) << "row " << i;
+}
+
 TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
   const Messages m = makeMessages();
   writeBag(path("in.bag"), m);
@@ -801,6 +856,16 @@ TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
   EXPECT_NE(r.output.find("'panda_link3'"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(path("o.bag")));
   EXPECT_FALSE(fs::exists(path("o.bag.partial")));
+
+  // A bag cut short (a recorder killed): rosbag's words and the repair.
+  fs::copy_file(path("in.bag"), path("cut.bag"));
+  fs::resize_file(path("cut.bag"), fs::file_size(path("cut.bag")) * 2 / 3);
+  r = run(tool + " --bag " + quote(path("cut.bag")) + " --config " + quote(path("config.yaml")) +
+          " --csv " + quote(path("o.csv")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("'rosbag reindex " + path("cut.bag") + "'"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(path("o.csv")));
 
   // Usage errors.
   r = run(tool + " --bag " + quote(path("in.bag")) + " --csv a.csv --output b.bag");

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -220,6 +221,58 @@ TEST(UrdfReader, FloatingJointAtTheRootMakesAFloatingBase) {
   EXPECT_EQ(model.nsegments(), 1);
   EXPECT_EQ(model.link_name[0], "body");
   EXPECT_EQ(model.joint_type[0], jle::JointType::kFloating);
+}
+
+// A link of mass 0 with a nonzero inertia is taken as given, and said (Model::warnings,
+// logged by the node and the tools at load); a massless link without inertia is not.
+TEST(UrdfReader, MassZeroWithANonzeroInertiaIsWarned) {
+  const std::string xml = R"(<robot name="r">
+    <link name="base"/>
+    <link name="l1"><inertial><mass value="0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial></link>
+    <link name="l2"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+    <link name="l3"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+    <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+    <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/></joint>
+    <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><axis xyz="0 0 1"/></joint>
+  </robot>)";
+  const jle::Model<double> model = jle::modelFromUrdfString(xml);
+  ASSERT_EQ(model.warnings.size(), 1u);
+  EXPECT_NE(model.warnings[0].find("link 'l1': mass 0 with a nonzero inertia (ixx 0.01, iyy "
+                                   "0.02, izz 0.03 kg m^2)"),
+            std::string::npos)
+      << model.warnings[0];
+}
+
+// <limit>: the position bounds of a revolute or prismatic joint, none for a continuous
+// one (its lower and upper are ignored); velocity and effort where positive.
+TEST(UrdfReader, JointLimitsAreRead) {
+  const std::string xml = R"(<robot name="r">
+    <link name="base"/>
+    <link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+    <link name="l2"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+    <link name="l3"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+    <joint name="r" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+      <limit lower="-1.5" upper="2" velocity="3" effort="40"/></joint>
+    <joint name="c" type="continuous"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/>
+      <limit lower="-1" upper="1" velocity="0" effort="10"/></joint>
+    <joint name="n" type="revolute"><parent link="l2"/><child link="l3"/><axis xyz="0 0 1"/></joint>
+  </robot>)";
+  const jle::Model<double> model = jle::modelFromUrdfString(xml);
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto s = [&](const char* joint) {
+    return static_cast<std::size_t>(model.segmentOfJoint(joint));
+  };
+  EXPECT_EQ(model.lower_limit[s("r")], -1.5);
+  EXPECT_EQ(model.upper_limit[s("r")], 2.0);
+  EXPECT_EQ(model.velocity_limit[s("r")], 3.0);
+  EXPECT_EQ(model.effort_limit[s("r")], 40.0);
+  EXPECT_EQ(model.lower_limit[s("c")], -inf);
+  EXPECT_EQ(model.upper_limit[s("c")], inf);
+  EXPECT_EQ(model.velocity_limit[s("c")], inf);  // 0: none
+  EXPECT_EQ(model.effort_limit[s("c")], 10.0);
+  EXPECT_EQ(model.lower_limit[s("n")], -inf);  // no <limit>
+  EXPECT_EQ(model.velocity_limit[s("n")], inf);
+  EXPECT_EQ(model.effort_limit[s("n")], inf);
 }
 
 TEST(UrdfReader, MissingFileNamesThePath) {
