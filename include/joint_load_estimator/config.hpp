@@ -305,14 +305,14 @@ struct StampSettings {
   int jump_confirm = 3;
 };
 
-/// The smoothed stream's filter by default: the constant-jerk Kalman smoother, process
-/// noise 1e3 raised from the data where the positions' spectrum shows motion above its
-/// bandwidth (auto_bandwidth: the running leg, the impacts, the gait; docs/accuracy.md),
-/// lag 0.2 s. The process noise was chosen on the accuracy study's scenes (docs/accuracy.md, "The
-/// defaults against the best of the study"): with the joint states' velocities 1.05x the
-/// best offline row on geometric mean over 24 scenes (1e2: 1.24x, 1e4: 1.09x, the adaptive
-/// smoother 1.08x); positions only 1.70x (1e2: 1.63x), and 4.3x where the positions carry
-/// coloured noise (1e2: 2.3x; the adaptive smoother 189-205x). README, "Two streams".
+/// The smoothed stream's filter by default: the constant-jerk Kalman smoother, lag 0.2 s,
+/// its bandwidth set from the data (auto_bandwidth): where the positions' spectrum meets
+/// its noise floor, at least 7 Hz (kLagFloor / lag), and where it shows no floor (data
+/// without noise: the running leg) up to max_bandwidth (1 kHz: 0.45 of the rate);
+/// process noise 1e3 (9 Hz at 1 kHz) until the first choice (4 s; data without noise:
+/// 0.5 s). Measured on the
+/// accuracy study's scenes: docs/accuracy.md, "The defaults against the best of the
+/// study"; README, "Two streams".
 inline DifferentiatorConfig defaultSmoother() {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;
@@ -320,6 +320,7 @@ inline DifferentiatorConfig defaultSmoother() {
   c.process_noise = 1e3;
   c.lag = 0.2;
   c.auto_bandwidth = true;
+  c.max_bandwidth = 1e3;
   return c;
 }
 

@@ -76,6 +76,18 @@ class Estimator {
   bool velocityUsed(int i) const { return velocity_used_[static_cast<std::size_t>(i)] != 0; }
   /// How many coordinates take their q-dot from the measured velocities.
   int velocitiesUsed() const;
+  /// Whether the measured velocities are the better evidence of the rates: true but where
+  /// the filter sets its bandwidth from the data (differentiator.auto_bandwidth, the
+  /// smoothed stream) and both spectra have chosen; there, where the velocities' noise
+  /// floor is below the positions' times (2 pi f)^2, f the positions' bandwidth (at f, the
+  /// velocities' share of noise is the smaller). Where it is false, the coordinates of
+  /// velocityUsed() take q-dot and q-ddot from the positions too (accuracy study: the
+  /// Panda scenes' velocities, 1e-3 rad/s, are worse evidence than their positions;
+  /// the coloured-noise scenes' much better).
+  bool velocitiesBetter() const;
+  /// The positions' filter's bandwidth [Hz] where it is set from the data
+  /// (DifferentiatorBank::bandwidth: auto_bandwidth); 0 for a filter without one.
+  double bandwidth() const { return bank_.config().auto_bandwidth ? bank_.bandwidth() : 0.0; }
 
   /// Forgets all history (a backward jump of time).
   void reset();

@@ -303,6 +303,16 @@ class Pipeline {
   /// immediate stream's: each puts the next of its records in smoothedRecord()).
   bool flushSmoothed();
   bool takeDrainedSmoothed();
+  /// The smoothed stream's bandwidth [Hz] (its smoother's gain is 1/2 there): chosen from
+  /// the joint positions' spectrum where smoothed.differentiator.auto_bandwidth (before
+  /// the first choice, process_noise's); 0 without one.
+  double smoothedBandwidth() const { return smoothed_ ? smoothed_->estimator.bandwidth() : 0.0; }
+  /// Whether the smoothed stream takes q-dot and q-ddot from the measured velocities where
+  /// the joint states carry them (Estimator::velocitiesBetter), or from the positions.
+  bool smoothedVelocities() const {
+    return smoothed_ && smoothed_->estimator.velocitiesUsed() > 0 &&
+           smoothed_->estimator.velocitiesBetter();
+  }
   const PipelineCounters& counters() const { return counters_; }
   const Settings& settings() const { return settings_; }
   /// What the computed loads need, fixed at construction: coordinate i, wrench input k,

@@ -62,12 +62,12 @@ class Fft {
 /// so that jitter in the stamps is noise here as it is to the smoother. Missing samples
 /// (up to kMaxFill intervals) are interpolated linearly; a longer gap ends the current
 /// block. The grid is averaged in groups down to at most kMaxRate and cut into blocks of
-/// about kBlockSeconds (a power of two of samples); the first block is left out (it holds
-/// the start of the filters that give the rates). Each block's first differences (which
-/// flatten the spectrum, so that the window leaks little of the motion into the noise
-/// band) are windowed (Hann) and transformed; the positions' spectrum is theirs divided by
-/// |1 - exp(-i w)|^2, summed over the channels that choose and averaged over the blocks
-/// (equally for the first kMemorySeconds, then with that memory). The score
+/// about block_seconds (kBlockSeconds by default; a power of two of samples); the first
+/// block is left out (it holds the start of the filters that give the rates). Each block's first
+/// differences (which flatten the spectrum, so that the window leaks little of the motion into the
+/// noise band) are windowed (Hann) and transformed; the positions' spectrum is theirs divided by |1
+/// - exp(-i w)|^2, summed over the channels that choose and averaged over the blocks (equally for
+/// the first kMemorySeconds, then with that memory). The score
 ///   GCV(w) = mean_k (1 - G_k(w))^2 P_k / (1 - mean_k G_k(w))^2,
 /// G_k the zero-phase filter's gain 1 / (1 + (tan(pi k / n) / tan(pi w))^8), is the one
 /// zero_phase.cpp's gcvScore evaluates in the time domain (the circulant approximation
@@ -115,9 +115,17 @@ class SpectralCutoff {
 
   SpectralCutoff() = default;
   /// channels: how many of the first channels of each sample choose (e.g. the joint
-  /// positions, not the wrenches); lowest, highest: the cutoffs searched [Hz].
-  SpectralCutoff(int channels, double lowest, double highest, Rule rule = Rule::kGcv)
-      : channels_(channels), lowest_(lowest), highest_(highest), rule_(rule) {
+  /// positions, not the wrenches); lowest, highest: the cutoffs searched [Hz]; blocks of
+  /// about block_seconds, the first one left out unless first_block (a caller that
+  /// reads only fallsThroughout(), which the filters' start does not make).
+  SpectralCutoff(int channels, double lowest, double highest, Rule rule = Rule::kGcv,
+                 double block_seconds = kBlockSeconds, bool first_block = false)
+      : channels_(channels),
+        lowest_(lowest),
+        highest_(highest),
+        block_seconds_(block_seconds),
+        first_block_(first_block),
+        rule_(rule) {
     if (channels_ <= 0) return;
     // Every buffer at the largest block (the grid is at most kMaxRate): none grows later.
     fft_ = Fft(kMaxBlock);
@@ -199,6 +207,16 @@ class SpectralCutoff {
 
   /// The chosen cutoff [Hz] (0 before the first choice).
   double cutoff() const { return cutoff_; }
+  /// Rule::kNoiseFloor: the noise floor of the last choice (the variance of white noise
+  /// that gives that level, summed over the channels that choose) [unit^2]; 0 where no
+  /// floor was found (the spectrum falls to the highest cutoff: data without noise).
+  double floorLevel() const { return floor_level_; }
+  /// Whether the last choice is the highest cutoff searched.
+  bool atHighest() const { return at_highest_; }
+  /// Rule::kNoiseFloor: whether the last spectrum fell more steeply than kFlatSlope over
+  /// every octave up to the highest band: no flat part at any level, nothing like noise
+  /// (data exact to the rounding).
+  bool fallsThroughout() const { return falls_; }
   /// Whether the last choice sits on a bound of the search (the lowest or the highest
   /// cutoff, or no noise floor found): the data do not settle it.
   bool onBound() const { return on_bound_; }
@@ -222,7 +240,7 @@ class SpectralCutoff {
     h_ = h;
     const double hd = h * decimation_;
     block_ = 16;
-    while (block_ * hd < 0.9 * kBlockSeconds && block_ < kMaxBlock) block_ *= 2;
+    while (block_ * hd < 0.9 * block_seconds_ && block_ < kMaxBlock) block_ *= 2;
     window_norm_ = 0.0;
     for (int j = 0; j < block_; ++j) {
       window_[j] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (j + 0.5) / block_);
@@ -250,7 +268,8 @@ class SpectralCutoff {
     sum_.setZero();
     in_sum_ = 0;
     if (++filled_ <= block_) return chosen;
-    const bool first = ++seen_ == 1;  // the first block holds the filters' start (rates)
+    // The first block holds the filters' start (rates).
+    const bool first = ++seen_ == 1 && !first_block_;
     if (!first) {
       while (step_ >= 0) chosen = step() || chosen;
       block_samples_.swap(samples_);
@@ -342,22 +361,27 @@ class SpectralCutoff {
       band_centre_[bands++] = std::sqrt(first * last) * bin;
     }
     const double top = std::min(highest_, 0.45 / hd);
-    on_bound_ = true;
+    on_bound_ = at_highest_ = true;
     cutoff_ = top;
+    floor_level_ = 0.0;
+    falls_ = false;
     if (bands < 2) return;
     for (int j = bands - 2; j >= 0; --j)
       band_level_[j] = std::max(band_level_[j], band_level_[j + 1]);  // the envelope
+    bool flat = false;
     for (int knee = 0; knee < bands; ++knee) {
       int end = knee;  // the band an octave above
       while (end + 1 < bands && band_centre_[end] < 1.95 * band_centre_[knee]) ++end;
-      if (band_centre_[end] < 1.9 * band_centre_[knee]) return;  // no octave left: no floor
+      if (band_centre_[end] < 1.9 * band_centre_[knee]) break;  // no octave left: no floor
       const double slope = std::log(band_level_[end] / band_level_[knee]) /
                            std::log(band_centre_[end] / band_centre_[knee]);
+      flat = flat || slope > kFlatSlope;
       if (slope > kFlatSlope && band_level_[knee] < kFloorBelowPeak * band_level_[0]) {
         crossFloor(knee, end, top);
         return;
       }
     }
+    falls_ = !flat;
   }
 
   // The crossing of the envelope (non-increasing) with twice the median level of the
@@ -367,7 +391,8 @@ class SpectralCutoff {
     for (int j = knee; j <= end; ++j) floor_[j - knee] = band_raw_[j];
     const int m = end - knee + 1;
     std::nth_element(floor_, floor_ + m / 2, floor_ + m);
-    const double twice = 2.0 * floor_[m / 2];
+    floor_level_ = floor_[m / 2];
+    const double twice = 2.0 * floor_level_;
     // The envelope again up to the floor's octave only: noise that rises above it (a
     // hump near the Nyquist rate) is not motion coming down to the floor.
     for (int j = end, k = end; j >= 0; --j)
@@ -376,6 +401,7 @@ class SpectralCutoff {
     while (below <= end && band_level_[below] > twice) ++below;
     if (below == 0 || below > end) {
       cutoff_ = below == 0 ? lowest_ : top;
+      at_highest_ = below > end;
       return;
     }
     const int c = below - 1;
@@ -384,7 +410,8 @@ class SpectralCutoff {
     const double f =
         std::exp(std::log(band_centre_[c]) + u * std::log(band_centre_[c + 1] / band_centre_[c]));
     cutoff_ = std::max(lowest_, std::min(top, f));
-    on_bound_ = cutoff_ <= 1.01 * lowest_ || cutoff_ >= 0.99 * top;
+    at_highest_ = cutoff_ >= 0.99 * top;
+    on_bound_ = cutoff_ <= 1.01 * lowest_ || at_highest_;
   }
 
   // GCV(w), w [cycles per grid sample]; the two-sided means from the one-sided spectrum
@@ -407,8 +434,11 @@ class SpectralCutoff {
   static constexpr int kMaxBands = 160;  ///< bands of ratio 1.1 at most (1.1^160: 4e6)
   int channels_ = 0;
   double lowest_ = 0.5, highest_ = 50.0;
+  double block_seconds_ = kBlockSeconds;
+  bool first_block_ = false;
   Rule rule_ = Rule::kGcv;
-  bool on_bound_ = false;
+  bool on_bound_ = false, at_highest_ = false, falls_ = false;
+  double floor_level_ = 0.0;
   double band_level_[kMaxBands] = {}, band_raw_[kMaxBands] = {}, band_centre_[kMaxBands] = {};
   double floor_[kMaxBands] = {};
   bool started_ = false, have_first_ = false;

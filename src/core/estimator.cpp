@@ -70,6 +70,7 @@ Estimator::Estimator(const Model<double>& model, const EstimatorConfig& config)
   velocity_channels_.assign(static_cast<std::size_t>(model_.nq), 0.0);
   velocity_used_.assign(static_cast<std::size_t>(model_.nq), 0);
   bank_.chooseBandwidthFrom(model_.nq);  // the joints, not the base pose or the wrenches
+  velocity_bank_.raiseOnly(true);
   last_inputs_.assign(channels_.size() * 3 + 2 * static_cast<std::size_t>(model_.nq), 0.0);
   const std::vector<char> dynamics = selectSegments();
   markNeeded(dynamics);
@@ -191,6 +192,7 @@ bool Estimator::retune(const DifferentiatorConfig& differentiator, int decimatio
   bank_ = DifferentiatorBank(differentiator, bank_.channels());
   bank_.chooseBandwidthFrom(model_.nq);
   velocity_bank_ = DifferentiatorBank(differentiator, model_.nq);
+  velocity_bank_.raiseOnly(true);
   config_.differentiator = differentiator;
   covariance_.history = 0;
   have_last_ = false;
@@ -338,10 +340,20 @@ int Estimator::velocitiesUsed() const {
   return n;
 }
 
+bool Estimator::velocitiesBetter() const {
+  if (!(bank_.spectralCutoff() > 0.0) || !(velocity_bank_.spectralCutoff() > 0.0)) return true;
+  const double f = bank_.bandwidth();
+  const double floor_q = bank_.noiseFloor(), floor_v = velocity_bank_.noiseFloor();
+  if (!(floor_q > 0.0)) return false;  // positions without noise: nothing is better
+  const double w = 2.0 * M_PI * f;
+  return floor_v < floor_q * w * w;
+}
+
 inline BaseState<double> Estimator::readEstimate() {
+  const bool velocities = velocity_active_ && velocitiesBetter();
   for (int i = 0; i < model_.nq; ++i) {
     q_[i] = bank_.value(i);
-    if (velocity_used_[static_cast<std::size_t>(i)]) {
+    if (velocities && velocity_used_[static_cast<std::size_t>(i)]) {
       qd_[i] = velocity_bank_.value(i);
       qdd_[i] = velocity_bank_.rate(i);
     } else {

@@ -475,6 +475,11 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("mimic joints contradicting their leader", c.mimic_contradictions);
   status.add("samples with a joint held from an earlier message", c.held_samples);
   status.add("joints with measured velocities", pipeline_->velocitiesUsed());
+  if (pipeline_->hasSmoothed()) {
+    status.add("smoothed stream: bandwidth [Hz]", pipeline_->smoothedBandwidth());
+    status.add("smoothed stream: rates from",
+               pipeline_->smoothedVelocities() ? "measured velocities" : "positions");
+  }
   status.add("not published: stale input", c.count(Outcome::kStale));
   status.add("time jumps back", c.backJumps());
   status.add("time jumps forward", c.forward_jumps);

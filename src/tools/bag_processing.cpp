@@ -464,8 +464,12 @@ void BagProcessor::summarize(double total_s) const {
                sink_.destination().c_str(), compute_s, compute_s > 0 ? samples / compute_s : 0.0,
                total_s, total_s > 0 ? samples / total_s : 0.0);
   if (pipeline_.hasSmoothed())
-    std::fprintf(stderr, "process_bag: smoothed stream (lag %.3g s): %ld loads\n",
-                 pipeline_.settings().smoothed.differentiator.lag, smoothed_written_);
+    std::fprintf(stderr,
+                 "process_bag: smoothed stream (lag %.3g s): %ld loads; bandwidth %.3g Hz, "
+                 "rates from the %s\n",
+                 pipeline_.settings().smoothed.differentiator.lag, smoothed_written_,
+                 pipeline_.smoothedBandwidth(),
+                 pipeline_.smoothedVelocities() ? "measured velocities" : "positions");
   printDrops();
 }
 
