@@ -359,6 +359,9 @@ struct SceneSpec {
   std::vector<std::string> only;  // differentiators to run (labels); empty: all
   bool received = false;          // stamps taken on receipt: a scene of real logs
   double quick_duration = 0.3;    // [s] with --quick
+  /// plausibility/position_margin [rad or m]: Settings' unless the scene's motion leaves
+  /// its URDF's joint limits further (its positions would be refused as implausible).
+  double position_margin = jle::PlausibilityConfig().position_margin;
   /// Non-zero: the wrench inputs are contacts only (no sinusoidal part): a stance of this
   /// peak (link frame) from each impact's start (heel strike), stance_duration long.
   jle::Stance::Vector6 stance_peak = jle::Stance::Vector6::Zero();
@@ -523,8 +526,12 @@ void robotScenes(const std::string& data, std::vector<SceneSpec>& specs) {
   };
   add("ur5", "UR5 chain, stop-and-go, sensors as panda, F/T at tool0",
       "/urdf/chains/ur5_chain.urdf", "tool0", 3);
-  add("kinova", "Kinova Jaco 2 chain, stop-and-go, sensors as panda, F/T at the end effector",
+  add("kinova",
+      "Kinova Jaco 2 chain, stop-and-go, sensors as panda, F/T at the end effector; its motion "
+      "leaves the URDF's limits of joints 2, 3 and 5 (e.g. 0.82 - 5.46 rad), so "
+      "plausibility/position_margin is 100 rad here",
       "/urdf/chains/kinova_chain.urdf", "j2s6s200_end_effector", 4);
+  specs.back().position_margin = 100.0;
   s.name = "talos";
   s.description =
       "TALOS reduced, pelvis fixed, 32 joints, sums of sines, 5 s, wrenches at "
@@ -869,9 +876,10 @@ double threadCpuSeconds() {
 }
 
 // The node's settings around an estimator configuration: one wrench topic per input.
-jle::Settings nodeSettings(const jle::EstimatorConfig& config) {
+jle::Settings nodeSettings(const jle::EstimatorConfig& config, double position_margin) {
   jle::Settings settings;
   settings.estimator = config;
+  settings.plausibility.position_margin = position_margin;
   settings.smoothed.enabled = false;  // the configuration's own stream, timed alone
   for (const jle::WrenchInputConfig& w : config.wrenches) {
     jle::WrenchTopicSettings topic;
@@ -946,7 +954,7 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
   out.newest.reserve(n);
   out.loads.reserve(n * 7 * segments.size());
   out.qdd.resize(model.nq, static_cast<Eigen::Index>(n));
-  jle::Pipeline pipeline(model, nodeSettings(config), nullptr);
+  jle::Pipeline pipeline(model, nodeSettings(config, scene.spec.position_margin), nullptr);
   const std::vector<std::size_t> slots = recordSlots(pipeline.record(), segments);
   std::vector<double> position(static_cast<std::size_t>(model.nq));
   std::vector<double> velocity;
@@ -988,8 +996,21 @@ Outputs runOnce(const Scene& scene, const jle::EstimatorConfig& config,
   const auto stop = std::chrono::steady_clock::now();
   const double cpu_stop = threadCpuSeconds();
   if (pipeline.counters().count(jle::InputKind::kWrench, jle::Outcome::kUsed) !=
-      static_cast<long>(r.wrenches.size()))
-    throw std::logic_error(scene.spec.name + ": a wrench message was not used");
+      static_cast<long>(r.wrenches.size())) {
+    std::string why;  // every outcome of the wrench and joint-state messages, counted
+    for (jle::InputKind kind : {jle::InputKind::kWrench, jle::InputKind::kJointState}) {
+      why += kind == jle::InputKind::kWrench ? " wrenches:" : "; joint states:";
+      for (int o = 0; o < static_cast<int>(jle::Outcome::kCount); ++o) {
+        const long c = pipeline.counters().count(kind, static_cast<jle::Outcome>(o));
+        if (c > 0)
+          why += " " + std::string(jle::toString(static_cast<jle::Outcome>(o))) + " " +
+                 std::to_string(c);
+      }
+    }
+    throw std::logic_error(scene.spec.name + ": a wrench message was not used (of " +
+                           std::to_string(r.wrenches.size()) + ":" + why + "; " +
+                           pipeline.problem() + ")");
+  }
   out.wall_us =
       std::chrono::duration<double, std::micro>(stop - start).count() / static_cast<double>(n);
   out.cpu_us = 1e6 * (cpu_stop - cpu_start) / static_cast<double>(n);
