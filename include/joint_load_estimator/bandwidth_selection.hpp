@@ -39,56 +39,22 @@ class BandwidthSelection {
   BandwidthSelection() = default;
   /// noise: the position noise's standard deviation [unit] if known, 0 to estimate it;
   /// memory: the time constant of the likelihood's memory [s].
-  BandwidthSelection(int models, int channels, double noise, double memory)
-      : models_(models),
-        channels_(channels),
-        fixed_variance_(noise * noise),
-        memory_(memory),
-        squares_(Eigen::MatrixXd::Zero(models, channels)),
-        log_variances_(Eigen::VectorXd::Zero(models)),
-        log_variance_(Eigen::VectorXd::Zero(channels)),
-        noise_time_(Eigen::VectorXd::Zero(channels)),
-        noise_samples_(Eigen::VectorXi::Zero(channels)),
-        last_(Eigen::VectorXd::Constant(channels, std::nan(""))),
-        best_per_channel_(Eigen::VectorXi::Zero(channels)) {
-    reset();
-  }
+  BandwidthSelection(int models, int channels, double noise, double memory);
 
   /// A restart of the filters (a gap): the likelihoods start again, the widest is
   /// selected; the noise estimate stays (the sensor did not change).
-  void reset() {
-    squares_.setZero();
-    log_variances_.setZero();
-    best_ = models_ - 1;
-  }
+  void reset();
 
   /// The samples x (channels), the widest filter's innovations and their variance per
   /// unit noise variance when the signal is predicted exactly; dt [s] since the last
   /// sample. A sample equal to the channel's previous one (a quantised signal at rest, a
   /// constant channel) carries no information on the noise: its innovation is what is
   /// left of the filter's transient, not noise.
-  void observeNoise(const double* x, const double* innovation, double variance, double dt) {
-    if (fixed_variance_ > 0.0) return;
-    for (int c = 0; c < channels_; ++c) {
-      const bool repeated = x[c] == last_[c];
-      last_[c] = x[c];
-      const double z2 = innovation[c] * innovation[c] / variance;
-      if (repeated || !(z2 > 0.0) || !std::isfinite(z2)) continue;
-      noise_time_[c] += dt;
-      ++noise_samples_[c];
-      const double w = std::min(1.0, dt / std::min(noise_time_[c], kNoiseMemory));
-      log_variance_[c] += w * (std::log(z2) - kLogChiSquareMean - log_variance_[c]);
-    }
-  }
+  void observeNoise(const double* x, const double* innovation, double variance, double dt);
 
   /// Filter m's innovations (channels) and their predicted variance per unit noise
   /// variance, dt [s] since the last sample.
-  void score(int m, const double* innovation, double variance, double dt) {
-    const double forget = std::exp(-dt / memory_);
-    log_variances_[m] = forget * log_variances_[m] + std::log(variance);
-    for (int c = 0; c < channels_; ++c)
-      squares_(m, c) = forget * squares_(m, c) + innovation[c] * innovation[c] / variance;
-  }
+  void score(int m, const double* innovation, double variance, double dt);
 
   /// The log-likelihood of filter m's recent innovations on channel c (up to a constant
   /// common to the filters), with the noise variance r2 of the channel.
@@ -97,56 +63,20 @@ class BandwidthSelection {
   }
 
   /// Selects the filter after score() of every filter; returns it.
-  int select() {
-    int active = 0;
-    for (int c = 0; c < channels_; ++c) {
-      const double r2 = noiseVariance(c);
-      if (!chooses(c)) continue;
-      int best = models_ - 1;
-      for (int m = models_ - 2; m >= 0; --m)
-        if (logLikelihood(m, c, r2) > logLikelihood(best, c, r2)) best = m;
-      best_per_channel_[active++] = best;
-    }
-    if (active == 0) return best_ = models_ - 1;
-    // The upper median: with an even count, the wider of the two middle choices.
-    int* first = best_per_channel_.data();
-    std::nth_element(first, first + active / 2, first + active);
-    return best_ = first[active / 2];
-  }
+  int select();
 
   int selected() const { return best_; }
 
   /// Whether filter m has fallen kBehind behind the selected one on most channels.
-  bool behind(int m) const {
-    int behind = 0, active = 0;
-    for (int c = 0; c < channels_; ++c) {
-      if (!chooses(c)) continue;
-      ++active;
-      const double r2 = noiseVariance(c);
-      if (logLikelihood(m, c, r2) < logLikelihood(best_, c, r2) - kBehind) ++behind;
-    }
-    return active > 0 && 2 * behind >= active;
-  }
+  bool behind(int m) const;
 
   /// Filter m restarted from the selected one's state: its likelihood is raised to
   /// kBehind below the selected one's.
-  void restarted(int m) {
-    for (int c = 0; c < channels_; ++c) {
-      const double r2 = noiseVariance(c);
-      if (!chooses(c)) continue;
-      // squares such that logLikelihood(m) = logLikelihood(best) - kBehind
-      const double target = logLikelihood(best_, c, r2) - kBehind;
-      squares_(m, c) =
-          std::min(squares_(m, c), std::max(0.0, r2 * (-2.0 * target - log_variances_[m])));
-    }
-  }
+  void restarted(int m);
 
   /// The noise variance of channel c [unit^2]: the given one, else the estimate (0 while
   /// there is none).
-  double noiseVariance(int c) const {
-    if (fixed_variance_ > 0.0) return fixed_variance_;
-    return noise_time_[c] > 0.0 ? std::exp(log_variance_[c]) : 0.0;
-  }
+  double noiseVariance(int c) const;
 
   /// Whether channel c takes part in the choice: its noise is known, or estimated from
   /// kNoiseSamples informative samples.

@@ -7,7 +7,7 @@
 // `/` between a map and its key and `[i]` for a list's element: 'wrenches[0]/sign'.
 #pragma once
 
-#include <joint_load_estimator/differentiation.hpp>
+#include <joint_load_estimator/differentiator_config.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/force_plate.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>

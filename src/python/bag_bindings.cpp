@@ -52,8 +52,6 @@ py::dict processBag(const std::string& bag, const std::string& urdf, const std::
   options.summary = summary;
   if (!zero_phase.is_none()) {
     options.smooth = true;
-    options.smoothing.order = 4;
-    options.smoothing.padding = 0;
     if (py::isinstance<py::str>(zero_phase)) {
       if (zero_phase.cast<std::string>() != "auto")
         throw std::invalid_argument("zero_phase must be a cutoff [Hz], 'auto' or None");

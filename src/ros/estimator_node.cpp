@@ -76,12 +76,25 @@ EstimatorNode::~EstimatorNode() {
   if (service_spinner_) service_spinner_->stop();
 }
 
+std::string resolveParameter(const ros::NodeHandle& nh, const std::string& name) {
+  try {
+    return nh.resolveName(name);
+  } catch (const ros::InvalidNameException& e) {
+    throw SettingsError("parameter '~robot_description' is '" + name.substr(0, 80) +
+                        "': neither the name of the parameter holding the URDF nor a URDF (" +
+                        e.what() + ")");
+  }
+}
+
 Model<double> EstimatorNode::loadModel() {
-  std::string urdf;
-  const std::string param = nh_.resolveName(settings_.robot_description);
-  if (!nh_.getParam(settings_.robot_description, urdf))
-    throw SettingsError("parameter '" + param +
-                        "' (robot_description) is not set or is not a string");
+  std::string urdf = settings_.robot_description;
+  std::string param = private_nh_.resolveName("robot_description") + " (the URDF itself)";
+  if (!isUrdfText(urdf)) {
+    param = resolveParameter(nh_, settings_.robot_description);
+    if (!nh_.getParam(settings_.robot_description, urdf))
+      throw SettingsError("parameter '" + param +
+                          "' (robot_description) is not set or is not a string");
+  }
   try {
     Model<double> model = modelFromUrdfString(urdf, modelOptions(settings_));
     for (const std::string& w : model.warnings) ROS_WARN("robot model: %s", w.c_str());

@@ -40,13 +40,14 @@ Exit status: 0 on shutdown; 1 a bad configuration or model (the culprit is named
 bool waitForRobotDescription(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
   std::string name;
   private_nh.param<std::string>("robot_description", name, jle::Settings().robot_description);
+  if (jle::isUrdfText(name)) return true;  // the URDF itself
+  const std::string resolved = jle::resolveParameter(nh, name);
   ros::WallTime said;
-  while (!nh.hasParam(name)) {
+  while (!nh.hasParam(resolved)) {
     if (!ros::ok()) return false;
     if (said.isZero() || (ros::WallTime::now() - said).toSec() >= 5.0) {
       said = ros::WallTime::now();
-      ROS_WARN("waiting for the parameter '%s' (robot_description): not set yet",
-               nh.resolveName(name).c_str());
+      ROS_WARN("waiting for the parameter '%s' (robot_description): not set yet", resolved.c_str());
     }
     ros::WallDuration(0.1).sleep();
   }

@@ -170,12 +170,12 @@ URDF the model refuses, a CSV defect: the message names FILE:LINE and the column
 
 struct Options {
   std::string urdf, input, output;
-  Eigen::Vector3d gravity_world{0.0, 0.0, -9.80665};
+  Eigen::Vector3d gravity_world = jle::EstimatorConfig().gravity_world;
   jle::WrenchFrame frame = jle::WrenchFrame::kChild;
   bool floating_base = false;
   bool accept_nonphysical_inertia = jle::ModelOptions().accept_nonphysical_inertia;
   std::vector<jle::ForcePlateConfig> plates;
-  double contact_threshold = 20.0;
+  double contact_threshold = jle::ForcePlateConfig().contact_threshold;
   bool per_kg = false;
   double body_mass = 0.0;  // 0: the model's total mass
   bool sto = false;
@@ -186,8 +186,8 @@ struct Options {
   std::string write_kinematics;  // --write-kinematics FILE
   bool kinematics = false;
   bool friction = false;
-  double velocity_scale = 0.01;                    // [rad/s or m/s], jle::FrictionConfig's default
-  jle::PlanarMode planar = jle::PlanarMode::kOff;  // --planar
+  double velocity_scale = jle::FrictionConfig().velocity_scale;  // [rad/s or m/s]
+  jle::PlanarMode planar = jle::PlanarMode::kOff;                // --planar
 };
 
 Eigen::Vector3d parseGravity(const std::string& text) {

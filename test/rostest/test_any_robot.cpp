@@ -37,14 +37,17 @@ class AnyRobot : public ::testing::Test {
       : joint_pub_(nh().advertise<sensor_msgs::JointState>("/arm1/driver/joint_states", 1000)),
         loads1_("/arm1/joint_load_estimator/joint_loads"),
         efforts1_("/arm1/joint_load_estimator/joint_efforts"),
-        loads2_("/arm2/joint_load_estimator/joint_loads") {}
+        loads2_("/arm2/joint_load_estimator/joint_loads"),
+        loads3_("/arm3/joint_load_estimator/joint_loads") {}
 
   void SetUp() override {
-    for (const char* node : {"/arm1/joint_load_estimator", "/arm2/joint_load_estimator"})
+    for (const char* node :
+         {"/arm1/joint_load_estimator", "/arm2/joint_load_estimator", "/arm3/joint_load_estimator"})
       ASSERT_TRUE(jle_test::waitForSubscriber(joint_pub_, node)) << node;
     ASSERT_TRUE(loads1_.connectTo("/arm1/joint_load_estimator"));
     ASSERT_TRUE(efforts1_.connectTo("/arm1/joint_load_estimator"));
     ASSERT_TRUE(loads2_.connectTo("/arm2/joint_load_estimator"));
+    ASSERT_TRUE(loads3_.connectTo("/arm3/joint_load_estimator"));
     start_ = ros::Time::now();
   }
 
@@ -57,12 +60,13 @@ class AnyRobot : public ::testing::Test {
       ros::spinOnce();
       ros::WallDuration(kPeriod).sleep();
     }
-    jle_test::spinUntilQuiet([&] { return loads1_.size() + loads2_.size() + efforts1_.size(); });
+    jle_test::spinUntilQuiet(
+        [&] { return loads1_.size() + loads2_.size() + loads3_.size() + efforts1_.size(); });
   }
 
-  // arm2's loads stamped like `msg`, or null.
-  const jle_test::JointLoads* peer(const jle_test::JointLoads& msg) const {
-    for (const auto& m : loads2_.msgs())
+  // arm2's (or arm3's) loads stamped like `msg`, or null.
+  const jle_test::JointLoads* peer(const jle_test::JointLoads& msg, int arm = 2) const {
+    for (const auto& m : (arm == 2 ? loads2_ : loads3_).msgs())
       if (m->header.stamp == msg.header.stamp) return m.get();
     return nullptr;
   }
@@ -100,6 +104,7 @@ class AnyRobot : public ::testing::Test {
   jle_test::LoadsRecorder loads1_;
   Recorder<sensor_msgs::JointState> efforts1_;
   jle_test::LoadsRecorder loads2_;
+  jle_test::LoadsRecorder loads3_;
   ros::Time start_;
   long sent_ = 0;
   std::map<std::uint64_t, long> stamps_;  // sample index of each stamp sent
@@ -147,11 +152,14 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
       for (int j = 0; j < 6; ++j) EXPECT_NEAR(e.position[j], q[j], 1e-3) << kJoints[j];
     }
   }
-  // The URDF from a file (arm1) and from an existing parameter (arm2): the same loads.
-  for (const auto& m : loads1_.msgs()) {
-    const jle_test::JointLoads* other = peer(*m);
-    ASSERT_NE(other, nullptr);
-    EXPECT_EQ(m->effort, other->effort);
+  // The URDF from a file (arm1), from an existing parameter (arm2) and as the text of
+  // ~robot_description (arm3): the same loads.
+  for (int arm : {2, 3}) {
+    for (const auto& m : loads1_.msgs()) {
+      const jle_test::JointLoads* other = peer(*m, arm);
+      ASSERT_NE(other, nullptr) << "arm" << arm;
+      EXPECT_EQ(m->effort, other->effort) << "arm" << arm;
+    }
   }
 
   // 2. decimation 2: every second sample, the filters kept (arm2's loads exactly).

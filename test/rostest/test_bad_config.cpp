@@ -129,6 +129,11 @@ TEST(BadConfig, RobotDescriptionThatIsNotXml) {
   expectRefused("/not_xml", {"'/not_xml/robot_description'", "malformed XML"});
 }
 
+TEST(BadConfig, RobotDescriptionThatIsNeitherANameNorAUrdf) {
+  expectRefused("/bad_name", {"'~robot_description' is 'my robot: the arm'",
+                              "neither the name of the parameter holding the URDF nor a URDF"});
+}
+
 TEST(BadConfig, ModelWithANegativeMass) {
   expectRefused("/bad_model", {"link 'heavy_link'", "negative mass"});
 }

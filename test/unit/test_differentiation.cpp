@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
+#include <vector>
 
 namespace {
 
@@ -234,6 +236,36 @@ double accelError(const DifferentiatorConfig& c) {
     ++count;
   }
   return std::sqrt(sum / count);
+}
+
+// Two configurations are the same filter when every field is equal (fields(), which the
+// compiler checks names every field: a field forgotten there would keep the old filter on
+// a retune); the process noise is compared as the filter runs it.
+TEST(Differentiator, ConfigurationsAreComparedWhole) {
+  EXPECT_EQ(jle::detail::fieldCount<DifferentiatorConfig>(),
+            std::tuple_size_v<decltype(DifferentiatorConfig().fields())>);
+  const DifferentiatorConfig base;
+  EXPECT_TRUE(jle::sameDifferentiator(base, base));
+  std::vector<DifferentiatorConfig> changed(14, base);
+  changed[0].type = jle::DifferentiatorType::kAdaptive;
+  changed[1].window = 11;
+  changed[2].order = 3;
+  changed[3].delay = 1;
+  changed[4].kalman_model = jle::KalmanModel::kConstantAcceleration;
+  changed[5].process_noise = 2e4;
+  changed[6].measurement_noise = 2e-4;
+  changed[7].lag = 0.1;
+  changed[8].auto_bandwidth = true;
+  changed[9].min_bandwidth = 1.0;
+  changed[10].max_bandwidth = 40.0;
+  changed[11].noise = 1e-3;
+  changed[12].memory = 2.0;
+  changed[13].max_gap = 0.25;
+  for (std::size_t k = 0; k < changed.size(); ++k)
+    EXPECT_FALSE(jle::sameDifferentiator(base, changed[k])) << "field " << k;
+  DifferentiatorConfig explicit_default = base;
+  explicit_default.process_noise = jle::processNoise(base);
+  EXPECT_TRUE(jle::sameDifferentiator(base, explicit_default));
 }
 
 // process_noise 0 (the default) is the model's: 1e4 for constant jerk, 10 for constant

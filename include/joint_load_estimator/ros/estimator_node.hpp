@@ -34,6 +34,10 @@
 
 namespace jle {
 
+/// `name` (~robot_description's value, not URDF text) resolved in `nh`; a name ROS refuses
+/// throws SettingsError saying that it is neither a parameter's name nor a URDF.
+std::string resolveParameter(const ros::NodeHandle& nh, const std::string& name);
+
 class EstimatorNode {
  public:
   /// Reads the parameters and the model, subscribes and advertises. Throws

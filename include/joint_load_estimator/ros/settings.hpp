@@ -7,6 +7,8 @@
 
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <string>
+
 namespace jle {
 
 /// The XmlRpc value `value` (a node's private namespace) as a parameter tree; a type
@@ -15,5 +17,12 @@ ParamValue fromXmlRpc(const XmlRpc::XmlRpcValue& value);
 
 /// parseSettings(fromXmlRpc(params)).
 Settings parseSettings(const XmlRpc::XmlRpcValue& params);
+
+/// Whether ~robot_description holds the URDF itself (robot_state_publisher's habit:
+/// `_robot_description:="$(cat robot.urdf)"`, a <param textfile=...> in the node) rather
+/// than the name of the parameter that holds it: a name has no '<'.
+inline bool isUrdfText(const std::string& robot_description) {
+  return robot_description.find('<') != std::string::npos;
+}
 
 }  // namespace jle
