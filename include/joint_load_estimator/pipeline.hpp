@@ -9,6 +9,7 @@
 #include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/external_effort.hpp>
+#include <joint_load_estimator/frame_resolver.hpp>
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/sample_clock.hpp>
@@ -24,9 +25,6 @@
 #include <vector>
 
 namespace jle {
-
-/// A message stamp [ns since the epoch]: a ROS header's sec * 1e9 + nsec.
-using Stamp = std::int64_t;
 
 /// What became of one input message. Every message is either used or counted under
 /// the reason it was not (PipelineCounters).
@@ -95,17 +93,6 @@ struct PipelineCounters {
   }
   /// Over every kind of input.
   long count(Outcome outcome) const;
-};
-
-/// Frames the URDF does not hold rigidly (tf2 in the ROS layer: the node's listener, or
-/// process_bag's buffer filled from a bag's /tf and /tf_static).
-class FrameSource {
- public:
-  virtual ~FrameSource() = default;
-  /// Pose of `frame` in `target` at `stamp` (0: the latest known). False with `error`
-  /// set when it is not known at that stamp.
-  virtual bool lookup(const std::string& target, const std::string& frame, Stamp stamp,
-                      Eigen::Isometry3d& X_target_frame, std::string& error) = 0;
 };
 
 /// Why a record's loads are not to be trusted: LoadsRecord::status holds these bits, 0
@@ -212,6 +199,8 @@ class Pipeline {
   /// frames are known) and must outlive the pipeline. Throws SettingsError or
   /// std::invalid_argument naming the key, link or joint.
   Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames);
+  Pipeline(const Pipeline&) = delete;  // its parts refer to its model and settings
+  Pipeline& operator=(const Pipeline&) = delete;
 
   /// A joint state: names, positions (same size), velocities and efforts (empty or the
   /// same size; a non-finite velocity or effort only drops that joint's measured value). `clock` is
@@ -350,19 +339,14 @@ class Pipeline {
   Stamp timeOrigin() const { return time_ref_; }
 
   /// Wrench input k's last resolved frame (the frame of its sensor residual), or empty.
-  const std::string& wrenchFrame(int k) const { return wrenches_[ix(k)].frame; }
+  const std::string& wrenchFrame(int k) const { return frame_resolver_.wrenchFrame(k); }
 
  private:
   struct WrenchInput {
-    std::string frame;   // last resolved frame
-    bool rigid = false;  // `frame` is a URDF frame rigid to the link: pose cached
-    Eigen::Isometry3d X_link_frame = Eigen::Isometry3d::Identity();
     Eigen::Vector3d bias_force = Eigen::Vector3d::Zero(), bias_torque = Eigen::Vector3d::Zero();
     bool stamped = false;  // has had a non-zero stamp
   };
   struct PlateInput {
-    std::string frame;  // frame whose pose the estimator holds
-    bool pose_known = false;
     bool stamped = false;
   };
   // The smoothed stream: its estimator, its record, and its loads drained by a reset.
@@ -411,7 +395,6 @@ class Pipeline {
   Outcome staleProblem();
   void remember(double t, Stamp stamp, bool has_effort);
   void growRing(std::size_t size);
-  bool resolveWrenchFrame(int k, const std::string& frame, Stamp stamp);
   bool resolvePlatePose(int k, const std::string& frame);
   void fillRecord(const Estimator& estimator, LoadsRecord& rec);
   void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
@@ -443,8 +426,8 @@ class Pipeline {
   bool nextRecord(Estimator& estimator, LoadsRecord& record, bool end);
 
   Settings settings_;
-  FrameSource* frames_;
   Estimator estimator_;
+  FrameResolver frame_resolver_;
   std::unique_ptr<ExternalEffort> external_;  // external_effort/enabled
   std::vector<double> external_variance_;     // the model efforts' variances, per joint
   JointStateMap joints_;

@@ -151,8 +151,8 @@ Settings checkedSettings(const Model<double>& model, Settings settings) {
 
 Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSource* frames)
     : settings_(checkedSettings(model, settings)),
-      frames_(frames),
       estimator_(model, settings_.estimator),
+      frame_resolver_(estimator_.model(), settings_, frames),
       joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints),
               settings_.plausibility.mimic_tolerance),
       wrenches_(settings_.estimator.wrenches.size()),
@@ -482,16 +482,11 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
 }
 
 bool Pipeline::basePose(Stamp stamp, BasePose& base) {
-  std::string error = "no frame source (tf2)";
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  if (frames_ && frames_->lookup(settings_.world_frame, settings_.base_frame, stamp, X, error)) {
-    base.position = X.translation();
-    base.orientation = Eigen::Quaterniond(X.rotation());
-    return true;
-  }
-  problem_ = "floating base: no pose of '" + settings_.base_frame + "' in '" +
-             settings_.world_frame + "' at " + seconds(stamp) + ": " + error;
-  return false;
+  if (!frame_resolver_.basePose(stamp, X, problem_)) return false;
+  base.position = X.translation();
+  base.orientation = Eigen::Quaterniond(X.rotation());
+  return true;
 }
 
 Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
@@ -868,17 +863,19 @@ void Pipeline::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) {
     InputRecord& in = rec.inputs[k];
     in.stale = estimator.stale(input);
     in.used = estimator.sensorSegment(input) >= 0 && estimator.sensorUsed(input);
-    const WrenchInput& w = wrenches_[k];
-    if (!w.frame.empty() && in.frame != w.frame) in.frame = w.frame;  // rare: a new frame
-    in.residual = in.used ? residualInReading(estimator.sensorResidual(input),
-                                              w.X_link_frame.linear(), w.X_link_frame.translation())
-                          : Wrench<double>();
+    const std::string& frame = frame_resolver_.wrenchFrame(input);
+    if (!frame.empty() && in.frame != frame) in.frame = frame;  // rare: a new frame
+    const Eigen::Isometry3d& X = frame_resolver_.wrenchPose(input);
+    in.residual =
+        in.used ? residualInReading(estimator.sensorResidual(input), X.linear(), X.translation())
+                : Wrench<double>();
   }
   for (std::size_t k = 0; k < rec.plates.size(); ++k) {
     PlateRecord& p = rec.plates[k];
     p.stale = estimator.plateStale(static_cast<int>(k));
     p.reading = estimator.plateReading(static_cast<int>(k));
-    if (p.frame != plates_[k].frame) p.frame = plates_[k].frame;  // rare: a new frame
+    const std::string& frame = frame_resolver_.plateFrame(static_cast<int>(k));
+    if (p.frame != frame) p.frame = frame;  // rare: a new frame
   }
   if (model().floating_base) {
     rec.base_force = estimator.data().force[0];
@@ -922,27 +919,6 @@ void Pipeline::setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::V
   wrenches_[ix(k)].bias_torque = torque;
 }
 
-bool Pipeline::resolveWrenchFrame(int k, const std::string& frame, Stamp stamp) {
-  WrenchInput& input = wrenches_[ix(k)];
-  if (input.rigid && frame == input.frame) return true;
-  const std::string& link = settings_.estimator.wrenches[ix(k)].link;
-  input.frame = frame;
-  // A URDF frame on the same segment as the link: a constant transform from the model.
-  Eigen::Matrix3d R;
-  Eigen::Vector3d p;
-  input.rigid = rigidFrameInLink(model(), link, frame, R, p);
-  if (input.rigid) {
-    input.X_link_frame.linear() = R;
-    input.X_link_frame.translation() = p;
-    return true;
-  }
-  std::string error = "no frame source (tf2)";
-  if (frames_ && frames_->lookup(link, frame, stamp, input.X_link_frame, error)) return true;
-  problem_ = "wrench '" + settings_.wrenches[ix(k)].topic + "': frame '" + frame +
-             "' is neither a URDF link rigid to '" + link + "' nor known to tf2: " + error;
-  return false;
-}
-
 Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
                            const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
   constexpr InputKind kind = InputKind::kWrench;
@@ -966,12 +942,14 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   if (timeline != Outcome::kUsed) return timeline;
   if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
     return count(kind, Outcome::kImplausible);
-  if (!resolveWrenchFrame(k, frame, stamp)) return count(kind, Outcome::kFrame);
+  if (!frame_resolver_.resolveWrench(k, frame, stamp, problem_))
+    return count(kind, Outcome::kFrame);
   const WrenchInput& input = wrenches_[ix(k)];
   // The sensor's offset is in its own frame and sign: removed before anything else.
   const Eigen::Vector3d f = force - input.bias_force, m = torque - input.bias_torque;
+  const Eigen::Isometry3d& X = frame_resolver_.wrenchPose(k);
   Eigen::Vector3d f_link, m_link;
-  wrenchInLink(input.X_link_frame.linear(), input.X_link_frame.translation(), f, m, f_link, m_link);
+  wrenchInLink(X.linear(), X.translation(), f, m, f_link, m_link);
   const double t = relative(stamp);
   if (smoothed_) smoothed_->estimator.addWrench(k, t, f_link, m_link);  // the same order
   if (!estimator_.addWrench(k, t, f_link, m_link))
@@ -982,29 +960,16 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
 }
 
 bool Pipeline::resolvePlatePose(int k, const std::string& frame) {
-  PlateInput& plate = plates_[ix(k)];
-  if (plate.pose_known && frame == plate.frame) return true;
-  if (settings_.force_plates[ix(k)].pose_configured) {  // the estimator holds the configured pose
-    plate.frame = frame;
-    plate.pose_known = true;
-    return true;
-  }
-  // A lab plate is fixed in the world: looked up until found, then kept. The estimator's
-  // world is world_frame for a floating base, the URDF root link for a fixed one.
-  const std::string& world = model().floating_base ? settings_.world_frame : model().link_name[0];
-  std::string error = "no frame source (tf2)";
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  if (!frames_ || !frames_->lookup(world, frame, 0, X, error)) {
-    problem_ = "force plate '" + settings_.estimator.plates[ix(k)].plate.name +
-               "': no pose of frame '" + frame + "' in '" + world +
-               "' from tf2 (and no position/orientation configured): " + error;
-    return false;
+  switch (frame_resolver_.resolvePlate(k, frame, X, problem_)) {
+    case FrameResolver::PlatePose::kKnown: return true;
+    case FrameResolver::PlatePose::kFound:  // a lab plate is fixed: set once
+      estimator_.setPlatePose(k, X.rotation(), X.translation());
+      if (smoothed_) smoothed_->estimator.setPlatePose(k, X.rotation(), X.translation());
+      return true;
+    case FrameResolver::PlatePose::kUnknown: break;
   }
-  estimator_.setPlatePose(k, X.rotation(), X.translation());
-  if (smoothed_) smoothed_->estimator.setPlatePose(k, X.rotation(), X.translation());
-  plate.frame = frame;
-  plate.pose_known = true;
-  return true;
+  return false;
 }
 
 Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
