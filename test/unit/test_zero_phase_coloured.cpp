@@ -295,19 +295,35 @@ class JointLoadsColoured : public jle_test::ToolTest {
   }
 };
 
-// Positions only, the default rule: the cutoff within a factor of 2 of the oracle's, the
-// loads within 1.3 times its error, the rule printed.
+// The bounds a positions-only choice must meet: its cutoff within a factor of 1.5 of the
+// oracle's, its loads within 1.3 times the oracle's error (issue 37's bound). Measured:
+// 4.53 Hz and 0.0735 N m against the oracle's 5.05 Hz and 0.0696 N m (1.06x); GCV 50 Hz
+// and 10.4 N m (149x).
+::testing::AssertionResult withinTheBounds(double cutoff, double error) {
+  const bool near = std::abs(std::log(cutoff / oracle().cutoff)) <= std::log(1.5);
+  if (near && error <= 1.3 * oracle().error) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "chose " << cutoff << " Hz, " << error << " N m; oracle "
+                                       << oracle().cutoff << " Hz, " << oracle().error << " N m";
+}
+
+// Positions only, the default rule: within the bounds, the rule printed. The same bounds
+// fail the white-noise rule (GCV, --cutoff-rule gcv), which takes the noise flat to 50 Hz
+// for motion and climbs to the search's bound: the bounds tell a sound choice from it.
 TEST_F(JointLoadsColoured, PositionsOnlyChoosesASaneCutoffAndBoundedLoads) {
   const Recording& r = coloured();
   writeCsv("q.csv", r, false);
   std::string err;
   const Eigen::MatrixXd effort = efforts(r, "q.csv", {}, err);
   ASSERT_EQ(effort.rows(), r.q.rows()) << err;
-  const double cutoff = printedCutoff(err);
-  EXPECT_NEAR(std::log(cutoff / oracle().cutoff), 0.0, std::log(2.0)) << err;
   EXPECT_NE(err.find("(noise spectrum)"), std::string::npos) << err;
-  EXPECT_LT(effortError(r, effort), 1.3 * oracle().error)
-      << err << "oracle " << oracle().cutoff << " Hz, " << oracle().error << " N m";
+  EXPECT_TRUE(withinTheBounds(printedCutoff(err), effortError(r, effort))) << err;
+  std::printf("joint_loads, positions only: %.3g Hz, %.3g N m; oracle %.3g Hz, %.3g N m\n",
+              printedCutoff(err), effortError(r, effort), oracle().cutoff, oracle().error);
+  const Eigen::MatrixXd gcv = efforts(r, "q.csv", {"--cutoff-rule", "gcv"}, err);
+  ASSERT_EQ(gcv.rows(), r.q.rows()) << err;
+  EXPECT_FALSE(withinTheBounds(printedCutoff(err), effortError(r, gcv))) << err;
+  std::printf("joint_loads --cutoff-rule gcv: %.3g Hz, %.3g N m\n", printedCutoff(err),
+              effortError(r, gcv));
 }
 
 // With J.qd columns: the velocity evidence chooses, and says so.
