@@ -1486,12 +1486,10 @@ void runDifferentiator(SceneRun& run, const Differentiator& diff,
   }
 }
 
-// Wrench input i's readings low-passed alike (zero phase, `cutoff`) and linearly
-// interpolated to the times t (held beyond its ends): rows of t, (force, moment) columns.
-Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutoff, int order,
-                               const std::vector<double>& t) {
-  std::vector<double> stamps;
+// Wrench input i's readings: their stamps, and (force, moment) per row.
+Eigen::MatrixXd wrenchReadings(const jle::SensorReadings& r, int i, std::vector<double>& stamps) {
   std::vector<Eigen::Matrix<double, 6, 1>> raw;
+  stamps.clear();
   for (const jle::WrenchReading& w : r.wrenches)
     if (w.input == i) {
       stamps.push_back(w.stamp);
@@ -1501,6 +1499,15 @@ Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutof
   Eigen::MatrixXd x(static_cast<Eigen::Index>(raw.size()), 6);
   for (std::size_t k = 0; k < raw.size(); ++k)
     x.row(static_cast<Eigen::Index>(k)) = raw[k].transpose();
+  return x;
+}
+
+// Wrench input i's readings low-passed alike (zero phase, `cutoff`) and linearly
+// interpolated to the times t (held beyond its ends): rows of t, (force, moment) columns.
+Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutoff, int order,
+                               const std::vector<double>& t) {
+  std::vector<double> stamps;
+  const Eigen::MatrixXd x = wrenchReadings(r, i, stamps);
   const Eigen::MatrixXd f = jle::lowPassZeroPhase(stamps, x, cutoff, order);
   Eigen::MatrixXd out(static_cast<Eigen::Index>(t.size()), 6);
   for (std::size_t k = 0; k < t.size(); ++k) {
@@ -1546,7 +1553,11 @@ RunResult zeroPhaseRun(const SceneRun& run, const jle::ZeroPhaseConfig& config, 
       jle::smoothZeroPhase(scene.stamps, readingMatrix(scene, false), config, v);
   std::vector<Eigen::MatrixXd> wrenches;
   std::vector<int> frames;
+  choice = zp.choice;
   for (std::size_t i = 0; i < run.inputs.size(); ++i) {
+    std::vector<double> stamps;
+    const Eigen::MatrixXd raw = wrenchReadings(scene.readings, static_cast<int>(i), stamps);
+    jle::checkFilteredAlike(stamps, raw, config, "wrench input " + run.inputs[i].name, choice);
     wrenches.push_back(
         filteredWrench(scene.readings, static_cast<int>(i), zp.cutoff, config.order, scene.stamps));
     frames.push_back(model.frameIndex(run.inputs[i].link));
@@ -1575,7 +1586,6 @@ RunResult zeroPhaseRun(const SceneRun& run, const jle::ZeroPhaseConfig& config, 
   result.wall_us = elapsed / static_cast<double>(n);
   result.cpu_us = 1e6 * (threadCpuSeconds() - cpu_start) / static_cast<double>(n);
   result.cutoff_hz = zp.cutoff;
-  choice = zp.choice;
   return result;
 }
 

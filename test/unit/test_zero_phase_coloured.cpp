@@ -241,6 +241,56 @@ TEST(QuietEncoders, StopAndGoAt4kHzChoosesNearTheBestFixedCutoff) {
   expectNearTheOracle(record(jle::MotionKind::kStopAndGo, encoders(4000.0), 5.0));
 }
 
+// The wrench columns that the positions' cutoff filters alike (checkFilteredAlike): a
+// contact force of heel strikes (8 ms rise into a 0.25 s half sine, 1500 N, 0.5 N of
+// noise, 1 kHz) carries content far above a 5 Hz choice, and is warned about; a slow F/T
+// wrench (0.1 .. 1 Hz sines, 0.1 N of noise) is not; a fixed cutoff is not checked.
+TEST(FilteredAlike, WarnsWhereTheWrenchesCarryContentAboveTheCutoff) {
+  jle::WrenchMotion strikes, slow;
+  for (double start : {0.7, 1.9, 3.1, 4.3}) {
+    jle::Stance s;
+    s.start = start;
+    s.rise = 0.008;
+    s.duration = 0.25;
+    s.peak << 150.0, 0.0, 1500.0, 0.0, 60.0, 0.0;
+    strikes.stances.push_back(s);
+  }
+  slow.mean << 5.0, -3.0, -15.0, 0.2, -0.1, 0.05;
+  slow.amplitude << 5.0, 2.0, 8.0, 0.3, 0.5, 0.1;
+  slow.omega << 0.7, 1.9, 3.3, 4.4, 5.8, 6.2;
+  jle::PortableRandom random(5);
+  std::vector<double> t;
+  Eigen::MatrixXd f_strikes(6000, 6), f_slow(6000, 6);
+  for (Eigen::Index k = 0; k < 6000; ++k) {
+    t.push_back(1e-3 * static_cast<double>(k));
+    f_strikes.row(k) = strikes.at(t.back()).transpose();
+    f_slow.row(k) = slow.at(t.back()).transpose();
+    for (Eigen::Index c = 0; c < 6; ++c) {
+      f_strikes(k, c) += 0.5 * random.gaussian();
+      f_slow(k, c) += 0.1 * random.gaussian();
+    }
+  }
+  jle::CutoffChoice choice;
+  choice.rule = jle::CutoffRule::kSpectrum;
+  choice.cutoff = 5.0;
+  const jle::ZeroPhaseConfig config;
+  const double f = jle::checkFilteredAlike(t, f_strikes, config, "the contact", choice);
+  EXPECT_GT(f, jle::kCutoffDisagreement * 5.0);
+  ASSERT_EQ(choice.warnings.size(), 1u);
+  EXPECT_NE(choice.warnings.front().find("zero-phase cutoff: the contact: its own spectrum"),
+            std::string::npos)
+      << choice.warnings.front();
+  std::printf("heel strikes: %.3g Hz; %s\n", f, choice.warnings.front().c_str());
+  choice.warnings.clear();
+  const double g = jle::checkFilteredAlike(t, f_slow, config, "the F/T sensor", choice);
+  EXPECT_LT(g, jle::kCutoffDisagreement * 5.0);
+  EXPECT_TRUE(choice.warnings.empty()) << choice.warnings.front();
+  std::printf("slow wrench: %.3g Hz\n", g);
+  choice.rule = jle::CutoffRule::kFixed;
+  EXPECT_EQ(jle::checkFilteredAlike(t, f_strikes, config, "the contact", choice), 0.0);
+  EXPECT_TRUE(choice.warnings.empty());
+}
+
 class JointLoadsColoured : public jle_test::ToolTest {
  protected:
   JointLoadsColoured() : ToolTest("jle_coloured") {}
