@@ -256,7 +256,7 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
   const std::vector<double> qs =
       quick ? std::vector<double>{1e2} : std::vector<double>{1e2, 1e3, 1e4};
   const std::vector<double> lags =
-      quick ? std::vector<double>{0.1} : std::vector<double>{0.02, 0.05, 0.1, 0.2};
+      quick ? std::vector<double>{0.1} : std::vector<double>{0.02, 0.05, 0.1, 0.2, 0.25};
   for (double q : qs)
     for (double lag : lags) {
       jle::DifferentiatorConfig c;
@@ -279,13 +279,23 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
     std::snprintf(label, sizeof label, "KS-adaptive lag=%.0fms", 1e3 * lag);
     out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}, false});
   }
-  // The smoothers at the smoothed stream's delay (0.2 s) given the joint states'
-  // velocities too, where the scene has them: the candidates for its default.
   if (quick) return;
+  // The smoothed stream's default filter (its bandwidth from the data) at every lag of
+  // 0.2 s or more that issue 37 allows (at most 0.25 s) but its own.
+  for (double lag : lags) {
+    jle::DifferentiatorConfig c = jle::defaultSmoother();
+    if (lag < 0.2 || lag == c.lag) continue;
+    c.lag = lag;
+    char label[64];
+    std::snprintf(label, sizeof label, "KS-CJ auto lag=%.0fms", 1e3 * lag);
+    out.push_back({label, "kalman_cj_smooth", c, c.measurement_noise, false, {}, false});
+  }
+  // The smoothers at the smoothed stream's delays (0.2 s and more) given the joint states'
+  // velocities too, where the scene has them: the candidates for its default.
   const std::size_t smoothers = out.size();
   for (std::size_t i = 0; i < smoothers; ++i)
     if ((out[i].family == "kalman_cj_smooth" || out[i].family == "adaptive_smooth") &&
-        out[i].config.lag == 0.2) {
+        out[i].config.lag >= 0.2) {
       Differentiator d = out[i];
       d.label += " + velocities";
       d.velocities = true;
