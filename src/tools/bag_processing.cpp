@@ -474,6 +474,10 @@ void BagProcessor::summarize(double total_s) const {
                  pipeline_.settings().smoothed.differentiator.lag, smoothed_written_,
                  pipeline_.smoothedBandwidth(),
                  pipeline_.smoothedVelocities() ? "measured velocities" : "positions");
+  const std::string bound = pipeline_.smoothedBandwidthBound();
+  if (!bound.empty())
+    std::fprintf(stderr, "process_bag: warning: smoothed stream's bandwidth on a bound: %s\n",
+                 bound.c_str());
   printDrops();
 }
 
