@@ -256,7 +256,7 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
   const std::vector<double> qs =
       quick ? std::vector<double>{1e2} : std::vector<double>{1e2, 1e3, 1e4};
   const std::vector<double> lags =
-      quick ? std::vector<double>{0.1} : std::vector<double>{0.02, 0.05, 0.1, 0.2};
+      quick ? std::vector<double>{0.1} : std::vector<double>{0.02, 0.05, 0.1, 0.2, 0.25};
   for (double q : qs)
     for (double lag : lags) {
       jle::DifferentiatorConfig c;
@@ -279,13 +279,23 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
     std::snprintf(label, sizeof label, "KS-adaptive lag=%.0fms", 1e3 * lag);
     out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}, false});
   }
-  // The smoothers at the smoothed stream's delay (0.2 s) given the joint states'
-  // velocities too, where the scene has them: the candidates for its default.
   if (quick) return;
+  // The smoothed stream's default filter (its bandwidth from the data) at every lag of
+  // 0.2 s or more that issue 37 allows (at most 0.25 s) but its own.
+  for (double lag : lags) {
+    jle::DifferentiatorConfig c = jle::defaultSmoother();
+    if (lag < 0.2 || lag == c.lag) continue;
+    c.lag = lag;
+    char label[64];
+    std::snprintf(label, sizeof label, "KS-CJ auto lag=%.0fms", 1e3 * lag);
+    out.push_back({label, "kalman_cj_smooth", c, c.measurement_noise, false, {}, false});
+  }
+  // The smoothers at the smoothed stream's delays (0.2 s and more) given the joint states'
+  // velocities too, where the scene has them: the candidates for its default.
   const std::size_t smoothers = out.size();
   for (std::size_t i = 0; i < smoothers; ++i)
     if ((out[i].family == "kalman_cj_smooth" || out[i].family == "adaptive_smooth") &&
-        out[i].config.lag == 0.2) {
+        out[i].config.lag >= 0.2) {
       Differentiator d = out[i];
       d.label += " + velocities";
       d.velocities = true;
@@ -1486,12 +1496,10 @@ void runDifferentiator(SceneRun& run, const Differentiator& diff,
   }
 }
 
-// Wrench input i's readings low-passed alike (zero phase, `cutoff`) and linearly
-// interpolated to the times t (held beyond its ends): rows of t, (force, moment) columns.
-Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutoff, int order,
-                               const std::vector<double>& t) {
-  std::vector<double> stamps;
+// Wrench input i's readings: their stamps, and (force, moment) per row.
+Eigen::MatrixXd wrenchReadings(const jle::SensorReadings& r, int i, std::vector<double>& stamps) {
   std::vector<Eigen::Matrix<double, 6, 1>> raw;
+  stamps.clear();
   for (const jle::WrenchReading& w : r.wrenches)
     if (w.input == i) {
       stamps.push_back(w.stamp);
@@ -1501,6 +1509,15 @@ Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutof
   Eigen::MatrixXd x(static_cast<Eigen::Index>(raw.size()), 6);
   for (std::size_t k = 0; k < raw.size(); ++k)
     x.row(static_cast<Eigen::Index>(k)) = raw[k].transpose();
+  return x;
+}
+
+// Wrench input i's readings low-passed alike (zero phase, `cutoff`) and linearly
+// interpolated to the times t (held beyond its ends): rows of t, (force, moment) columns.
+Eigen::MatrixXd filteredWrench(const jle::SensorReadings& r, int i, double cutoff, int order,
+                               const std::vector<double>& t) {
+  std::vector<double> stamps;
+  const Eigen::MatrixXd x = wrenchReadings(r, i, stamps);
   const Eigen::MatrixXd f = jle::lowPassZeroPhase(stamps, x, cutoff, order);
   Eigen::MatrixXd out(static_cast<Eigen::Index>(t.size()), 6);
   for (std::size_t k = 0; k < t.size(); ++k) {
@@ -1546,7 +1563,11 @@ RunResult zeroPhaseRun(const SceneRun& run, const jle::ZeroPhaseConfig& config, 
       jle::smoothZeroPhase(scene.stamps, readingMatrix(scene, false), config, v);
   std::vector<Eigen::MatrixXd> wrenches;
   std::vector<int> frames;
+  choice = zp.choice;
   for (std::size_t i = 0; i < run.inputs.size(); ++i) {
+    std::vector<double> stamps;
+    const Eigen::MatrixXd raw = wrenchReadings(scene.readings, static_cast<int>(i), stamps);
+    jle::checkFilteredAlike(stamps, raw, config, "wrench input " + run.inputs[i].name, choice);
     wrenches.push_back(
         filteredWrench(scene.readings, static_cast<int>(i), zp.cutoff, config.order, scene.stamps));
     frames.push_back(model.frameIndex(run.inputs[i].link));
@@ -1575,7 +1596,6 @@ RunResult zeroPhaseRun(const SceneRun& run, const jle::ZeroPhaseConfig& config, 
   result.wall_us = elapsed / static_cast<double>(n);
   result.cpu_us = 1e6 * (threadCpuSeconds() - cpu_start) / static_cast<double>(n);
   result.cutoff_hz = zp.cutoff;
-  choice = zp.choice;
   return result;
 }
 

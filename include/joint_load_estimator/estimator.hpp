@@ -88,6 +88,10 @@ class Estimator {
   /// The positions' filter's bandwidth [Hz] where it is set from the data
   /// (DifferentiatorBank::bandwidth: auto_bandwidth); 0 for a filter without one.
   double bandwidth() const { return bank_.config().auto_bandwidth ? bank_.bandwidth() : 0.0; }
+  /// auto_bandwidth: the positions' spectrum's last choice [Hz] before the lag's floor (0
+  /// before the first), and its noise floor [unit^2] (0 where none was found).
+  double spectralCutoff() const { return bank_.spectralCutoff(); }
+  double noiseFloor() const { return bank_.noiseFloor(); }
 
   /// Forgets all history (a backward jump of time).
   void reset();

@@ -296,6 +296,11 @@ class Pipeline {
   /// the joint positions' spectrum where smoothed.differentiator.auto_bandwidth (before
   /// the first choice, process_noise's); 0 without one.
   double smoothedBandwidth() const { return smoothed_ ? smoothed_->estimator.bandwidth() : 0.0; }
+  /// What a user must hear when the smoothed stream's bandwidth sits on a bound of its
+  /// search (issue 37: never a silent choice): the lag's floor above the data's choice, or
+  /// the highest where the positions' spectrum shows no noise floor; empty otherwise (and
+  /// before the spectrum's first choice).
+  std::string smoothedBandwidthBound() const;
   /// Whether the smoothed stream takes q-dot and q-ddot from the measured velocities where
   /// the joint states carry them (Estimator::velocitiesBetter), or from the positions.
   bool smoothedVelocities() const {

@@ -99,6 +99,18 @@ ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::Matri
 Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
                                  double cutoff, int order, int padding = 0);
 
+/// The force, wrench or plate channels x (samples x channels at the stamps t [s]) that an
+/// automatic `choice` of the positions' cutoff filters alike: where their own spectrum
+/// meets its noise floor (CutoffRule::kSpectrum up to config.max_cutoff), returned [Hz];
+/// and a warning naming `what` into choice.warnings where that lies more than
+/// kCutoffDisagreement above choice.cutoff: content (an impact, a heel strike) that the
+/// positions' cutoff smooths away from the loads. 0 (and nothing said) for a fixed cutoff,
+/// or where the channels show no noise floor (no fast content above their noise, or none
+/// at all).
+double checkFilteredAlike(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                          const ZeroPhaseConfig& config, const std::string& what,
+                          CutoffChoice& choice);
+
 /// The cutoff [Hz] that config.rule chooses for the channels x at stamps t (config.cutoff
 /// for kFixed), without filtering the result; `velocities` as in smoothZeroPhase.
 double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,

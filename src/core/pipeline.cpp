@@ -256,6 +256,26 @@ void Pipeline::anchor(Stamp stamp) {
   have_ref_ = true;
 }
 
+std::string Pipeline::smoothedBandwidthBound() const {
+  if (!smoothed_) return "";
+  const Estimator& e = smoothed_->estimator;
+  const double chosen = e.spectralCutoff(), used = e.bandwidth();
+  if (!(chosen > 0.0)) return "";
+  char text[200];
+  if (!(e.noiseFloor() > 0.0)) {
+    std::snprintf(text, sizeof text,
+                  "the positions' spectrum shows no noise floor: the highest bandwidth, %.3g Hz",
+                  used);
+    return text;
+  }
+  if (!(used > 1.001 * chosen)) return "";
+  std::snprintf(text, sizeof text,
+                "the positions' spectrum chooses %.3g Hz, below the lag's floor %.3g Hz "
+                "(%.3g / lag): the smoother is wider than the data ask; a longer lag allows less",
+                chosen, used, DifferentiatorBank::kLagFloor);
+  return text;
+}
+
 double Pipeline::relative(Stamp stamp) {
   anchor(stamp);
   axis_used_ = true;

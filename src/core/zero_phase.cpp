@@ -683,11 +683,23 @@ CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& 
   return choice;
 }
 
-// The cutoff of config.rule for the channels x at the stamps t (xg on the grid; v the
-// measured velocities at t or null). The lowest cutoff searched is a thousandth of the
-// rate or one period over the record, the highest config.max_cutoff or 0.4 of the rate;
-// the scores leave out two periods of the lowest at each end, at most a quarter of the
-// record.
+// The search over the channels x at the stamps t (xg on the grid; v the measured
+// velocities at t or null). The lowest cutoff searched is a thousandth of the rate or one
+// period over the record, the highest config.max_cutoff or 0.4 of the rate; the scores
+// leave out two periods of the lowest at each end, at most a quarter of the record.
+CutoffSearch searchOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
+                      const Eigen::MatrixXd& xg, const Eigen::MatrixXd* v,
+                      const ZeroPhaseConfig& config) {
+  const double w_lo = std::max(1e-3, 1.0 / grid.m);
+  const double w_hi = std::max(w_lo, std::min(0.4, config.max_cutoff * grid.h));
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  CutoffSearch search{grid, t, x, xg, v, config.order, pad, w_lo, w_hi};
+  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
+                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
+  return search;
+}
+
+// The cutoff of config.rule for the channels x at the stamps t (searchOf's arguments).
 CutoffChoice cutoffOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
                       const Eigen::MatrixXd& xg, const Eigen::MatrixXd* v,
                       const ZeroPhaseConfig& config) {
@@ -696,13 +708,7 @@ CutoffChoice cutoffOf(const Grid& grid, const std::vector<double>& t, const Eige
     choice.cutoff = choice.lowest = choice.highest = config.cutoff;
     return choice;
   }
-  const double w_lo = std::max(1e-3, 1.0 / grid.m);
-  const double w_hi = std::max(w_lo, std::min(0.4, config.max_cutoff * grid.h));
-  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
-  CutoffSearch search{grid, t, x, xg, v, config.order, pad, w_lo, w_hi};
-  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
-                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
-  return chooseAutomatic(search, config);
+  return chooseAutomatic(searchOf(grid, t, x, xg, v, config), config);
 }
 
 // The measured velocities if they are usable evidence (the shape of x, at least half of
@@ -814,6 +820,28 @@ ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::Matri
   differentiate(padded, pad, grid.h, r.rate, r.accel);
   if (!grid.uniform) evaluateAt(grid, t, r);
   return r;
+}
+
+double checkFilteredAlike(const std::vector<double>& t, const Eigen::MatrixXd& x,
+                          const ZeroPhaseConfig& config, const std::string& what,
+                          CutoffChoice& choice) {
+  if (choice.rule == CutoffRule::kFixed || x.cols() == 0 || t.size() < 3) return 0.0;
+  validate(config);
+  checkInput(t, x);
+  const Grid grid = gridOf(t);
+  const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
+  bool found = false;
+  const double f = spectrumCutoff(searchOf(grid, t, x, xg, nullptr, config), found) / grid.h;
+  if (!found) return 0.0;
+  const bool bound = f >= 0.99 * std::min(config.max_cutoff, 0.4 / grid.h);
+  if (f > kCutoffDisagreement * choice.cutoff)
+    choice.warnings.push_back("zero-phase cutoff: " + what + ": its own spectrum meets its noise " +
+                              "floor at " + (bound ? "or above " : "") + hz(f) + ", " +
+                              std::to_string(static_cast<int>(f / choice.cutoff)) + "x the " +
+                              hz(choice.cutoff) + " that filters it alike: its fast " +
+                              "content (an impact, a heel strike) is smoothed away from the " +
+                              "loads; check them, or give --cutoff");
+  return f;
 }
 
 Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,

@@ -490,6 +490,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("joints with measured velocities", pipeline_->velocitiesUsed());
   if (pipeline_->hasSmoothed()) {
     status.add("smoothed stream: bandwidth [Hz]", pipeline_->smoothedBandwidth());
+    const std::string bound = pipeline_->smoothedBandwidthBound();
+    if (!bound.empty()) status.add("smoothed stream: bandwidth on a bound", bound);
     status.add("smoothed stream: rates from",
                pipeline_->smoothedVelocities() ? "measured velocities" : "positions");
   }

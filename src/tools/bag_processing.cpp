@@ -90,7 +90,9 @@ class SmoothedBag {
   std::vector<double> times(const std::vector<jle::Stamp>& stamps, const std::string& topic) const;
   Eigen::MatrixXd positions() const;
   Eigen::MatrixXd velocities() const;
-  void filterForces(const std::string& topic, Series& s, double cutoff, int order);
+  // The topic's wrenches filtered with choice's cutoff (and checked: checkFilteredAlike).
+  void filterForces(const std::string& topic, Series& s, const jle::ZeroPhaseConfig& config,
+                    jle::CutoffChoice& choice);
 
   std::string joint_topic_;
   std::vector<sensor_msgs::JointState> joints_;
@@ -150,14 +152,16 @@ Eigen::MatrixXd SmoothedBag::positions() const {
   return q;
 }
 
-void SmoothedBag::filterForces(const std::string& topic, Series& s, double cutoff, int order) {
+void SmoothedBag::filterForces(const std::string& topic, Series& s,
+                               const jle::ZeroPhaseConfig& config, jle::CutoffChoice& choice) {
   if (s.messages.size() < 3) return;  // too few to filter: the message path counts them
   Eigen::MatrixXd f(s.messages.size(), 6);
   for (std::size_t i = 0; i < s.messages.size(); ++i) {
     const geometry_msgs::Wrench& w = s.messages[i].wrench;
     f.row(i) << w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z;
   }
-  f = jle::lowPassZeroPhase(times(s.stamps, topic), f, cutoff, order);
+  jle::checkFilteredAlike(times(s.stamps, topic), f, config, topic, choice);
+  f = jle::lowPassZeroPhase(times(s.stamps, topic), f, choice.cutoff, config.order);
   for (std::size_t i = 0; i < s.messages.size(); ++i) {
     geometry_msgs::Wrench& w = s.messages[i].wrench;
     w.force.x = f(i, 0), w.force.y = f(i, 1), w.force.z = f(i, 2);
@@ -182,7 +186,7 @@ jle::CutoffChoice SmoothedBag::smooth(const jle::ZeroPhaseConfig& config) {
   jle::ZeroPhaseResult r;
   try {
     r = jle::smoothZeroPhase(times(joint_stamps_, joint_topic_), q, config, velocities());
-    for (auto& [topic, series] : forces_) filterForces(topic, series, r.cutoff, config.order);
+    for (auto& [topic, series] : forces_) filterForces(topic, series, config, r.choice);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("--zero-phase: ") + e.what());
   }
@@ -470,6 +474,10 @@ void BagProcessor::summarize(double total_s) const {
                  pipeline_.settings().smoothed.differentiator.lag, smoothed_written_,
                  pipeline_.smoothedBandwidth(),
                  pipeline_.smoothedVelocities() ? "measured velocities" : "positions");
+  const std::string bound = pipeline_.smoothedBandwidthBound();
+  if (!bound.empty())
+    std::fprintf(stderr, "process_bag: warning: smoothed stream's bandwidth on a bound: %s\n",
+                 bound.c_str());
   printDrops();
 }
 

@@ -824,12 +824,15 @@ jle::CutoffChoice smoothPositions(const Options& options, jle::StateColumns& col
     scatter(k.value, columns.q, r);
     scatter(k.rate, columns.qd, r);
     scatter(k.accel, columns.qdd, r);
+    jle::CutoffChoice choice = k.choice;
     const std::vector<int> forces = forceColumns(columns);
-    if (!forces.empty())
-      scatter(jle::lowPassZeroPhase(r.t, gather(r, forces), k.cutoff, z.order, z.padding), forces,
-              r);
+    if (!forces.empty()) {
+      const Eigen::MatrixXd raw = gather(r, forces);
+      jle::checkFilteredAlike(r.t, raw, z, "the wrench and plate columns", choice);
+      scatter(jle::lowPassZeroPhase(r.t, raw, k.cutoff, z.order, z.padding), forces, r);
+    }
     if (columns.base_pose[0] >= 0) smoothBase(options, columns, r, k.cutoff);
-    return k.choice;
+    return choice;
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(options.input + ": smoothing the positions (--cutoff): " + e.what());
   }

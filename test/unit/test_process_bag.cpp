@@ -817,6 +817,65 @@ TEST_F(ProcessBagTest, AbsurdAndGlitchedPositionsChangeNoLoad) {
   for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(b.rows[i], a.rows[i]) << "row " << i;
 }
 
+// Measured velocities (issue 37) through process_bag with the default settings: joint
+// states that carry the exact velocities give other loads than the same positions alone
+// (they are used); a NaN velocity of panda_joint2 in every tenth message drops no message
+// (it costs that velocity only); velocities that are all NaN are none: the loads are the
+// positions-only ones, bit for bit, every message kept.
+TEST_F(ProcessBagTest, MeasuredVelocitiesAreUsedAndNaNOnesDropNothingElse) {
+  const Messages m = makeMessages();
+  // Joint k's exact rate at time t (position()'s derivative; the fingers still).
+  const auto rate = [](std::size_t k, double t) {
+    if (k == 7) return 0.0;
+    const double w = 2 * kPi * (0.3 + 0.1 * static_cast<double>(k));
+    return 0.3 * w * std::cos(w * t + static_cast<double>(k));
+  };
+  // The messages with velocity(sample, joint k) (names as makeMessages orders them).
+  const auto withVelocities = [&](const std::string& bag, auto velocity) {
+    Messages v = m;
+    for (std::size_t i = 0; i < v.joints.size(); ++i) {
+      sensor_msgs::JointState& js = v.joints[i].second;
+      js.velocity.assign(js.name.size(), 0.0);
+      for (std::size_t n = 1; n < js.name.size(); ++n)
+        js.velocity[n] = velocity(i, kJoints.size() - n);
+    }
+    writeBag(path(bag), v);
+  };
+  writeBag(path("q.bag"), m);
+  withVelocities("qv.bag", [&](std::size_t i, std::size_t k) { return rate(k, 0.001 * i); });
+  withVelocities("nan10.bag", [&](std::size_t i, std::size_t k) {
+    return k == 1 && i % 10 == 5 ? std::nan("") : rate(k, 0.001 * i);
+  });
+  withVelocities("nan.bag", [](std::size_t, std::size_t) { return std::nan(""); });
+  writeFile(path("config.yaml"), "joint_states_topic: arm/joint_states\n");
+  std::map<std::string, Table> csv;
+  for (const char* name : {"q", "qv", "nan10", "nan"}) {
+    const Result r =
+        run(std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) + " --config " +
+            quote(path("config.yaml")) + " --bag " + quote(path(name + std::string(".bag"))) +
+            " --csv " + quote(path(name + std::string(".csv"))));
+    ASSERT_EQ(r.status, 0) << name << ": " << r.output;
+    EXPECT_EQ(r.output.find("invalid"), std::string::npos) << name << ": " << r.output;
+    csv[name] = readCsv(path(name + std::string(".csv")));
+  }
+  const Table& q = csv["q"];
+  ASSERT_GT(q.rows.size(), 250u);
+  double moved = 0.0;  // the largest change of a load that the velocities make
+  for (const char* name : {"qv", "nan10", "nan"}) {
+    const Table& t = csv[name];
+    ASSERT_EQ(t.header, q.header) << name;
+    ASSERT_EQ(t.rows.size(), q.rows.size()) << name << ": a message dropped";
+  }
+  for (std::size_t i = 0; i < q.rows.size(); ++i) {
+    EXPECT_EQ(csv["nan"].rows[i], q.rows[i]) << "row " << i;
+    for (std::size_t c = 1; c < q.rows[i].size(); ++c)
+      moved = std::max(moved, std::abs(csv["qv"].rows[i][c] - q.rows[i][c]));
+  }
+  // Far above the CSV's rounding (17 digits): the velocities change the loads.
+  EXPECT_GT(moved, 1e-6);
+  std::printf("largest change of a load by the measured velocities: %.3g\n", moved);
+}
+
 TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
   const Messages m = makeMessages();
   writeBag(path("in.bag"), m);

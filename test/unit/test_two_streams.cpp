@@ -150,6 +150,7 @@ struct SmoothedRun {
   double error = 0.0, reference = 0.0;  // [rad/s^2]
   double bandwidth = 0.0;               // [Hz] smoothedBandwidth() at the end
   bool velocities = false;              // smoothedVelocities() at the end
+  std::string bound;                    // smoothedBandwidthBound() at the end
 };
 
 SmoothedRun runSmoothed(const jle::SensorModel& sensor, bool velocities,
@@ -190,6 +191,7 @@ SmoothedRun runSmoothed(const jle::SensorModel& sensor, bool velocities,
   SmoothedRun run;
   run.bandwidth = p.smoothedBandwidth();
   run.velocities = p.smoothedVelocities();
+  run.bound = p.smoothedBandwidthBound();
   while (p.flushSmoothed()) collect();
   run.error = std::sqrt(sum / count);
   const jle::ZeroPhaseResult z = jle::smoothZeroPhase(t, x, jle::ZeroPhaseConfig{});
@@ -232,6 +234,7 @@ TEST(TwoStreams, TheSmoothedStreamNearsTheOfflineSmootherOnALowNoiseEncoder) {
       "process noise 1e3 %.4g; offline zero-phase %.4g rad/s^2; bandwidth %.3g Hz\n",
       given.error, positions.error, held.error, given.reference, given.bandwidth);
   EXPECT_FALSE(given.velocities);
+  EXPECT_EQ(given.bound, "");  // the data's choice, not a bound
   EXPECT_LT(given.bandwidth, 8.9);
   EXPECT_GE(given.bandwidth, 1.4 / 0.2 - 1e-9);  // kLagFloor / lag
   EXPECT_LT(given.error, 2.7 * given.reference);
@@ -258,6 +261,8 @@ TEST(TwoStreams, TheSmoothedBandwidthStaysLowUnderColouredNoise) {
   EXPECT_TRUE(run.velocities);
   EXPECT_LT(run.bandwidth, 8.9);
   EXPECT_LT(run.error, 1.5 * run.reference);
+  // The floor is a bound of the search: said (process_bag's summary, the diagnostics).
+  EXPECT_NE(run.bound.find("below the lag's floor 7 Hz"), std::string::npos) << run.bound;
 }
 
 // Exact positions at 200 Hz (the accuracy study's leg_running_200hz): their spectrum

@@ -241,6 +241,56 @@ TEST(QuietEncoders, StopAndGoAt4kHzChoosesNearTheBestFixedCutoff) {
   expectNearTheOracle(record(jle::MotionKind::kStopAndGo, encoders(4000.0), 5.0));
 }
 
+// The wrench columns that the positions' cutoff filters alike (checkFilteredAlike): a
+// contact force of heel strikes (8 ms rise into a 0.25 s half sine, 1500 N, 0.5 N of
+// noise, 1 kHz) carries content far above a 5 Hz choice, and is warned about; a slow F/T
+// wrench (0.1 .. 1 Hz sines, 0.1 N of noise) is not; a fixed cutoff is not checked.
+TEST(FilteredAlike, WarnsWhereTheWrenchesCarryContentAboveTheCutoff) {
+  jle::WrenchMotion strikes, slow;
+  for (double start : {0.7, 1.9, 3.1, 4.3}) {
+    jle::Stance s;
+    s.start = start;
+    s.rise = 0.008;
+    s.duration = 0.25;
+    s.peak << 150.0, 0.0, 1500.0, 0.0, 60.0, 0.0;
+    strikes.stances.push_back(s);
+  }
+  slow.mean << 5.0, -3.0, -15.0, 0.2, -0.1, 0.05;
+  slow.amplitude << 5.0, 2.0, 8.0, 0.3, 0.5, 0.1;
+  slow.omega << 0.7, 1.9, 3.3, 4.4, 5.8, 6.2;
+  jle::PortableRandom random(5);
+  std::vector<double> t;
+  Eigen::MatrixXd f_strikes(6000, 6), f_slow(6000, 6);
+  for (Eigen::Index k = 0; k < 6000; ++k) {
+    t.push_back(1e-3 * static_cast<double>(k));
+    f_strikes.row(k) = strikes.at(t.back()).transpose();
+    f_slow.row(k) = slow.at(t.back()).transpose();
+    for (Eigen::Index c = 0; c < 6; ++c) {
+      f_strikes(k, c) += 0.5 * random.gaussian();
+      f_slow(k, c) += 0.1 * random.gaussian();
+    }
+  }
+  jle::CutoffChoice choice;
+  choice.rule = jle::CutoffRule::kSpectrum;
+  choice.cutoff = 5.0;
+  const jle::ZeroPhaseConfig config;
+  const double f = jle::checkFilteredAlike(t, f_strikes, config, "the contact", choice);
+  EXPECT_GT(f, jle::kCutoffDisagreement * 5.0);
+  ASSERT_EQ(choice.warnings.size(), 1u);
+  EXPECT_NE(choice.warnings.front().find("zero-phase cutoff: the contact: its own spectrum"),
+            std::string::npos)
+      << choice.warnings.front();
+  std::printf("heel strikes: %.3g Hz; %s\n", f, choice.warnings.front().c_str());
+  choice.warnings.clear();
+  const double g = jle::checkFilteredAlike(t, f_slow, config, "the F/T sensor", choice);
+  EXPECT_LT(g, jle::kCutoffDisagreement * 5.0);
+  EXPECT_TRUE(choice.warnings.empty()) << choice.warnings.front();
+  std::printf("slow wrench: %.3g Hz\n", g);
+  choice.rule = jle::CutoffRule::kFixed;
+  EXPECT_EQ(jle::checkFilteredAlike(t, f_strikes, config, "the contact", choice), 0.0);
+  EXPECT_TRUE(choice.warnings.empty());
+}
+
 class JointLoadsColoured : public jle_test::ToolTest {
  protected:
   JointLoadsColoured() : ToolTest("jle_coloured") {}
@@ -295,19 +345,35 @@ class JointLoadsColoured : public jle_test::ToolTest {
   }
 };
 
-// Positions only, the default rule: the cutoff within a factor of 2 of the oracle's, the
-// loads within 1.3 times its error, the rule printed.
+// The bounds a positions-only choice must meet: its cutoff within a factor of 1.5 of the
+// oracle's, its loads within 1.3 times the oracle's error (issue 37's bound). Measured:
+// 4.53 Hz and 0.0735 N m against the oracle's 5.05 Hz and 0.0696 N m (1.06x); GCV 50 Hz
+// and 10.4 N m (149x).
+::testing::AssertionResult withinTheBounds(double cutoff, double error) {
+  const bool near = std::abs(std::log(cutoff / oracle().cutoff)) <= std::log(1.5);
+  if (near && error <= 1.3 * oracle().error) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "chose " << cutoff << " Hz, " << error << " N m; oracle "
+                                       << oracle().cutoff << " Hz, " << oracle().error << " N m";
+}
+
+// Positions only, the default rule: within the bounds, the rule printed. The same bounds
+// fail the white-noise rule (GCV, --cutoff-rule gcv), which takes the noise flat to 50 Hz
+// for motion and climbs to the search's bound: the bounds tell a sound choice from it.
 TEST_F(JointLoadsColoured, PositionsOnlyChoosesASaneCutoffAndBoundedLoads) {
   const Recording& r = coloured();
   writeCsv("q.csv", r, false);
   std::string err;
   const Eigen::MatrixXd effort = efforts(r, "q.csv", {}, err);
   ASSERT_EQ(effort.rows(), r.q.rows()) << err;
-  const double cutoff = printedCutoff(err);
-  EXPECT_NEAR(std::log(cutoff / oracle().cutoff), 0.0, std::log(2.0)) << err;
   EXPECT_NE(err.find("(noise spectrum)"), std::string::npos) << err;
-  EXPECT_LT(effortError(r, effort), 1.3 * oracle().error)
-      << err << "oracle " << oracle().cutoff << " Hz, " << oracle().error << " N m";
+  EXPECT_TRUE(withinTheBounds(printedCutoff(err), effortError(r, effort))) << err;
+  std::printf("joint_loads, positions only: %.3g Hz, %.3g N m; oracle %.3g Hz, %.3g N m\n",
+              printedCutoff(err), effortError(r, effort), oracle().cutoff, oracle().error);
+  const Eigen::MatrixXd gcv = efforts(r, "q.csv", {"--cutoff-rule", "gcv"}, err);
+  ASSERT_EQ(gcv.rows(), r.q.rows()) << err;
+  EXPECT_FALSE(withinTheBounds(printedCutoff(err), effortError(r, gcv))) << err;
+  std::printf("joint_loads --cutoff-rule gcv: %.3g Hz, %.3g N m\n", printedCutoff(err),
+              effortError(r, gcv));
 }
 
 // With J.qd columns: the velocity evidence chooses, and says so.
