@@ -93,8 +93,8 @@ TEST(FrameResolver, AnyOtherFrameIsLookedUpAtEveryMessage) {
 
 TEST(FrameResolver, AnUnknownFrameNamesTheInputFrameAndLink) {
   Ur5 r;
-  for (jle::FrameSource* frames : {static_cast<jle::FrameSource*>(&r.frames),
-                                   static_cast<jle::FrameSource*>(nullptr)}) {
+  for (jle::FrameSource* frames :
+       {static_cast<jle::FrameSource*>(&r.frames), static_cast<jle::FrameSource*>(nullptr)}) {
     jle::FrameResolver resolver(r.model, r.settings, frames);
     std::string problem;
     EXPECT_FALSE(resolver.resolveWrench(0, "nowhere", 5, problem));
