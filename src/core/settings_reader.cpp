@@ -221,6 +221,7 @@ void readStamps(Section& s, StampSettings& v) {
   s.read("regularize", v.regularize, kStampRegularize, StampRegularize::kAuto,
          StampRegularize::kOff);
   s.read("jump_confirm", v.jump_confirm);
+  s.read("merge_window", v.merge_window);
 }
 
 void readUncertainty(Section& s, UncertaintyConfig& u) {

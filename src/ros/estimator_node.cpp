@@ -473,6 +473,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
   status.add("velocities not used: non-finite", c.nonfinite_velocities);
   status.add("mimic joints contradicting their leader", c.mimic_contradictions);
+  status.add("merged: joint states of one instant from several publishers",
+             c.count(Outcome::kMerged));
   status.add("samples with a joint held from an earlier message", c.held_samples);
   status.add("joints with measured velocities", pipeline_->velocitiesUsed());
   if (pipeline_->hasSmoothed()) {

@@ -195,6 +195,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(time_jump_threshold);
   EXPECT_SAME(stamps.regularize);
   EXPECT_SAME(stamps.jump_confirm);
+  EXPECT_SAME(stamps.merge_window);
   EXPECT_SAME(keep_fixed_joints);
   EXPECT_SAME(accept_nonphysical_inertia);
   EXPECT_SAME(base_residual_threshold);
@@ -403,6 +404,7 @@ TEST(SettingsReader, StampsKeys) {
   Settings e;
   e.stamps.regularize = jle::StampRegularize::kAuto;
   e.stamps.jump_confirm = 5;
+  e.stamps.merge_window = 0.002;
   expectSame(parseFile(kConfig + "/ok_stamps.yaml"), e);
   // rosparam reads YAML 1.1, where a bare off is a boolean.
   XmlRpc::XmlRpcValue params;
