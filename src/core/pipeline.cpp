@@ -480,7 +480,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   // than the one being assembled, is dropped whole.
   const bool joins = joinsGroup(stamp);
   const Stamp newest = std::max(last_stamp_, group_.open && !joins ? group_.newest : Stamp{0});
-  if (last_stamp_ != 0 && stamp <= newest)
+  if (newest != 0 && stamp <= newest)
     return fail(
         kind, Outcome::kOrder,
         settings_.joint_states_topic + ": " +
@@ -554,9 +554,7 @@ void Pipeline::closeGroup() {
   }
   --counters_
         .outcomes[static_cast<int>(InputKind::kJointState)][static_cast<int>(Outcome::kMerged)];
-  const std::string problem = problem_;
   if (takeGroup() == Outcome::kPublished) group_record_ = true;
-  if (problem_.empty()) problem_ = problem;
 }
 
 bool Pipeline::stashGroupRecords() {

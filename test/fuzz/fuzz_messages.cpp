@@ -333,7 +333,7 @@ void checkJointOutcome(jle::Pipeline& p, const JointMessage& js, jle::Stamp stam
   const bool joining = joins(shadow, has, stamp, p.settings().stamps.merge_window);
   const jle::Stamp newest =
       std::max(shadow.last, shadow.group_open && !joining ? shadow.group_newest : 0);
-  JLE_FUZZ_CHECK((outcome == Outcome::kOrder) == (shadow.last != 0 && stamp <= newest));
+  JLE_FUZZ_CHECK((outcome == Outcome::kOrder) == (newest != 0 && stamp <= newest));
   if (outcome == Outcome::kOrder) return;
   // A value no UR5 produces (beyond its limits, faster than it moves): dropped after the
   // stamp checks, not taken, named.
