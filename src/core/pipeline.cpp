@@ -1,6 +1,7 @@
 #include <joint_load_estimator/frames.hpp>
 #include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/plausibility.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
 
 #include <algorithm>
@@ -195,13 +196,7 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     record_.inputs[k].frame = settings_.estimator.wrenches[k].link;
   record_.plates.resize(plates_.size());
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
-  coordinate_segment_.assign(static_cast<std::size_t>(m.nq), 0);
-  for (int s = 1; s < m.nsegments(); ++s) {  // the leader's joint: named as its coordinate
-    const int c = m.coordinate[static_cast<std::size_t>(s)];
-    if (c >= 0 && m.joint_name[static_cast<std::size_t>(s)] ==
-                      m.coordinate_names[static_cast<std::size_t>(c)])
-      coordinate_segment_[static_cast<std::size_t>(c)] = s;
-  }
+  coordinate_segment_ = coordinateSegments(m);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
     smoothed_ = std::make_unique<Stream>(model, smoothedEstimatorConfig(settings_));
@@ -842,8 +837,7 @@ std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
     if (rec.plates[k].stale && estimator.plateNeeded(static_cast<int>(k))) status |= kStaleInput;
   const Model<double>& m = model();
   for (std::size_t i = 0; i < rec.segment.size(); ++i)
-    if (std::abs(rec.effort[i]) >
-        p.effort_factor * m.effort_limit[static_cast<std::size_t>(rec.segment[i])])
+    if (implausibleEffort(m, p, static_cast<std::size_t>(rec.segment[i]), rec.effort[i]))
       status |= kImplausibleLoad;
   return status;
 }
@@ -926,31 +920,22 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   const std::vector<int>& coordinate = joints_.coordinates();  // bound by checkJointState
   const double dt = last_stamp_ != 0 ? 1e-9 * static_cast<double>(stamp - last_stamp_) : -1.0;
   bool too_fast = false;
-  char text[256];
   for (std::size_t i = 0; i < names.size(); ++i) {
     const int c = coordinate[i];
     if (c < 0) continue;
     const std::size_t s =
         static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(c)]);
-    const double q = position[i];
-    if (q < m.lower_limit[s] - p.position_margin || q > m.upper_limit[s] + p.position_margin) {
-      std::snprintf(text, sizeof text,
-                    ": position of joint '%s' is %.6g, beyond its URDF limits [%.6g, %.6g] by "
-                    "more than plausibility/position_margin %.3g: message dropped",
-                    names[i].c_str(), q, m.lower_limit[s], m.upper_limit[s], p.position_margin);
-      problem_ = settings_.joint_states_topic + text;
+    const std::string beyond = implausiblePosition(m, p, s, position[i]);
+    if (!beyond.empty()) {
+      problem_ = settings_.joint_states_topic + ": " + beyond + ": message dropped";
       return false;
     }
     if (dt <= 0.0 || !joints_.received(c) || too_fast) continue;
-    const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
-    const double step = std::abs(q - joints_.q()[static_cast<std::size_t>(c)]);
-    if (step <= p.velocity_factor * limit * dt + p.step_margin) continue;
+    const std::string fast =
+        implausibleStep(m, p, s, position[i] - joints_.q()[static_cast<std::size_t>(c)], dt);
+    if (fast.empty()) continue;
     too_fast = true;
-    std::snprintf(text, sizeof text,
-                  ": position of joint '%s' moved %.6g in %.6g s, beyond plausibility/"
-                  "velocity_factor %.3g times its velocity limit %.6g: message dropped",
-                  names[i].c_str(), step, dt, p.velocity_factor, limit);
-    problem_ = settings_.joint_states_topic + text;
+    problem_ = settings_.joint_states_topic + ": " + fast + ": message dropped";
   }
   if (!too_fast) {
     implausible_run_ = 0;
@@ -975,8 +960,7 @@ const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<std::
     if (coordinate[i] < 0 || !std::isfinite(velocity[i])) continue;
     const std::size_t s =
         static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(coordinate[i])]);
-    const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
-    if (std::abs(velocity[i]) <= p.velocity_factor * limit) continue;
+    if (!implausibleVelocity(m, p, s, velocity[i])) continue;
     if (!any) velocity_checked_ = velocity;  // same size after the first: no allocation
     velocity_checked_[i] = kNaN;             // counted and named as a non-finite one
     any = true;
