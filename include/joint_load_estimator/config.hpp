@@ -415,6 +415,10 @@ struct Settings {
   /// in the publisher's thread. Joint states from another process (TCP) are then
   /// dropped with an error (README "Latency: nodelet or TCP").
   bool inline_callbacks = false;
+  /// The node: when the ROS master it registered with is replaced by another (a restarted
+  /// roscore, which knows none of its topics), shut down (ros::requestShutdown) so that a
+  /// launch file's respawn="true" starts it again, registered. False: only said (an error).
+  bool exit_on_master_restart = false;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;
   FrictionConfig friction;

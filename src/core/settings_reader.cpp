@@ -325,6 +325,7 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("accept_nonphysical_inertia", n.accept_nonphysical_inertia);
   s.read("diagnostic_period", n.diagnostic_period);
   s.read("inline_callbacks", n.inline_callbacks);
+  s.read("exit_on_master_restart", n.exit_on_master_restart);
   s.read("decimation", n.estimator.decimation);
   s.read("gravity", n.estimator.gravity_world.data(), 3);
   s.read("precision", n.estimator.precision, kPrecisions);

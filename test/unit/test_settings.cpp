@@ -203,6 +203,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(bias_file);
   EXPECT_SAME(diagnostic_period);
   EXPECT_SAME(inline_callbacks);
+  EXPECT_SAME(exit_on_master_restart);
   EXPECT_SAME(body_mass);
   expectSame(a.estimator, b.estimator);
   EXPECT_SAME(smoothed.enabled);
@@ -266,6 +267,7 @@ TEST(SettingsReader, TopLevelKeys) {
   e.bias_file = "/tmp/ft_bias.yaml";
   e.diagnostic_period = 0.25;
   e.inline_callbacks = true;
+  e.exit_on_master_restart = true;
   e.body_mass = -1.0;
   expectSame(parseFile(kConfig + "/ok_top_level.yaml"), e);
 }
