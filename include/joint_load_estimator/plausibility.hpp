@@ -37,7 +37,8 @@ inline double velocityLimit(const Model<double>& model, const PlausibilityConfig
 /// than position_margin), naming joint, value and bound; empty when it is.
 inline std::string implausiblePosition(const Model<double>& model, const PlausibilityConfig& p,
                                        std::size_t s, double q) {
-  if (q >= model.lower_limit[s] - p.position_margin && q <= model.upper_limit[s] + p.position_margin)
+  if (q >= model.lower_limit[s] - p.position_margin &&
+      q <= model.upper_limit[s] + p.position_margin)
     return {};
   char text[256];
   std::snprintf(text, sizeof text,
