@@ -533,7 +533,9 @@ Outcome Pipeline::takeGroup() {
     joints_.clearFresh();
     return count(InputKind::kJointState, Outcome::kNoBasePose);
   }
-  return sample(group_.newest, group_.has_effort, &base);
+  const Outcome outcome = sample(group_.newest, group_.has_effort, &base);
+  joints_.clearFresh();  // also where the estimator refused the sample: the next instant's own
+  return outcome;
 }
 
 void Pipeline::closeGroup() {
