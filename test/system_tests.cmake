@@ -33,11 +33,11 @@ set(JLE_PYTEST_RESULT ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-bindings
 catkin_run_tests_target(pytest bindings pytest-bindings.xml
   COMMAND "JLE_TEST_DATA=${JLE_TEST_DATA} JLE_JOINT_LOADS=$<TARGET_FILE:joint_loads> \
 JLE_PROCESS_BAG=$<TARGET_FILE:process_bag> JLE_MAKE_EXAMPLE_BAG=$<TARGET_FILE:make_example_bag> \
-JLE_MAKE_GAIT_BAG=$<TARGET_FILE:make_gait_bag> \
+JLE_MAKE_GAIT_BAG=$<TARGET_FILE:make_gait_bag> JLE_NODE=$<TARGET_FILE:joint_load_estimator_node> \
 /usr/bin/python3 -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/test/python \
 --junitxml=${JLE_PYTEST_RESULT}"
   DEPENDENCIES joint_load_estimator_python joint_load_estimator_python_bag joint_loads
-  process_bag make_example_bag make_gait_bag)
+  process_bag make_example_bag make_gait_bag joint_load_estimator_node)
 
 # --- Node tests (rostest) -----------------------------------------------------------
 jle_add_node_test(test_node_loads loads.test rostest/test_loads.cpp)

@@ -303,6 +303,12 @@ struct StampSettings {
   /// a jump of time (>= 1); fewer are dropped as rogue stamps. The clock going back
   /// confirms a jump back at once.
   int jump_confirm = 3;
+  /// [s] >= 0: joint states of several publishers (each a subset of the joints) whose
+  /// stamps lie within this of each other are merged into one sample (Pipeline, README
+  /// "Never silently wrong"); a sample waits for every needed joint until a message of a
+  /// later instant comes. 5 ms: two drivers of one robot stamping one cycle up to 200 Hz;
+  /// a joint repeated closes an instant anyway, so a faster stream loses nothing by it.
+  double merge_window = 0.005;
 };
 
 /// The smoothed stream's filter by default: the constant-jerk Kalman smoother, lag 0.2 s,
@@ -411,6 +417,10 @@ struct Settings {
   /// in the publisher's thread. Joint states from another process (TCP) are then
   /// dropped with an error (README "Latency: nodelet or TCP").
   bool inline_callbacks = false;
+  /// The node: when the ROS master it registered with is replaced by another (a restarted
+  /// roscore, which knows none of its topics), shut down (ros::requestShutdown) so that a
+  /// launch file's respawn="true" starts it again, registered. False: only said (an error).
+  bool exit_on_master_restart = false;
   /// [kg] effort_per_kg = effort / body_mass; 0: not published; -1: the URDF's total mass.
   double body_mass = 0.0;
   FrictionConfig friction;

@@ -29,8 +29,15 @@ namespace jle {
 /// What became of one input message. Every message is either used or counted under
 /// the reason it was not (PipelineCounters).
 enum class Outcome : std::uint8_t {
-  kUsed,        ///< taken (a joint state entered the filters; no loads for it yet)
-  kPublished,   ///< a joint state: loads computed, record() holds them
+  kUsed,       ///< taken (a joint state entered the filters; no loads for it yet)
+  kPublished,  ///< a joint state: loads computed, record() holds them
+  /// A joint state carrying part of the needed joints, merged with the other publishers'
+  /// messages of its instant (Settings::stamps.merge_window) into one sample, whose outcome
+  /// is counted under the instant's last message. While the instant waits for a publisher
+  /// its last message is counted here; when a later instant closes it incomplete, the
+  /// sample is taken with the missing joints held (held_samples, kHeldJoint) and that
+  /// message is counted under the sample's outcome instead.
+  kMerged,
   kInvalid,     ///< sizes disagree, a name twice, or a non-finite position
   kOrder,       ///< same or older stamp than the input's previous one
   kFrame,       ///< frame neither rigid to the link in the URDF nor known to the FrameSource
@@ -83,8 +90,9 @@ struct PipelineCounters {
   /// joint states with a mimic joint's position contradicting its leader's (beyond
   /// plausibility/mimic_tolerance; the model's value is used)
   long mimic_contradictions = 0;
-  /// samples taken with a coordinate the loads need held from an earlier message (joint
-  /// states split over publishers, each message a sample: README "Never silently wrong")
+  /// samples taken with a coordinate the loads need held from an earlier message: an
+  /// instant of joint states split over publishers that a later one closed before every
+  /// publisher spoke (a slower or dead publisher; README "Never silently wrong")
   long held_samples = 0;
 
   long received(InputKind kind) const;
@@ -107,6 +115,9 @@ enum LoadsStatus : std::uint8_t {
   kStaleInput = 2,
   /// An effort beyond plausibility/effort_factor times its joint's URDF effort limit.
   kImplausibleLoad = 4,
+  /// Within plausibility/settle_time of a sample that held a needed joint's position from
+  /// an earlier message (a publisher of split joint states slower than the others, or dead).
+  kHeldJoint = 8,
 };
 
 /// The bits of `status` in words ("settling, stale input"); "trusted" for 0.
@@ -203,7 +214,9 @@ class Pipeline {
   Pipeline& operator=(const Pipeline&) = delete;
 
   /// A joint state: names, positions (same size), velocities and efforts (empty or the
-  /// same size; a non-finite velocity or effort only drops that joint's measured value). `clock` is
+  /// same size; a non-finite velocity or effort only drops that joint's measured value).
+  /// Messages of several publishers within stamps/merge_window are one sample, stamped with
+  /// the newest stamp among them, taken when every needed joint has come (kMerged). `clock` is
   /// the front end's clock when the message arrived (the node: ros::Time::now(); a bag: the
   /// message's bag time): it going back confirms a backward jump of time (a looping bag), and it
   /// stands for stamp 0 on a stream that never had a stamp (README, "Time stamps"). The estimator
@@ -212,7 +225,8 @@ class Pipeline {
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
                        const std::vector<double>& position, const std::vector<double>& velocity,
                        const std::vector<double>& effort);
-  /// The end of a stream (process_bag, joint_loads, a replay's last message): with a
+  /// The end of a stream (process_bag, joint_loads, a replay's last message): an instant
+  /// still waiting for a publisher is taken (its missing joints held); with a
   /// smoother (differentiator/lag > 0) the joint states whose loads are still to come are
   /// smoothed with the data there is; each call that returns true puts the next one's
   /// loads in record(), false when none is left (each was counted when it came).
@@ -371,6 +385,15 @@ class Pipeline {
     std::size_t drained_next = 0;
     Settle settle;
   };
+  // The instant being assembled from the joint states of several publishers: the
+  // stamps of its oldest and newest message, whether one had efforts, and whether its last
+  // message was counted kMerged (not kWaiting).
+  struct Group {
+    bool open = false;
+    Stamp oldest = 0, newest = 0;
+    bool has_effort = false;
+    bool last_merged = false;
+  };
   // One joint sample entering the filters: its time, stamp and measured efforts.
   struct Sample {
     double t = 0.0;
@@ -397,6 +420,19 @@ class Pipeline {
                      const std::vector<double>& velocity, const std::vector<double>& effort);
   bool basePose(Stamp stamp, BasePose& base);
   Outcome sample(Stamp stamp, bool has_effort, const BasePose* base);
+  // Split publishers: whether the last bound message joins the open instant, whether the
+  // instant has every needed joint, the instant taken (its sample's outcome), and an
+  // incomplete one closed (taken with the missing joints held, or forgotten while a
+  // joint was never received).
+  bool joinsGroup(Stamp stamp) const;
+  bool groupComplete() const;
+  Outcome takeGroup();
+  void closeGroup();
+  // A closed instant's loads (record_, the smoothed record) into the drained lists before
+  // another sample overwrites them (true if any was); unstash: the message's own loads
+  // after them, so that a front end publishes them in order.
+  bool stashGroupRecords();
+  void unstash(bool immediate_published);
   Outcome staleProblem();
   void remember(double t, Stamp stamp, bool has_effort);
   void growRing(std::size_t size);
@@ -406,7 +442,7 @@ class Pipeline {
   std::uint8_t statusOf(const Estimator& estimator, double settle_from,
                         const LoadsRecord& rec) const;
   static void noteStart(Settle& settle, SampleStatus status, double t);
-  void countHeld();
+  void countHeld(double t);
   static bool finiteLoads(const LoadsRecord& rec);
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
   bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
@@ -474,6 +510,10 @@ class Pipeline {
   int implausible_run_ = 0;
   std::vector<double> velocity_checked_;
   Settle settle_;  // the immediate stream's
+  Group group_;
+  bool group_record_ = false;  // record_ holds a closed instant's loads (takeDrained)
+  bool stashed_ = false, stashed_smoothed_ = false;  // by stashGroupRecords, this call
+  double held_t_ = -1e300;  // estimator time of the last sample that held a joint
 };
 
 }  // namespace jle

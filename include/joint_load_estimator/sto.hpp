@@ -83,6 +83,8 @@ class StoWriter {
 ///   base.mx, .my, .mz     -> ROOT_mx_moment, ROOT_my_moment, ROOT_mz_moment (world axes)
 ///   plate@P.contact       -> P_contact
 ///   plate@P.cop_x, _y, _z -> P_ground_force_px, _py, _pz (OpenSim's external-load names)
+///   status                -> status (the record's LoadsStatus bits, 0: trusted; OpenSim
+///                            reads it as one more column)
 /// The components of a world vector are OpenSim's ground axes' (y up): a .sto row holds
 /// (x, z, -y) of the CSV's (StoLayout, toOpenSimGround); stoLayout says which columns.
 /// Throws std::invalid_argument on a name that is none of these.

@@ -199,6 +199,7 @@ void validate(const Settings& settings) {
   if (settings.stamps.jump_confirm < 1)
     fail("stamps/jump_confirm",
          "must be >= 1, it is " + std::to_string(settings.stamps.jump_confirm));
+  nonNegative("stamps/merge_window", settings.stamps.merge_window);
   positive("base_residual_threshold", settings.base_residual_threshold);
   positive("still_velocity", settings.still_velocity);
   positive("diagnostic_period", settings.diagnostic_period);

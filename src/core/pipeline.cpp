@@ -1,6 +1,7 @@
 #include <joint_load_estimator/frames.hpp>
 #include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/plausibility.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
 
 #include <algorithm>
@@ -56,6 +57,7 @@ const char* toString(Outcome outcome) {
   switch (outcome) {
     case Outcome::kUsed: return "used";
     case Outcome::kPublished: return "published";
+    case Outcome::kMerged: return "merged";
     case Outcome::kInvalid: return "invalid";
     case Outcome::kOrder: return "stamp order";
     case Outcome::kFrame: return "unresolved frame";
@@ -194,13 +196,7 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     record_.inputs[k].frame = settings_.estimator.wrenches[k].link;
   record_.plates.resize(plates_.size());
   for (Sample& s : ring_) s.effort.assign(n, kNaN);
-  coordinate_segment_.assign(static_cast<std::size_t>(m.nq), 0);
-  for (int s = 1; s < m.nsegments(); ++s) {  // the leader's joint: named as its coordinate
-    const int c = m.coordinate[static_cast<std::size_t>(s)];
-    if (c >= 0 && m.joint_name[static_cast<std::size_t>(s)] ==
-                      m.coordinate_names[static_cast<std::size_t>(c)])
-      coordinate_segment_[static_cast<std::size_t>(c)] = s;
-  }
+  coordinate_segment_ = coordinateSegments(m);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
     smoothed_ = std::make_unique<Stream>(model, smoothedEstimatorConfig(settings_));
@@ -312,7 +308,14 @@ void Pipeline::resetTimeline(Stamp stamp) { resetTimeline(last_stamp_, stamp); }
 
 void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   // A looping bag (rosbag play -l), a restarted simulation, a driver's clock set: the
-  // filters' memory belongs to another timeline, and so does the time axis.
+  // filters' memory belongs to another timeline, and so does the time axis. An instant
+  // still waiting for a publisher is taken first, on its own timeline.
+  if (group_.open) {
+    closeGroup();
+    stashGroupRecords();
+    stashed_ = stashed_smoothed_ = false;
+  }
+  held_t_ = -1e300;
   jumped_ = true;
   jump_from_ = from;
   jump_to_ = stamp;
@@ -470,7 +473,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
                                const std::vector<double>& effort) {
   constexpr InputKind kind = InputKind::kJointState;
   problem_.clear();
-  smoothed_published_ = false;
+  smoothed_published_ = group_record_ = stashed_ = stashed_smoothed_ = false;
   unknown_joint_.clear();
   nonfinite_effort_.clear();
   nonfinite_velocity_.clear();
@@ -488,17 +491,118 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
     return fail(kind, Outcome::kRogueStamp, settings_.joint_states_topic + kZeroStamp);
   const Outcome timeline = checkJointStamp(stamp, clock);
   if (timeline != Outcome::kUsed) return timeline;
+  // The order before anything is stored: a message of an instant already taken, or older
+  // than the one being assembled, is dropped whole.
+  const bool joins = joinsGroup(stamp);
+  const Stamp newest = std::max(last_stamp_, group_.open && !joins ? group_.newest : Stamp{0});
+  if (newest != 0 && stamp <= newest)
+    return fail(
+        kind, Outcome::kOrder,
+        settings_.joint_states_topic + ": " +
+            toString(stamp == newest ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder) + " " +
+            seconds(stamp) + " (previous " + seconds(newest) + "): message dropped");
   if (!plausibleJointState(stamp, names, position)) return count(kind, Outcome::kImplausible);
+  if (group_.open && !joins) closeGroup();  // a later instant: the open one is complete as is
   mapJointState(names, position, plausibleVelocities(names, velocity), effort);
   anchor(stamp);
+  group_.oldest = group_.open ? std::min(group_.oldest, stamp) : stamp;
+  group_.newest = group_.open ? std::max(group_.newest, stamp) : stamp;
+  group_.has_effort = (group_.open && group_.has_effort) || !effort.empty();
+  group_.open = true;
+  group_.last_merged = false;
   const std::string& missing = missingJoint();
   if (!missing.empty())
     return fail(kind, Outcome::kWaiting,
                 settings_.joint_states_topic + ": no position received yet for joint '" + missing +
                     "': not publishing");
+  if (!groupComplete()) {
+    group_.last_merged = true;
+    return count(kind, Outcome::kMerged);
+  }
+  const bool stashed = stashGroupRecords();
+  const Outcome outcome = takeGroup();
+  if (stashed) unstash(outcome == Outcome::kPublished);
+  return outcome;
+}
+
+bool Pipeline::joinsGroup(Stamp stamp) const {
+  // One instant: within the window, and no needed joint twice (that is the next instant
+  // of its publisher).
+  if (!group_.open) return false;
+  const double span =
+      1e-9 * static_cast<double>(std::max(group_.newest, stamp) - std::min(group_.oldest, stamp));
+  if (span > settings_.stamps.merge_window) return false;
+  for (int k : joints_.coordinates())
+    if (k >= 0 && estimator_.coordinateNeeded(k) && joints_.fresh(k)) return false;
+  return true;
+}
+
+bool Pipeline::groupComplete() const {
+  for (int k = 0; k < model().nq; ++k)
+    if (estimator_.coordinateNeeded(k) && !joints_.fresh(k)) return false;
+  return true;
+}
+
+Outcome Pipeline::takeGroup() {
+  // Stamped with the newest of its messages: every position in the sample is known then,
+  // so a later instant's stamp is after it and a front end that publishes at once never
+  // stamps the past; the oldest message's joints are up to merge_window old in it.
+  group_.open = false;
   BasePose base;
-  if (model().floating_base && !basePose(stamp, base)) return count(kind, Outcome::kNoBasePose);
-  return sample(stamp, !effort.empty(), &base);
+  if (model().floating_base && !basePose(group_.newest, base)) {
+    joints_.clearFresh();
+    return count(InputKind::kJointState, Outcome::kNoBasePose);
+  }
+  const Outcome outcome = sample(group_.newest, group_.has_effort, &base);
+  joints_.clearFresh();  // also where the estimator refused the sample: the next instant's own
+  return outcome;
+}
+
+void Pipeline::closeGroup() {
+  // An instant that a later one closes before every publisher spoke. While a joint has
+  // never been received it is forgotten (its last message was counted waiting); else it
+  // is taken with the missing joints held (counted, the records flagged kHeldJoint), and
+  // its last message is counted under the sample's outcome instead of kMerged.
+  if (!group_.open) return;
+  if (!group_.last_merged) {
+    group_.open = false;
+    joints_.clearFresh();
+    return;
+  }
+  --counters_
+        .outcomes[static_cast<int>(InputKind::kJointState)][static_cast<int>(Outcome::kMerged)];
+  if (takeGroup() == Outcome::kPublished) group_record_ = true;
+}
+
+bool Pipeline::stashGroupRecords() {
+  // Rare (a message completing a sample right after it closed another, a reset, the end
+  // of a stream): copies of the records are fine here.
+  if (group_record_) {
+    drained_.push_back(record_);
+    group_record_ = false;
+    stashed_ = true;
+  }
+  if (smoothed_published_) {
+    smoothed_->drained.push_back(smoothed_->record);
+    smoothed_published_ = false;
+    stashed_smoothed_ = true;
+  }
+  return stashed_ || stashed_smoothed_;
+}
+
+void Pipeline::unstash(bool immediate_published) {
+  // The closed instant's loads first (record() and smoothedRecord(), as the front end
+  // publishes them), the message's own next (takeDrained).
+  if (stashed_ && immediate_published) std::swap(record_, drained_.back());
+  if (stashed_smoothed_ && smoothed_published_)
+    std::swap(smoothed_->record, smoothed_->drained.back());
+  else if (stashed_smoothed_ && !smoothed_published_) {
+    // Its own made none: the closed one's is the call's smoothed record again.
+    std::swap(smoothed_->record, smoothed_->drained.back());
+    smoothed_->drained.pop_back();
+    smoothed_published_ = true;
+  }
+  stashed_ = stashed_smoothed_ = false;
 }
 
 bool Pipeline::basePose(Stamp stamp, BasePose& base) {
@@ -535,7 +639,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   last_taken_clock_ = last_clock_;
   if (clock_back_ > 0) --clock_back_;
   remember(t, stamp, has_effort);
-  countHeld();
+  countHeld(t);
   if (smoothed_) sampleSmoothed(t, base);
   if (status == SampleStatus::kStale) return staleProblem();
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
@@ -571,9 +675,10 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
 void Pipeline::drainSmoother() {
   // Rare (a reset with a smoother): copies of the record are fine here.
   if (estimator_.pendingSamples() > 0)
-    while (flush()) drained_.push_back(record_);
+    while (nextRecord(estimator_, record_, true)) drained_.push_back(record_);
   if (smoothed_ && smoothed_->estimator.pendingSamples() > 0)
-    while (flushSmoothed()) smoothed_->drained.push_back(smoothed_->record);
+    while (nextRecord(smoothed_->estimator, smoothed_->record, true))
+      smoothed_->drained.push_back(smoothed_->record);
 }
 
 bool Pipeline::takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, std::size_t& next) {
@@ -587,6 +692,10 @@ bool Pipeline::takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, 
 }
 
 bool Pipeline::takeDrained() {
+  if (group_record_) {  // record_ holds the loads of an instant this call closed
+    group_record_ = false;
+    return true;
+  }
   return takeFrom(record_, drained_, drained_next_) || nextRecord(estimator_, record_, false);
 }
 
@@ -596,10 +705,20 @@ bool Pipeline::takeDrainedSmoothed() {
   return takeFrom(s.record, s.drained, s.drained_next) || nextRecord(s.estimator, s.record, false);
 }
 
-bool Pipeline::flush() { return nextRecord(estimator_, record_, true); }
+bool Pipeline::flush() {
+  if (group_.open) {  // the last instant, complete as it is
+    smoothed_published_ = group_record_ = false;
+    closeGroup();
+    stashGroupRecords();
+    stashed_ = stashed_smoothed_ = false;
+  }
+  return takeFrom(record_, drained_, drained_next_) || nextRecord(estimator_, record_, true);
+}
 
 bool Pipeline::flushSmoothed() {
-  return smoothed_ && nextRecord(smoothed_->estimator, smoothed_->record, true);
+  if (!smoothed_) return false;
+  Stream& s = *smoothed_;
+  return takeFrom(s.record, s.drained, s.drained_next) || nextRecord(s.estimator, s.record, true);
 }
 
 bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
@@ -729,23 +848,26 @@ std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
   const PlausibilityConfig& p = settings_.plausibility;
   std::uint8_t status = kTrusted;
   if (estimator.stamp() < settle_from + p.settle_time) status |= kSettling;
+  if (std::abs(estimator.stamp() - held_t_) <= p.settle_time) status |= kHeldJoint;
   for (const InputRecord& in : rec.inputs) status |= in.stale ? kStaleInput : 0;
   for (std::size_t k = 0; k < rec.plates.size(); ++k)
     if (rec.plates[k].stale && estimator.plateNeeded(static_cast<int>(k))) status |= kStaleInput;
   const Model<double>& m = model();
   for (std::size_t i = 0; i < rec.segment.size(); ++i)
-    if (std::abs(rec.effort[i]) >
-        p.effort_factor * m.effort_limit[static_cast<std::size_t>(rec.segment[i])])
+    if (implausibleEffort(m, p, static_cast<std::size_t>(rec.segment[i]), rec.effort[i]))
       status |= kImplausibleLoad;
   return status;
 }
 
-void Pipeline::countHeld() {
+void Pipeline::countHeld(double t) {
   // A needed coordinate no message since the last sample set: this sample holds it.
   bool held = false;
   for (int k = 0; k < model().nq && !held; ++k)
     held = estimator_.coordinateNeeded(k) && !joints_.fresh(k);
-  counters_.held_samples += held ? 1 : 0;
+  if (held) {
+    ++counters_.held_samples;
+    held_t_ = t;
+  }
   joints_.clearFresh();
 }
 
@@ -788,6 +910,7 @@ std::string describeStatus(std::uint8_t status) {
   add(kSettling, "settling");
   add(kStaleInput, "stale input");
   add(kImplausibleLoad, "implausible load");
+  add(kHeldJoint, "held joint");
   return words;
 }
 
@@ -814,31 +937,22 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   const std::vector<int>& coordinate = joints_.coordinates();  // bound by checkJointState
   const double dt = last_stamp_ != 0 ? 1e-9 * static_cast<double>(stamp - last_stamp_) : -1.0;
   bool too_fast = false;
-  char text[256];
   for (std::size_t i = 0; i < names.size(); ++i) {
     const int c = coordinate[i];
     if (c < 0) continue;
     const std::size_t s =
         static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(c)]);
-    const double q = position[i];
-    if (q < m.lower_limit[s] - p.position_margin || q > m.upper_limit[s] + p.position_margin) {
-      std::snprintf(text, sizeof text,
-                    ": position of joint '%s' is %.6g, beyond its URDF limits [%.6g, %.6g] by "
-                    "more than plausibility/position_margin %.3g: message dropped",
-                    names[i].c_str(), q, m.lower_limit[s], m.upper_limit[s], p.position_margin);
-      problem_ = settings_.joint_states_topic + text;
+    const std::string beyond = implausiblePosition(m, p, s, position[i]);
+    if (!beyond.empty()) {
+      problem_ = settings_.joint_states_topic + ": " + beyond + ": message dropped";
       return false;
     }
     if (dt <= 0.0 || !joints_.received(c) || too_fast) continue;
-    const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
-    const double step = std::abs(q - joints_.q()[static_cast<std::size_t>(c)]);
-    if (step <= p.velocity_factor * limit * dt + p.step_margin) continue;
+    const std::string fast =
+        implausibleStep(m, p, s, position[i] - joints_.q()[static_cast<std::size_t>(c)], dt);
+    if (fast.empty()) continue;
     too_fast = true;
-    std::snprintf(text, sizeof text,
-                  ": position of joint '%s' moved %.6g in %.6g s, beyond plausibility/"
-                  "velocity_factor %.3g times its velocity limit %.6g: message dropped",
-                  names[i].c_str(), step, dt, p.velocity_factor, limit);
-    problem_ = settings_.joint_states_topic + text;
+    problem_ = settings_.joint_states_topic + ": " + fast + ": message dropped";
   }
   if (!too_fast) {
     implausible_run_ = 0;
@@ -863,8 +977,7 @@ const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<std::
     if (coordinate[i] < 0 || !std::isfinite(velocity[i])) continue;
     const std::size_t s =
         static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(coordinate[i])]);
-    const double limit = std::isfinite(m.velocity_limit[s]) ? m.velocity_limit[s] : p.max_velocity;
-    if (std::abs(velocity[i]) <= p.velocity_factor * limit) continue;
+    if (!implausibleVelocity(m, p, s, velocity[i])) continue;
     if (!any) velocity_checked_ = velocity;  // same size after the first: no allocation
     velocity_checked_[i] = kNaN;             // counted and named as a non-finite one
     any = true;
@@ -943,7 +1056,7 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
                            const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
   constexpr InputKind kind = InputKind::kWrench;
   problem_.clear();
-  smoothed_published_ = false;
+  smoothed_published_ = group_record_ = false;
   const std::string& topic = settings_.wrenches.at(ix(k)).topic;
   if (!force.allFinite() || !torque.allFinite())
     return fail(kind, Outcome::kInvalid,
@@ -996,7 +1109,7 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
                           const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
   constexpr InputKind kind = InputKind::kPlate;
   problem_.clear();
-  smoothed_published_ = false;
+  smoothed_published_ = group_record_ = false;
   const std::string& name = settings_.estimator.plates.at(ix(k)).plate.name;
   if (!force.allFinite() || !moment.allFinite())
     return fail(kind, Outcome::kInvalid,

@@ -221,6 +221,7 @@ void readStamps(Section& s, StampSettings& v) {
   s.read("regularize", v.regularize, kStampRegularize, StampRegularize::kAuto,
          StampRegularize::kOff);
   s.read("jump_confirm", v.jump_confirm);
+  s.read("merge_window", v.merge_window);
 }
 
 void readUncertainty(Section& s, UncertaintyConfig& u) {
@@ -324,6 +325,7 @@ void readTopLevel(Section& s, Settings& n) {
   s.read("accept_nonphysical_inertia", n.accept_nonphysical_inertia);
   s.read("diagnostic_period", n.diagnostic_period);
   s.read("inline_callbacks", n.inline_callbacks);
+  s.read("exit_on_master_restart", n.exit_on_master_restart);
   s.read("decimation", n.estimator.decimation);
   s.read("gravity", n.estimator.gravity_world.data(), 3);
   s.read("precision", n.estimator.precision, kPrecisions);

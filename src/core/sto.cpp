@@ -84,6 +84,7 @@ VectorPart worldVectorPart(const std::string& name, WrenchFrame frame) {
 
 std::string stoName(const Model<double>& model, const std::string& name, WrenchFrame frame) {
   if (name == "t") return "time";
+  if (name == "status") return "status";
   const std::size_t dot = name.rfind('.');
   if (dot == std::string::npos) noStoName(name);
   const std::string head = name.substr(0, dot), suffix = name.substr(dot + 1);

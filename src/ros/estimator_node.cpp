@@ -10,6 +10,15 @@ namespace jle {
 namespace {
 
 constexpr double kThrottle = 2.0;  // [s] between repeats of one kind of message
+
+// The master's /run_id (roslaunch and roscore set it, new at every start), or empty.
+std::string masterRunId() {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  args[1] = "/run_id";
+  if (!ros::master::execute("getParam", args, result, payload, false)) return {};
+  return payload.getType() == XmlRpc::XmlRpcValue::TypeString ? std::string(payload) : "";
+}
 // [s] without a joint state: the loads have stopped (an ERROR in the diagnostics).
 constexpr double kSilence = 1.0;
 // ~joint_loads messages kept for reuse; beyond them, a message still held by a
@@ -58,6 +67,7 @@ EstimatorNode::EstimatorNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   updater_.add("joint loads", this, &EstimatorNode::diagnose);
   if (!sensor_topics_.empty() || model.floating_base)
     updater_.add("consistency", this, &EstimatorNode::diagnoseConsistency);
+  master_watch_ = std::make_unique<MasterWatch>(masterRunId());
   diagnostics_timer_ = nh_.createWallTimer(ros::WallDuration(settings_.diagnostic_period),
                                            &EstimatorNode::onDiagnosticsTimer, this);
   ROS_INFO(
@@ -373,11 +383,41 @@ void EstimatorNode::onDiagnosticsTimer(const ros::WallTimerEvent&) {
   // while it delivers a message inline (inline_callbacks), so holding ours across a
   // publication would invert the order of the two locks.
   try {
+    watchMaster();
     updater_.force_update();
   } catch (const std::exception& e) {
     ++exceptions_;
     ROS_ERROR_THROTTLE(kThrottle, "diagnostics: %s", e.what());
   }
+}
+
+void EstimatorNode::watchMaster() {
+  const bool reachable = ros::master::check();
+  const std::string& uri = ros::master::getURI();
+  switch (master_watch_->update(reachable, reachable ? masterRunId() : std::string())) {
+    case MasterWatch::Event::kNone: return;
+    case MasterWatch::Event::kLost:
+      ROS_ERROR(
+          "the ROS master %s does not answer: no new connection can be made while it is "
+          "down (those made keep working); if it is restarted, this node must be too",
+          uri.c_str());
+      return;
+    case MasterWatch::Event::kBack:
+      ROS_WARN("the ROS master %s answers again, the same one (run_id '%s'): nothing lost",
+               uri.c_str(), master_watch_->runId().c_str());
+      return;
+    case MasterWatch::Event::kRestarted: break;
+  }
+  const MasterWatch& w = *master_watch_;
+  ROS_ERROR(
+      "the ROS master %s was restarted (run_id '%s', now '%s'): it knows none of this "
+      "node's topics, so publishers started from now on never reach it and its outputs "
+      "reach no new subscriber. Restart this node (respawn=\"true\" in the launch file "
+      "and exit_on_master_restart: true do it)%s",
+      uri.c_str(), w.previousRunId().empty() ? "unknown" : w.previousRunId().c_str(),
+      w.runId().empty() ? "unknown" : w.runId().c_str(),
+      settings_.exit_on_master_restart ? ": exit_on_master_restart: shutting down" : "");
+  if (settings_.exit_on_master_restart) ros::requestShutdown();
 }
 
 void EstimatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -486,6 +526,8 @@ void EstimatorNode::diagnoseCounts(diagnostic_updater::DiagnosticStatusWrapper& 
   status.add("efforts not compared: non-finite", c.nonfinite_efforts);
   status.add("velocities not used: non-finite", c.nonfinite_velocities);
   status.add("mimic joints contradicting their leader", c.mimic_contradictions);
+  status.add("merged: joint states of one instant from several publishers",
+             c.count(Outcome::kMerged));
   status.add("samples with a joint held from an earlier message", c.held_samples);
   status.add("joints with measured velocities", pipeline_->velocitiesUsed());
   if (pipeline_->hasSmoothed()) {

@@ -500,10 +500,15 @@ void BagProcessor::printDrops() const {
   if (c.forward_jumps)
     drops += (drops.empty() ? "" : ", ") + std::to_string(c.forward_jumps) + " time jumps forward";
   if (!drops.empty()) std::fprintf(stderr, "process_bag: not used: %s\n", drops.c_str());
+  if (const long merged = c.count(jle::InputKind::kJointState, jle::Outcome::kMerged))
+    std::fprintf(stderr,
+                 "process_bag: %ld joint states merged with other publishers' of their instant "
+                 "(stamps/merge_window)\n",
+                 merged);
   if (c.held_samples)
     std::fprintf(stderr,
-                 "process_bag: %ld samples held a joint from an earlier message (joint states "
-                 "split over publishers)\n",
+                 "process_bag: %ld samples held a joint from an earlier message (a publisher of "
+                 "split joint states slower than the others, or stopped: flagged HELD_JOINT)\n",
                  c.held_samples);
 }
 

@@ -9,6 +9,7 @@
 #include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/kinematics.hpp>
 #include <joint_load_estimator/planar.hpp>
+#include <joint_load_estimator/plausibility.hpp>
 #include <joint_load_estimator/sto.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
@@ -411,6 +412,38 @@ void checkBaseQuaternion(const jle::CsvReader& reader, const jle::StateColumns& 
                             ", not 1 (within 1 %)");
 }
 
+// Plausibility at the door, the rules of jle::Pipeline (plausibility.hpp, its defaults):
+// a position beyond its joint's URDF limits by more than the margin (1e300, 100 rad), a
+// step from the previous row faster than the joint moves (a one-row glitch), a measured
+// velocity beyond what the joint does. A row of the file: refused as a defect of the CSV
+// (exit status 1, the line and column named), never smoothed into its neighbours. The
+// step is checked where rows are differentiated (`previous`: positions only); rows with
+// JOINT.qd, JOINT.qdd are states of their own.
+void checkPlausible(const jle::CsvReader& reader, const jle::Model<double>& model,
+                    const jle::StateColumns& columns, const std::vector<double>& cells,
+                    const std::vector<double>* previous) {
+  static const jle::PlausibilityConfig p;
+  static const std::string kWhy =
+      ": refused (no such joint moves so; README \"Never silently wrong\")";
+  const std::vector<int> segment = jle::coordinateSegments(model);
+  const double dt = previous ? cells[columns.t] - (*previous)[columns.t] : 0.0;
+  for (std::size_t k = 0; k < columns.q.size(); ++k) {
+    const std::size_t s = static_cast<std::size_t>(segment[k]);
+    const double q = cells[columns.q[k]];
+    const std::string beyond = jle::implausiblePosition(model, p, s, q);
+    if (!beyond.empty()) reader.failAt(columns.q[k], beyond + kWhy);
+    const std::string fast =
+        dt > 0.0 ? jle::implausibleStep(model, p, s, q - (*previous)[columns.q[k]], dt) : "";
+    if (!fast.empty()) reader.failAt(columns.q[k], fast + kWhy);
+    if (columns.qd[k] < 0 || !jle::implausibleVelocity(model, p, s, cells[columns.qd[k]])) continue;
+    reader.failAt(columns.qd[k], "velocity of joint '" + model.joint_name[s] + "' is " +
+                                     shortest(cells[columns.qd[k]]) +
+                                     ", beyond plausibility/"
+                                     "velocity_factor times its velocity limit " +
+                                     shortest(jle::velocityLimit(model, p, s)) + kWhy);
+  }
+}
+
 // The base pose of a row's cells, its quaternion normalised.
 void setBasePose(const jle::StateColumns& columns, Row& row) {
   const auto& c = columns.base_pose;
@@ -467,6 +500,7 @@ class Processor {
     Row& row = slot(n);
     reader.numbers(row.cells.data());
     row.line = reader.line();
+    checkPlausible(reader, model_, columns_, row.cells, nullptr);
     if (model_.floating_base) readBasePose(reader, columns_, row);
     if (estimate_ && n > 0 && !(row.cells[columns_.t] > slot(n - 1).cells[columns_.t]))
       reader.failAt(columns_.t, "time does not increase (the previous row's is " +
@@ -496,6 +530,18 @@ class Processor {
 
   // Emits the last row, after `n` rows in all.
   void finish(long n, Output& out) {
+    finishRows(n, out);
+    if (implausible_ > 0)
+      std::fprintf(stderr,
+                   "joint_loads: warning: %ld rows with an effort beyond plausibility/"
+                   "effort_factor %.3g times its joint's URDF effort limit (implausible loads; "
+                   "the first: %s)\n",
+                   implausible_, jle::PlausibilityConfig().effort_factor,
+                   first_implausible_.c_str());
+  }
+
+ private:
+  void finishRows(long n, Output& out) {
     if (!estimate_) return;
     if (n > 0 && n < 3)
       throw std::runtime_error(options_.input + ": " + std::to_string(n) +
@@ -504,7 +550,6 @@ class Processor {
     if (n >= 3) emit(n - 1, 2, out);
   }
 
- private:
   Row& slot(long index) { return window_[static_cast<std::size_t>(index % 3)]; }
 
   // Row `index` (its window: the rows index - m ... index - m + 2; m < 0: none) to the
@@ -526,7 +571,7 @@ class Processor {
       applyPlates(cells);
       jle::inverseDynamics(model_, data_);
     }
-    writeLoads(cells, out);
+    writeLoads(slot(index), out);
   }
 
   // --planar: the planar solver is set up if the model is planar (auto) or asserted (on),
@@ -648,7 +693,8 @@ class Processor {
   }
 
   // One output row, in the order of names().
-  void writeLoads(const std::vector<double>& cells, Output& out) {
+  void writeLoads(const Row& row, Output& out) {
+    const std::vector<double>& cells = row.cells;
     const auto put = [](const jle::Wrench<double>& w, double* o) {
       for (int i = 0; i < 3; ++i) *o++ = w.force[i];
       for (int i = 0; i < 3; ++i) *o++ = w.moment[i];
@@ -666,7 +712,27 @@ class Processor {
     o = putOutputs(o);
     for (double x : cop_) *o++ = x;
     assert(static_cast<std::size_t>(o - loads_.data()) == loads_.size());
+    checkLoads(row);
     out.row(loads_);
+  }
+
+  // Loads that are not finite are never written (a data error naming the row); efforts
+  // beyond plausibility/effort_factor times the URDF effort limit are counted, said at
+  // the end (finish()).
+  void checkLoads(const Row& row) {
+    for (double x : loads_)
+      if (!std::isfinite(x))
+        throw std::runtime_error(options_.input + ":" + std::to_string(row.line) +
+                                 ": the loads are not finite (an absurd acceleration or "
+                                 "wrench?): not written");
+    static const jle::PlausibilityConfig p;
+    for (int s : model_.moving_segments)
+      if (jle::implausibleEffort(model_, p, static_cast<std::size_t>(s), data_.effort[s])) {
+        if (implausible_++ == 0)
+          first_implausible_ =
+              "line " + std::to_string(row.line) + ", joint '" + model_.joint_name[s] + "'";
+        break;
+      }
   }
 
   const Options& options_;
@@ -684,6 +750,8 @@ class Processor {
   std::vector<int> segments_;  // every segment, for the planar passes
   std::vector<std::string> names_;
   std::vector<double> loads_, cop_;
+  long implausible_ = 0;  // rows with an implausible effort
+  std::string first_implausible_;
 };
 
 // The robot, with every --plate's link checked.
@@ -712,12 +780,13 @@ struct Record {
   std::vector<double> t;  // [s]
 };
 
-Record readRecord(jle::CsvReader& reader, const jle::StateColumns& columns,
-                  const std::string& input) {
+Record readRecord(jle::CsvReader& reader, const jle::Model<double>& model,
+                  const jle::StateColumns& columns, const std::string& input) {
   Record r;
   while (reader.next()) {
     std::vector<double> cells(static_cast<std::size_t>(reader.columns()));
     reader.numbers(cells.data());
+    checkPlausible(reader, model, columns, cells, r.cells.empty() ? nullptr : &r.cells.back());
     if (columns.base_pose[0] >= 0) checkBaseQuaternion(reader, columns, cells);
     const double t = cells[columns.t];
     if (!r.t.empty() && !(t > r.t.back()))
@@ -879,7 +948,7 @@ void runPositionsOnly(const Options& options, const jle::Model<double>& model,
                              "twist and acceleration are computed from its smoothed pose like "
                              "the joints' rates; leave out base.vx ... base.alz, or give "
                              "JOINT.qd and JOINT.qdd of every joint");
-  Record record = readRecord(reader, columns, options.input);
+  Record record = readRecord(reader, model, columns, options.input);
   const jle::CutoffChoice choice = smoothPositions(options, columns, record);
   std::fprintf(stderr,
                "joint_loads: positions only: zero-phase Butterworth, order %d per pass, "

@@ -192,6 +192,7 @@ class Outputs : public jle::LoadsSink {
   std::unique_ptr<jle::CsvWriter> csv_, smoothed_csv_;
   std::vector<double> smoothed_row_;
   std::unique_ptr<jle::StoWriter> sto_;
+  std::vector<double> sto_row_;  // the .sto row: t, the joints' loads, status
   // external_effort/enabled: the wrench topics per contact link and the contact events.
   std::vector<std::string> external_topics_;
   std::string contact_topic_;
@@ -248,8 +249,11 @@ void Outputs::open(const jle::Pipeline& pipeline) {
     csv_->writeHeader(jle::jointLoadColumns(record.joint, layout));
   }
   if (!options.sto.empty()) {
+    std::vector<std::string> sto_names = names;
+    sto_names.push_back("status");
     sto_ = std::make_unique<jle::StoWriter>(options.sto);
-    sto_->writeHeader(jle::stoLayout(pipeline.model(), names, jle::WrenchFrame::kChild));
+    sto_->writeHeader(jle::stoLayout(pipeline.model(), sto_names, jle::WrenchFrame::kChild));
+    sto_row_.assign(sto_names.size(), 0.0);
   }
   openSmoothed(pipeline);
 }
@@ -324,7 +328,12 @@ void Outputs::write(const jle::LoadsRecord& record, long seq) {
   if (csv_) row = writeStatus(record, writeExternal(record, row));
   assert(static_cast<std::size_t>(row - row_.data()) == (csv_ ? row_.size() : sto_columns_));
   if (csv_) csv_->writeRow(row_.data(), row_.size());
-  if (sto_) sto_->writeRow(row_.data(), sto_columns_);
+  if (sto_) {
+    std::copy(row_.begin(), row_.begin() + static_cast<long>(sto_row_.size()) - 1,
+              sto_row_.begin());
+    sto_row_.back() = record.status;
+    sto_->writeRow(sto_row_.data(), sto_row_.size());
+  }
   if (bag_) {
     jle::toMessage(record, loads_);
     loads_.header.seq = static_cast<std::uint32_t>(seq);

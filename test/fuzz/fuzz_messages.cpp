@@ -6,8 +6,9 @@
 // whole range a ROS stamp holds), wrench messages (frames known and unknown) and jumps
 // of the clock. Checks the documented outcome of every message against a shadow of
 // the rules (invalid sizes and values, stamp 0, stamp order, rogue stamps, confirmed
-// jumps and resets: README, "Time stamps"), that every message is
-// counted once, and the published record. Built by build_and_run.sh.
+// jumps and resets: README, "Time stamps"; joint states of several publishers merged
+// into one sample per instant, stamps/merge_window), that every message is counted once,
+// and the published records. Built by build_and_run.sh.
 #include "fuzz_check.hpp"
 
 #include <joint_load_estimator/pipeline.hpp>
@@ -169,7 +170,8 @@ void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
 // per input, the last joint state taken, rogue stamps (a gap the clock saw too is none)
 // and the jumps they confirm, the clock going back.
 struct Shadow {
-  jle::Stamp last = 0;  // 0: none since the start or a reset
+  jle::Stamp last = 0;     // 0: none since the start or a reset
+  jle::Stamp highest = 0;  // the newest sample taken on any timeline
   jle::Stamp last_clock = 0, pending_stamp = 0, taken_clock = 0;
   int pending = 0, clock_back = 0;
   bool joints_stamped = false, wrench_stamped = false;
@@ -185,7 +187,16 @@ struct Shadow {
     if (!stamped) stamp = clock;
     return !stamped;
   }
-  void reset() { last = 0, pending = 0, clock_back = 0; }
+  // The instant being assembled from partial joint states (Pipeline's Group): its
+  // stamps, the needed coordinates it has, whether its last message was counted merged.
+  bool group_open = false, group_last_merged = false;
+  jle::Stamp group_oldest = 0, group_newest = 0;
+  std::vector<bool> group_has;
+  // A reset takes an open instant first, on its own timeline, then forgets it.
+  void reset() {
+    if (group_open && group_last_merged) highest = std::max(highest, group_newest);
+    last = 0, pending = 0, clock_back = 0, group_open = false;
+  }
   void clockSeen(jle::Stamp stamp, jle::Stamp clock) {
     const bool back = last_clock != 0 && clock < last_clock;
     last_clock = clock;
@@ -216,6 +227,7 @@ struct Shadow {
   }
   void taken(jle::Stamp stamp) {
     last = stamp;
+    highest = std::max(highest, stamp);
     taken_clock = last_clock;
     if (clock_back > 0) --clock_back;
   }
@@ -226,6 +238,42 @@ struct JointMessage {
   std::vector<double> position, velocity, effort;
   bool valid = true;  // sizes agree, names are unique, positions and velocities finite
 };
+
+// The needed coordinates the message sets.
+std::vector<bool> neededIn(const jle::Pipeline& p, const JointMessage& js) {
+  std::vector<bool> has(static_cast<std::size_t>(p.model().nq), false);
+  for (const std::string& name : js.names)
+    for (int k = 0; k < p.model().nq; ++k)
+      if (name == p.model().coordinate_names[static_cast<std::size_t>(k)] && p.coordinateNeeded(k))
+        has[static_cast<std::size_t>(k)] = true;
+  return has;
+}
+
+// Whether the message joins the open instant: within the merge window, and no needed
+// coordinate twice.
+bool joins(const Shadow& shadow, const std::vector<bool>& has, jle::Stamp stamp, double window) {
+  if (!shadow.group_open) return false;
+  const jle::Stamp span =
+      std::max(shadow.group_newest, stamp) - std::min(shadow.group_oldest, stamp);
+  if (1e-9 * static_cast<double>(span) > window) return false;
+  for (std::size_t k = 0; k < has.size(); ++k)
+    if (has[k] && shadow.group_has[k]) return false;
+  return true;
+}
+
+// The records an instant closed by this message made, the message's own, and a
+// smoother's drained at a reset (of the old timeline): finite, and of a sample taken.
+void checkRecords(jle::Pipeline& p, const Shadow& shadow, jle::Outcome outcome) {
+  const auto check = [&](const jle::LoadsRecord& r) {
+    JLE_FUZZ_CHECK(r.stamp <= shadow.highest);
+    JLE_FUZZ_CHECK(r.effort.size() == r.joint.size());
+    for (std::size_t i = 0; i < r.effort.size(); ++i)  // never a non-finite load
+      JLE_FUZZ_CHECK(std::isfinite(r.effort[i]) && r.force[i].allFinite() &&
+                     r.moment[i].allFinite());
+  };
+  if (outcome == jle::Outcome::kPublished) check(p.record());
+  while (p.takeDrained()) check(p.record());
+}
 
 // Whether the message sets a coordinate the loads need (else kNoJoint: no sample, no time).
 bool moves(const jle::Pipeline& p, const JointMessage& js) {
@@ -259,8 +307,8 @@ void decodeJointState(Bytes& in, JointMessage& js) {
     for (std::size_t j = 0; j < i; ++j) js.valid = js.valid && js.names[i] != js.names[j];
 }
 
-void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stamp stamp,
-                       jle::Stamp clock, jle::Outcome outcome, Shadow& shadow) {
+void checkJointOutcome(jle::Pipeline& p, const JointMessage& js, jle::Stamp stamp, jle::Stamp clock,
+                       jle::Outcome outcome, Shadow& shadow) {
   using jle::Outcome;
   if (!js.valid) {
     JLE_FUZZ_CHECK(outcome == Outcome::kInvalid && !p.problem().empty());
@@ -285,29 +333,51 @@ void checkJointOutcome(const jle::Pipeline& p, const JointMessage& js, jle::Stam
     shadow.reset();
   }
   JLE_FUZZ_CHECK(outcome != Outcome::kInvalid && outcome != Outcome::kFrame);
-  if (outcome == Outcome::kWaiting) return;
-  if (outcome == Outcome::kOrder) {
-    JLE_FUZZ_CHECK(shadow.last != 0 && stamp <= shadow.last);
-    return;
-  }
+  // The order before anything is stored: of an instant taken, or older than the open one.
+  const std::vector<bool> has = neededIn(p, js);
+  const bool joining = joins(shadow, has, stamp, p.settings().stamps.merge_window);
+  const jle::Stamp newest =
+      std::max(shadow.last, shadow.group_open && !joining ? shadow.group_newest : 0);
+  JLE_FUZZ_CHECK((outcome == Outcome::kOrder) == (newest != 0 && stamp <= newest));
+  if (outcome == Outcome::kOrder) return;
   // A value no UR5 produces (beyond its limits, faster than it moves): dropped after the
   // stamp checks, not taken, named.
   if (outcome == Outcome::kImplausible) {
     JLE_FUZZ_CHECK(!p.problem().empty());
     return;
   }
-  JLE_FUZZ_CHECK(shadow.last == 0 || stamp > shadow.last);
-  shadow.taken(stamp);
-  if (outcome == Outcome::kPublished) {
-    JLE_FUZZ_CHECK(p.record().stamp <= stamp);
-    JLE_FUZZ_CHECK(p.record().effort.size() == p.record().joint.size());
-    for (std::size_t i = 0; i < p.record().effort.size(); ++i)  // never a non-finite load
-      JLE_FUZZ_CHECK(std::isfinite(p.record().effort[i]) && p.record().force[i].allFinite() &&
-                     p.record().moment[i].allFinite());
+  // A later instant closes the open one: taken (its missing joints held) unless its last
+  // message was waiting for a joint never received.
+  if (shadow.group_open && !joining) {
+    if (shadow.group_last_merged) shadow.taken(shadow.group_newest);
+    shadow.group_open = false;
   }
+  if (!shadow.group_open) {
+    shadow.group_has.assign(has.size(), false);
+    shadow.group_oldest = shadow.group_newest = stamp;
+  }
+  shadow.group_open = true;
+  shadow.group_oldest = std::min(shadow.group_oldest, stamp);
+  shadow.group_newest = std::max(shadow.group_newest, stamp);
+  bool complete = true;
+  for (std::size_t k = 0; k < has.size(); ++k) {
+    shadow.group_has[k] = shadow.group_has[k] || has[k];
+    complete = complete && (shadow.group_has[k] || !p.coordinateNeeded(static_cast<int>(k)));
+  }
+  shadow.group_last_merged = outcome == Outcome::kMerged;
+  if (outcome == Outcome::kWaiting || outcome == Outcome::kMerged) {
+    JLE_FUZZ_CHECK(outcome == Outcome::kWaiting || !complete);
+    checkRecords(p, shadow, outcome);
+    return;
+  }
+  JLE_FUZZ_CHECK(complete);
+  JLE_FUZZ_CHECK(shadow.last == 0 || shadow.group_newest > shadow.last);
+  shadow.taken(shadow.group_newest);
+  shadow.group_open = false;
+  checkRecords(p, shadow, outcome);
   // The smoothed stream describes a sample taken on this timeline, at or before this one.
   if (p.smoothedPublished()) {
-    JLE_FUZZ_CHECK(p.smoothedRecord().stamp <= stamp);
+    JLE_FUZZ_CHECK(p.smoothedRecord().stamp <= shadow.last);
     JLE_FUZZ_CHECK(p.smoothedRecord().effort.size() == p.smoothedRecord().joint.size());
   }
 }
@@ -366,6 +436,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const std::string frame = kind % 8 == 7 ? "tool0" : (kind & 8) ? "base_link" : "nowhere";
       const jle::Outcome outcome = p.onWrench(0, stamp, clock, frame, f, mo);
       checkWrenchOutcome(p, f, mo, frame, stamp, clock, outcome, shadow);
+      checkRecords(p, shadow, outcome);  // a reset's drained loads
       continue;
     }
     decodeJointState(in, js);

@@ -60,6 +60,16 @@ def random_states(model, n, seed):
             rng.uniform(-20.0, 20.0, (n, model.nq)))
 
 
+def plausible_states(model, n, seed):
+    """Random states that joint_loads takes (README "Never silently wrong": a position
+    beyond the URDF limits by more than 1 rad, or a velocity beyond 3 times the limit, is
+    refused): within [-0.9, 0.9] rad (every Panda and body joint's limits widened by the
+    margin hold it) and [-0.5, 0.5] rad/s (the Panda's fingers: 3 x 0.2 m/s)."""
+    rng = np.random.default_rng(seed)
+    return (rng.uniform(-0.9, 0.9, (n, model.nq)), rng.uniform(-0.5, 0.5, (n, model.nq)),
+            rng.uniform(-20.0, 20.0, (n, model.nq)))
+
+
 # --- the package layout ------------------------------------------------------------
 def test_package_exposes_the_core_beside_the_messages():
     assert jle.Model and jle.inverse_dynamics and jle.Estimator and jle.process_bag
@@ -182,7 +192,7 @@ def compare_with_columns(loads, columns):
 def test_inverse_dynamics_is_joint_loads(tmp_path, frame):
     model = jle.Model(PANDA)
     n = 300
-    q, qd, qdd = random_states(model, n, 2)
+    q, qd, qdd = plausible_states(model, n, 2)
     wrench = np.random.default_rng(3).uniform(-30.0, 30.0, (n, 6))
     t = 0.001 * np.arange(n)
     rows = np.column_stack([t] + [np.stack([q[:, k], qd[:, k], qdd[:, k]], 1)
@@ -197,7 +207,7 @@ def test_inverse_dynamics_is_joint_loads(tmp_path, frame):
 def test_floating_base_is_joint_loads(tmp_path):
     model = jle.Model(BODY, floating_base=True)
     n = 100
-    q, qd, qdd = random_states(model, n, 4)
+    q, qd, qdd = plausible_states(model, n, 4)
     rng = np.random.default_rng(5)
     quaternion = rng.normal(size=(n, 4))
     quaternion /= np.linalg.norm(quaternion, axis=1)[:, None]

@@ -153,6 +153,25 @@ const std::vector<Kind>& kinds() {
          gripper.position = {0.02};
          send.joint(gripper);
        }},
+      // Joint states split over two publishers (README "Never silently wrong"): the arm's
+      // first three joints 0.3 ms before the other three, the same positions as the clean
+      // sample: merged into one sample, stamped with the newer stamp, the clean loads.
+      {"SplitPublishers", "the sample split over two publishers, 0.3 ms apart",
+       "merged: joint states of one instant from several publishers",
+       [](sensor_msgs::JointState& js, const HostileSend& send) {
+         sensor_msgs::JointState first = js;
+         first.header.stamp = js.header.stamp - ros::Duration(0.0003);
+         const auto keep = [](auto& v, std::size_t from, std::size_t to) {
+           if (v.empty()) return;
+           v.assign(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(to));
+         };
+         const std::size_t n = js.name.size();
+         for (auto* v : {&first.position, &first.velocity, &first.effort}) keep(*v, 0, 3);
+         keep(first.name, 0, 3);
+         for (auto* v : {&js.position, &js.velocity, &js.effort}) keep(*v, 3, n);
+         keep(js.name, 3, n);
+         send.joint(first);
+       }},
       {"NanEffort", "a NaN effort", "efforts not compared: non-finite",
        [](sensor_msgs::JointState& js, const HostileSend&) {
          js.effort[2] = std::numeric_limits<double>::quiet_NaN();
@@ -313,6 +332,8 @@ void hostileStream(const std::vector<const Kind*>& cycle, const ros::Time& start
                                          "dropped: implausible",
                                          "not published: non-finite loads",
                                          "time jumps back",
+                                         "merged: joint states of one instant from several "
+                                         "publishers",
                                          "input '/hostile/joint_states': lost (header.seq gaps)"};
   for (const std::string& key : keys)
     before[key] = std::max(0L, diag.latest(hostile.status(), key));

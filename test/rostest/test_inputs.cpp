@@ -36,9 +36,10 @@ VectorXd ur5Pose() {
 
 // ---------------------------------------------------------------------------------
 
-// Arm joints and finger joints from two publishers, at interleaved stamps: nothing is
-// published until every coordinate has been heard of (the node says which one it still
-// misses), then every message is a sample.
+// Arm joints and finger joints from two publishers, the fingers 0.5 ms after the arm:
+// nothing is published until every coordinate has been heard of (the node says which one
+// it still misses), then each pair is one sample (stamps/merge_window), stamped with the
+// fingers' stamp: no loads at the arm's stamps.
 TEST(Inputs, LoadsWaitForEveryJointFromSeveralPublishers) {
   NodeUnderTest node("multi");
   LogRecorder& log = logs();
@@ -72,12 +73,13 @@ TEST(Inputs, LoadsWaitForEveryJointFromSeveralPublishers) {
                     {"no position received yet", "'panda_finger_joint1'"}, k < 4 ? 0.2 : kTimeout);
   }
   EXPECT_TRUE(named) << "the node did not name the joint it misses";
-  // The fingers at 4.5 ms: the first complete sample; with the arm at 5 ms and the fingers
-  // at 5.5 ms, the 3-point filter publishes at 5.5 ms.
-  const ros::Time first = at(start, 4) + ros::Duration(0, 500000);
-  sendFingers(first);
+  // The fingers at 4.5 ms complete the instant of the last arm message: the first sample;
+  // the pairs at 5 and 6 ms the next two, and the 3-point filter publishes at 6.5 ms.
+  sendFingers(at(start, 4) + ros::Duration(0, 500000));
   sendArm(at(start, 5));
-  const ros::Time first_published = at(start, 5) + ros::Duration(0, 500000);
+  sendFingers(at(start, 5) + ros::Duration(0, 500000));
+  sendArm(at(start, 6));
+  const ros::Time first_published = at(start, 6) + ros::Duration(0, 500000);
   sendFingers(first_published);
   auto msg = node.loads().waitForStamp(first_published);
   ASSERT_TRUE(msg) << "no loads once every joint was received";
@@ -87,16 +89,19 @@ TEST(Inputs, LoadsWaitForEveryJointFromSeveralPublishers) {
   ref.compute(q, VectorXd::Zero(8), VectorXd::Zero(8));
   EXPECT_LT(ref.relativeError(*msg), kRel);
   EXPECT_EQ(msg->name.size(), 9u);  // the mimic joint's loads too
-  // From then on each message of either publisher is a sample.
-  for (int k = 6; k < 10; ++k) {
+  EXPECT_EQ(msg->status & joint_load_estimator::JointLoads::HELD_JOINT, 0);
+  // From then on each pair is a sample: its loads at the fingers' stamp, none at the arm's.
+  for (int k = 7; k < 10; ++k) {
     sendArm(at(start, k));
-    ASSERT_TRUE(node.loads().waitForStamp(at(start, k)));
     const ros::Time t = at(start, k) + ros::Duration(0, 500000);
     sendFingers(t);
     msg = node.loads().waitForStamp(t);
     ASSERT_TRUE(msg);
     EXPECT_LT(ref.relativeError(*msg), kRel);
   }
+  EXPECT_EQ(node.loads().size(), 4u);
+  for (const auto& m : node.loads().msgs())
+    EXPECT_EQ(m->header.stamp.nsec % 1000000, 500000u) << m->header.stamp;
 }
 
 // ---------------------------------------------------------------------------------

@@ -3,7 +3,9 @@
 // input), as fast as it runs, with bad messages mixed in every 50 samples: NaN
 // positions, a position array of the wrong length, a duplicate stamp, a backward stamp,
 // an unknown joint name, a NaN wrench, a backward wrench, and what no arm produces (a
-// position of 1e300 rad, one joint 3 rad off for one message, a wrench of 1e300 N).
+// position of 1e300 rad, one joint 3 rad off for one message, a wrench of 1e300 N); and
+// every 50 samples one good sample split over two publishers (joints 0-3 stamped 0.2 ms
+// before joints 4-6), to be merged into one sample.
 // Checks that
 //  - memory stays flat: VmRSS at 100% of the samples exceeds VmRSS at 10% by < 1 MB;
 //  - no good sample is lost: every good sample after the filter's warm-up is published
@@ -95,6 +97,10 @@ int main(int argc, char** argv) {
   long injected[kKinds] = {};
   long good = 0, published = 0, warming = 0, late_warming = 0, other = 0;
   long nonfinite = 0, untrusted = 0;  // published loads: not finite; flagged after 1 s
+  long split = 0, split_wrong = 0;    // samples split over two publishers; not merged
+  const std::vector<std::string> names_a(model.coordinate_names.begin(),
+                                         model.coordinate_names.begin() + 4),
+      names_b(model.coordinate_names.begin() + 4, model.coordinate_names.end());
   long rss_10 = -1;
   // The clock (the node's ros::Time::now()) goes on at the pace of the good samples; a
   // bad message's stamp is its own.
@@ -123,6 +129,12 @@ int main(int argc, char** argv) {
         position_unknown[static_cast<std::size_t>(k)] = position[static_cast<std::size_t>(k)];
       position_unknown.back() = 1.0;
       s = message(stamp, names_unknown, position_unknown);
+    } else if (i % 50 == 40 && i > 1000) {  // split: the first half waits for the second
+      ++split;
+      const Outcome first =
+          message(stamp - dt / 5, names_a, {position.begin(), position.begin() + 4});
+      s = message(stamp, names_b, {position.begin() + 4, position.end()});
+      split_wrong += first != Outcome::kMerged || s != Outcome::kPublished;
     } else {
       s = message(stamp, names, position);
     }
@@ -231,7 +243,13 @@ int main(int argc, char** argv) {
               untrusted);
   expect(nonfinite == 0, "a published load is not finite");
   expect(untrusted == 0, "a load after the filters settled is flagged untrusted");
-  expect(c.received(InputKind::kJointState) == good + injected[kNan] + injected[kLength] +
+  std::printf("split over two publishers: %ld samples, merged %ld, not merged %ld, held %ld\n",
+              split, c.count(InputKind::kJointState, Outcome::kMerged), split_wrong,
+              c.held_samples);
+  expect(split > 0 && split_wrong == 0 &&
+             c.count(InputKind::kJointState, Outcome::kMerged) == split && c.held_samples == 0,
+         "a sample split over two publishers was not merged into one");
+  expect(c.received(InputKind::kJointState) == split + good + injected[kNan] + injected[kLength] +
                                                    injected[kDuplicate] + injected[kBackward] +
                                                    injected[kAbsurd] + injected[kGlitch],
          "a joint state was not counted");

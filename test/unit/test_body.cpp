@@ -589,7 +589,10 @@ TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int r = 1; r < 6; ++r) {
     std::vector<double> row{0.01 * r};
-    for (std::size_t k = 0; k < 3 * kSagittalJoints.size(); ++k) row.push_back(2.0 * u(gen));
+    // q within every joint's URDF limits widened by 1 rad (joint_loads refuses what no
+    // joint reaches: README "Never silently wrong"), q-dot and q-ddot within 2.
+    for (std::size_t k = 0; k < 3 * kSagittalJoints.size(); ++k)
+      row.push_back((k % 3 == 0 ? 0.9 : 2.0) * u(gen));
     // A ground reaction in the plane: force (x, z), moment about y.
     for (double c : {100.0 * u(gen), 0.0, 700.0 + 50.0 * u(gen), 0.0, 10.0 * u(gen), 0.0})
       row.push_back(c);

@@ -372,6 +372,17 @@ TEST_F(CliTest, PositionsOnlyKinematicsReproduceTheirLoads) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(readFile(again), readFile(outPath()));
   EXPECT_EQ(parseTable(readFile(outPath())).rows.size(), table.rows.size());
+  // A position no joint reaches is refused before the smoothing spreads it to its
+  // neighbours (every row NaN, before).
+  Table absurd = positions;
+  absurd.rows[20][static_cast<std::size_t>(absurd.column("panda_joint2.q"))] = "1e300";
+  writeFile(path("absurd.csv"), formatTable(absurd));
+  r = jointLoads({"--urdf", kPandaChain, "--input", path("absurd.csv")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(path("absurd.csv") + ":22: column 'panda_joint2.q': position of joint "
+                                            "'panda_joint2' is 1e+300, beyond its URDF limits"),
+            std::string::npos)
+      << r.err;
 
   r = jointLoads({"--urdf", kPandaChain, "--input", full, "--cutoff", "8"});
   EXPECT_EQ(r.status, 1);
@@ -516,6 +527,59 @@ TEST_F(CliBadInputTest, BadCellsNameFileLineAndColumn) {
                 {"inf", 1, {file + ":7: column 't': '-inf' is not a finite number"}});
   expectRefused(withCell(5, "panda_joint1.qdd", "1e400"),
                 {"overflow", 1, {file + ":7: column 'panda_joint1.qdd': '1e400' is not a finite"}});
+}
+
+// Plausibility at the door (README "Never silently wrong"), the rules of the node and
+// process_bag: a position no joint reaches (1e300), a velocity of 1e6 rad/s, and in a
+// CSV of positions only (differentiated across rows) a one-row glitch of 1 rad (the
+// Panda's joint 3 moves 2.175 rad/s: 0.11 rad in a 1 ms row with the margin): the file
+// refused, the line, column, joint and value named.
+TEST_F(CliBadInputTest, ImplausiblePositionsAndVelocitiesAreRefused) {
+  const std::string file = path("bad.csv");
+  expectRefused(withCell(4, "panda_joint3.q", "1e300"),
+                {"absurd",
+                 1,
+                 {file + ":6: column 'panda_joint3.q': position of joint 'panda_joint3' is "
+                         "1e+300, beyond its URDF limits [-2.8973, 2.8973] by more than "
+                         "plausibility/position_margin 1"}});
+  Table positions;  // good_ without JOINT.qd, JOINT.qdd
+  std::vector<std::size_t> kept;
+  for (std::size_t c = 0; c < good_.header.size(); ++c) {
+    const std::string& name = good_.header[c];
+    if (name.find(".qd") != std::string::npos) continue;  // .qd and .qdd
+    kept.push_back(c);
+    positions.header.push_back(name);
+  }
+  for (const std::vector<std::string>& row : good_.rows) {
+    positions.rows.emplace_back();
+    for (std::size_t c : kept) positions.rows.back().push_back(row[c]);
+  }
+  std::string& q3 = positions.rows[4][static_cast<std::size_t>(positions.column("panda_joint3.q"))];
+  q3 = std::to_string(std::stod(q3) + 1.0);
+  expectRefused(positions, {"glitch",
+                            1,
+                            {file + ":6: column 'panda_joint3.q': position of joint "
+                                    "'panda_joint3' moved ",
+                             " in 0.001 s, beyond plausibility/velocity_factor 3 times its "
+                             "velocity limit 2.175"}});
+  expectRefused(withCell(4, "panda_joint3.qd", "1e6"),
+                {"velocity",
+                 1,
+                 {file + ":6: column 'panda_joint3.qd': velocity of joint 'panda_joint3' is "
+                         "1000000, beyond"}});
+}
+
+// An effort beyond plausibility/effort_factor times the URDF effort limit (a 1e5 N
+// wrench on the hand): the loads written, and counted in a warning naming the first.
+TEST_F(CliBadInputTest, ImplausibleEffortsAreCountedAndWarned) {
+  writeFile(path("heavy.csv"), formatTable(withCell(2, "wrench@panda_hand.fz", "100000")));
+  const Result r = jointLoads({"--urdf", kPandaChain, "--input", path("heavy.csv")});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("joint_loads: warning: 1 rows with an effort beyond plausibility/"
+                       "effort_factor 3 times its joint's URDF effort limit (implausible loads; "
+                       "the first: line 4, joint 'panda_joint"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST_F(CliBadInputTest, RowsOfTheWrongLengthNameFileLineAndColumn) {

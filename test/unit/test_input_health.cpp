@@ -1,6 +1,8 @@
 // InputHealth (ros/input_health.hpp): the per-input counts behind the node's
-// diagnostics, against counts written out by hand.
+// diagnostics, against counts written out by hand; MasterWatch (ros/master_watch.hpp): a
+// lost, returned or restarted ROS master, from the polls the node makes.
 #include <joint_load_estimator/ros/input_health.hpp>
+#include <joint_load_estimator/ros/master_watch.hpp>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +55,42 @@ TEST(InputHealth, PeriodsCountTheirOwnMessages) {
   for (Outcome o : {Outcome::kInvalid, Outcome::kOrder, Outcome::kFrame, Outcome::kNoBasePose,
                     Outcome::kNoJoint})
     EXPECT_TRUE(InputHealth::dropped(o));
+}
+
+// The node polls ros::master::check() and /run_id: a master that stops answering is
+// said once; the same one back (its run_id) loses nothing; another one (a restarted
+// roscore: a new run_id, even between two polls, or none to compare) is a restart, said
+// once.
+TEST(MasterWatch, LostBackAndRestarted) {
+  using Event = jle::MasterWatch::Event;
+  jle::MasterWatch w("run-1");
+  EXPECT_EQ(w.update(true, "run-1"), Event::kNone);
+  EXPECT_EQ(w.update(false, ""), Event::kLost);
+  EXPECT_EQ(w.update(false, ""), Event::kNone);
+  EXPECT_EQ(w.update(true, "run-1"), Event::kBack);
+  EXPECT_EQ(w.update(true, "run-1"), Event::kNone);
+  // Restarted between two polls: a new run_id.
+  EXPECT_EQ(w.update(true, "run-2"), Event::kRestarted);
+  EXPECT_EQ(w.previousRunId(), "run-1");
+  EXPECT_EQ(w.runId(), "run-2");
+  EXPECT_EQ(w.update(true, "run-2"), Event::kNone);
+  // Down, then up with another run_id, which roscore sets a moment after its master
+  // answers: the polls without it decide nothing yet.
+  EXPECT_EQ(w.update(false, ""), Event::kLost);
+  EXPECT_EQ(w.update(true, ""), Event::kNone);
+  EXPECT_EQ(w.update(true, "run-3"), Event::kRestarted);
+  EXPECT_EQ(w.previousRunId(), "run-2");
+  // Back without any run_id for 3 polls: taken for a restart (unknown run_id).
+  EXPECT_EQ(w.update(false, ""), Event::kLost);
+  EXPECT_EQ(w.update(true, ""), Event::kNone);
+  EXPECT_EQ(w.update(true, ""), Event::kNone);
+  EXPECT_EQ(w.update(true, ""), Event::kRestarted);
+  EXPECT_EQ(w.runId(), "");
+  // A master without /run_id (rosmaster alone): back after a loss is taken for a restart.
+  jle::MasterWatch bare("");
+  EXPECT_EQ(bare.update(true, ""), Event::kNone);
+  EXPECT_EQ(bare.update(false, ""), Event::kLost);
+  EXPECT_EQ(bare.update(true, ""), Event::kRestarted);
 }
 
 }  // namespace

@@ -442,8 +442,8 @@ void expectStoMatchesCsv(const Sto& sto, const Table& csv, const std::vector<Sto
   EXPECT_EQ(sto.header_lines[0], "Inverse Dynamics Generalized Forces");
   EXPECT_EQ(sto.header_lines[1], "version=1");
   EXPECT_EQ(sto.header_lines[2], "nRows=" + std::to_string(csv.rows.size()));
-  // process_bag's CSV has a status column last, which the .sto has not.
-  const std::size_t columns = csv.header.size() - (csv.column("status") >= 0 ? 1 : 0);
+  // process_bag's CSV has a status column last, and so has its .sto.
+  const std::size_t columns = csv.header.size();
   EXPECT_EQ(sto.header_lines[3], "nColumns=" + std::to_string(columns));
   EXPECT_EQ(sto.header_lines[4], "inDegrees=no");
   ASSERT_EQ(sto.table.header.size(), columns);
@@ -552,7 +552,13 @@ TEST_F(OfflineFormatsTest, ProcessBagWritesOpenSimStorage) {
                       {{"t", "time"},
                        {"panda_joint2.effort", "panda_joint2_moment"},
                        {"panda_joint4.mx", "panda_joint4_on_panda_link4_in_panda_link4_mx"},
-                       {"panda_joint7.fz", "panda_joint7_on_panda_link7_in_panda_link7_fz"}});
+                       {"panda_joint7.fz", "panda_joint7_on_panda_link7_in_panda_link7_fz"},
+                       {"status", "status"}});
+  // The status column (LoadsStatus bits): the first loads settling (1), the last trusted.
+  const Table sto = parseSto(readFile(path("o.sto"))).table;
+  EXPECT_EQ(sto.header.back(), "status");
+  EXPECT_EQ(sto.number(0, "status"), 1.0);
+  EXPECT_EQ(sto.number(sto.rows.size() - 1, "status"), 0.0);
   // Only a .sto.
   r = run(JLE_PROCESS_BAG,
           {"--bag", path("in.bag"), "--urdf", kPandaDemo, "--sto", path("only.sto")});

@@ -89,24 +89,8 @@ TEST(Pipeline, PartialMessagesGiveTheExactLoads) {
   const Eigen::Vector3d f(3.0, -1.0, 4.0), m(0.2, 0.1, -0.3);  // constant: resampling exact
   jle::Data<double> reference(model);
   int published = 0;
-  for (int k = 0; k < 100; ++k) {
-    // Both publishers stamp the same instant (one driver cycle), jittered by 20%.
-    const Stamp stamp = kStart + k * kMs + static_cast<Stamp>(2e5 * std::sin(k));
-    const double t = static_cast<double>(stamp - kStart) * 1e-9;
-    std::vector<double> pa, pw;
-    for (int i = 0; i < 3; ++i) pa.push_back(q(i, t));
-    for (int i = 3; i < 6; ++i) pw.push_back(q(i, t));
-    ASSERT_EQ(pipeline.onWrench(0, stamp, stamp, "tool0", f, m), Outcome::kUsed);
-    // The wrist's driver speaks once, first: the arm's joints are still missing. Then
-    // the arm's messages alone make the samples, the wrist held.
-    if (k == 0) {
-      EXPECT_EQ(pipeline.onJointState(stamp, stamp, wrist, pw, kNone, kNone), Outcome::kWaiting);
-      EXPECT_NE(pipeline.problem().find("'" + arm[0] + "'"), std::string::npos)
-          << pipeline.problem();
-    }
-    if (pipeline.onJointState(stamp, stamp, arm, pa, kNone, kNone) != Outcome::kPublished) continue;
+  const auto check = [&](const jle::LoadsRecord& r) {
     ++published;
-    const jle::LoadsRecord& r = pipeline.record();
     Eigen::VectorXd qv(6), qdv(6), qddv(6);
     // The 3-point estimate describes the middle sample: the record's stamp is its own.
     const double tr = static_cast<double>(r.stamp - kStart) * 1e-9;
@@ -127,7 +111,29 @@ TEST(Pipeline, PartialMessagesGiveTheExactLoads) {
       EXPECT_LT((r.moment[i] - reference.moment[s]).norm(), 1e-9 * scale);
       EXPECT_NEAR(r.effort[i], reference.effort[s], 1e-9 * scale);
     }
+    EXPECT_TRUE(r.status & jle::kHeldJoint) << r.stamp;  // the wrist's joints held
+  };
+  for (int k = 0; k < 100; ++k) {
+    // Both publishers stamp the same instant (one driver cycle), jittered by 20%.
+    const Stamp stamp = kStart + k * kMs + static_cast<Stamp>(2e5 * std::sin(k));
+    const double t = static_cast<double>(stamp - kStart) * 1e-9;
+    std::vector<double> pa, pw;
+    for (int i = 0; i < 3; ++i) pa.push_back(q(i, t));
+    for (int i = 3; i < 6; ++i) pw.push_back(q(i, t));
+    ASSERT_EQ(pipeline.onWrench(0, stamp, stamp, "tool0", f, m), Outcome::kUsed);
+    // The wrist's driver speaks once, first: the arm's joints are still missing. Then
+    // it is dead: each arm message's instant waits for it until the next one closes it,
+    // and is a sample with the wrist held (its loads come by takeDrained()).
+    if (k == 0) {
+      EXPECT_EQ(pipeline.onJointState(stamp, stamp, wrist, pw, kNone, kNone), Outcome::kWaiting);
+      EXPECT_NE(pipeline.problem().find("'" + arm[0] + "'"), std::string::npos)
+          << pipeline.problem();
+    }
+    if (pipeline.onJointState(stamp, stamp, arm, pa, kNone, kNone) == Outcome::kPublished)
+      check(pipeline.record());
+    while (pipeline.takeDrained()) check(pipeline.record());
   }
+  while (pipeline.flush()) check(pipeline.record());
   EXPECT_EQ(published, 98);  // every stamp but the window's start
   const jle::PipelineCounters& c = pipeline.counters();
   EXPECT_EQ(c.received(InputKind::kJointState), 101);

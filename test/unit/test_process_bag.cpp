@@ -876,6 +876,49 @@ TEST_F(ProcessBagTest, MeasuredVelocitiesAreUsedAndNaNOnesDropNothingElse) {
   std::printf("largest change of a load by the measured velocities: %.3g\n", moved);
 }
 
+// Every joint state of the clean bag split over two publishers (names 0-3, the unknown
+// joint among them, and 4-8, at the same stamp): merged into one sample per instant, the
+// CSV is the clean one's, row for row; the summary counts the merged messages, none held
+// (before, half of them were dropped as `stamp order` and their positions used late).
+TEST_F(ProcessBagTest, SplitPublishersGiveTheLoadsOfOnePublisher) {
+  const Messages m = makeMessages();
+  writeBag(path("clean.bag"), m);
+  Messages split = m;
+  split.joints.clear();
+  for (const auto& [stamp, js] : m.joints) {
+    sensor_msgs::JointState a = js, b = js;
+    const auto part = [](auto& v, std::size_t from, std::size_t to) {
+      v.assign(v.begin() + static_cast<long>(from), v.begin() + static_cast<long>(to));
+    };
+    const std::size_t n = js.name.size();
+    part(a.name, 0, 4), part(a.position, 0, 4), part(a.effort, 0, 4);
+    part(b.name, 4, n), part(b.position, 4, n), part(b.effort, 4, n);
+    split.joints.emplace_back(stamp, a);
+    split.joints.emplace_back(stamp, b);
+  }
+  writeBag(path("split.bag"), split);
+  writeFile(path("config.yaml"), kConfig);
+  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) +
+                           " --config " + quote(path("config.yaml"));
+  const Result clean =
+      run(tool + " --bag " + quote(path("clean.bag")) + " --csv " + quote(path("clean.csv")));
+  ASSERT_EQ(clean.status, 0) << clean.output;
+  const Result r =
+      run(tool + " --bag " + quote(path("split.bag")) + " --csv " + quote(path("split.csv")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  // The first message waits for the other half, never received yet; 299 merged.
+  EXPECT_NE(r.output.find("process_bag: 299 joint states merged with other publishers'"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("1 waiting for a joint"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("held a joint"), std::string::npos) << r.output;
+  const Table a = readCsv(path("clean.csv")), b = readCsv(path("split.csv"));
+  EXPECT_EQ(b.header, a.header);
+  ASSERT_EQ(b.rows.size(), a.rows.size());
+  ASSERT_GT(a.rows.size(), 100u);
+  for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(b.rows[i], a.rows[i]) << "row " << i;
+}
+
 TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
   const Messages m = makeMessages();
   writeBag(path("in.bag"), m);

@@ -195,6 +195,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(time_jump_threshold);
   EXPECT_SAME(stamps.regularize);
   EXPECT_SAME(stamps.jump_confirm);
+  EXPECT_SAME(stamps.merge_window);
   EXPECT_SAME(keep_fixed_joints);
   EXPECT_SAME(accept_nonphysical_inertia);
   EXPECT_SAME(base_residual_threshold);
@@ -202,6 +203,7 @@ void expectSame(const Settings& a, const Settings& b) {
   EXPECT_SAME(bias_file);
   EXPECT_SAME(diagnostic_period);
   EXPECT_SAME(inline_callbacks);
+  EXPECT_SAME(exit_on_master_restart);
   EXPECT_SAME(body_mass);
   expectSame(a.estimator, b.estimator);
   EXPECT_SAME(smoothed.enabled);
@@ -265,6 +267,7 @@ TEST(SettingsReader, TopLevelKeys) {
   e.bias_file = "/tmp/ft_bias.yaml";
   e.diagnostic_period = 0.25;
   e.inline_callbacks = true;
+  e.exit_on_master_restart = true;
   e.body_mass = -1.0;
   expectSame(parseFile(kConfig + "/ok_top_level.yaml"), e);
 }
@@ -403,6 +406,7 @@ TEST(SettingsReader, StampsKeys) {
   Settings e;
   e.stamps.regularize = jle::StampRegularize::kAuto;
   e.stamps.jump_confirm = 5;
+  e.stamps.merge_window = 0.002;
   expectSame(parseFile(kConfig + "/ok_stamps.yaml"), e);
   // rosparam reads YAML 1.1, where a bare off is a boolean.
   XmlRpc::XmlRpcValue params;

@@ -11,6 +11,7 @@
 #include <joint_load_estimator/ros/external_outputs.hpp>
 #include <joint_load_estimator/ros/inline_callback_queue.hpp>
 #include <joint_load_estimator/ros/input_health.hpp>
+#include <joint_load_estimator/ros/master_watch.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
 
@@ -104,6 +105,9 @@ class EstimatorNode {
   // /diagnostics on a wall-clock timer (diagnostic_period): it keeps its rate whatever
   // the inputs and the (sim) clock do.
   void onDiagnosticsTimer(const ros::WallTimerEvent& event);
+  // The master this node registered with, polled on the diagnostics timer: one that
+  // stops answering, or is replaced (a restarted roscore), said with an error.
+  void watchMaster();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   // The first of the reasons why the loads are not flowing, or empty (diagnose()).
   void diagnoseLevel(diagnostic_updater::DiagnosticStatusWrapper& status, long published);
@@ -157,6 +161,7 @@ class EstimatorNode {
   } smoothed_;
   diagnostic_updater::Updater updater_;
   ros::WallTimer diagnostics_timer_;
+  std::unique_ptr<MasterWatch> master_watch_;
   InputHealth joint_health_;
   Outcome last_joint_outcome_ = Outcome::kUsed;  // of the last joint state
   ros::WallTime started_ = ros::WallTime::now();
