@@ -12,8 +12,9 @@ namespace jle {
 
 /// The latest position of every coordinate and the latest measured effort of every
 /// published joint, from joint-state messages that may each carry a subset of the
-/// joints. The name-to-index mapping is cached for the last layout of names seen, so a
-/// stream of messages with one layout costs string comparisons and no allocation.
+/// joints. The name-to-index mapping is cached for the last layouts of names seen, so a
+/// stream of messages with one layout (or a few, alternating: publishers that split the
+/// joints) costs string comparisons and no allocation.
 class JointStateMap {
  public:
   /// `published_segments` as publishedSegments() returns them; mimic_tolerance [rad or m]:
@@ -42,7 +43,7 @@ class JointStateMap {
   int duplicate(const std::vector<std::string>& names);
   /// Per entry of the last layout bound (update(), duplicate()): the coordinate it
   /// sets (model.coordinate_names index), or -1 (a mimic, a fixed or unknown joint).
-  const std::vector<int>& coordinates() const { return coordinate_of_; }
+  const std::vector<int>& coordinates() const { return bindings_[current_].coordinate_of; }
 
   /// The positions, model.coordinate_names order (size nq).
   const std::vector<double>& q() const { return q_; }
@@ -63,7 +64,6 @@ class JointStateMap {
   const std::vector<double>& effort() const { return effort_; }
 
  private:
-  void bind(const std::vector<std::string>& names);
   void checkMimics(const std::vector<double>& position);
 
   std::vector<std::string> coordinate_names_;
@@ -73,7 +73,6 @@ class JointStateMap {
   std::vector<int> moving_coordinate_;
   std::vector<char> moving_is_mimic_;
   std::vector<double> moving_multiplier_, moving_offset_;
-  std::vector<int> mimic_of_;
   double mimic_tolerance_ = 0.01;
   int mimic_contradiction_ = -1;
   double mimic_expected_ = 0.0;
@@ -81,12 +80,23 @@ class JointStateMap {
   std::vector<double> q_, qd_;
   std::vector<char> received_, fresh_;
   std::vector<double> effort_;
-  // Cached binding of the last layout of names: per message index, the coordinate
-  // (-1: none: a mimic or unknown), the published joint (-1: none) and whether known.
-  std::vector<std::string> layout_;
-  std::vector<int> coordinate_of_, published_of_;
-  std::vector<char> known_;
-  int duplicate_ = -1;  // of the cached layout
+  // Cached bindings of the last kLayouts layouts of names (joint states split over
+  // publishers alternate between theirs): per message index, the coordinate (-1: none: a
+  // mimic or unknown), the published joint (-1: none), whether known, and the moving
+  // joint of a mimic (-1: none); the first duplicated name. A layout seen again costs
+  // string comparisons and no allocation.
+  struct Binding {
+    std::vector<std::string> layout;
+    std::vector<int> coordinate_of, published_of, mimic_of;
+    std::vector<char> known;
+    int duplicate = -1;
+    long used = -1;  // when last bound (-1: never)
+  };
+  static constexpr std::size_t kLayouts = 4;
+  const Binding& binding(const std::vector<std::string>& names);
+  std::vector<Binding> bindings_ = std::vector<Binding>(kLayouts);
+  std::size_t current_ = 0;
+  long binds_ = 0;
 };
 
 }  // namespace jle

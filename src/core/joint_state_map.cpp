@@ -29,42 +29,59 @@ JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>&
     published_joint_names_.push_back(model.joint_name[static_cast<std::size_t>(s)]);
 }
 
-void JointStateMap::bind(const std::vector<std::string>& names) {
-  layout_ = names;
-  const std::size_t n = names.size();
-  coordinate_of_.assign(n, -1);
-  published_of_.assign(n, -1);
-  known_.assign(n, 0);
-  mimic_of_.assign(n, -1);
-  duplicate_ = -1;
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = 0; j < i && duplicate_ < 0; ++j)
-      if (names[j] == names[i]) duplicate_ = static_cast<int>(i);
-    for (std::size_t k = 0; k < coordinate_names_.size(); ++k)
-      if (coordinate_names_[k] == names[i]) coordinate_of_[i] = static_cast<int>(k);
-    for (std::size_t j = 0; j < published_joint_names_.size(); ++j)
-      if (published_joint_names_[j] == names[i]) published_of_[i] = static_cast<int>(j);
-    for (std::size_t m = 0; m < moving_joint_names_.size(); ++m)
-      if (moving_joint_names_[m] == names[i]) {
-        known_[i] = 1;
-        if (moving_is_mimic_[m]) mimic_of_[i] = static_cast<int>(m);
-      }
-    if (coordinate_of_[i] >= 0 || published_of_[i] >= 0) known_[i] = 1;
+const JointStateMap::Binding& JointStateMap::binding(const std::vector<std::string>& names) {
+  ++binds_;
+  if (bindings_[current_].used >= 0 && bindings_[current_].layout == names) {
+    bindings_[current_].used = binds_;  // the common case: the last message's layout
+    return bindings_[current_];
   }
+  for (std::size_t b = 0; b < bindings_.size(); ++b) {
+    if (bindings_[b].used < 0 || bindings_[b].layout != names) continue;
+    bindings_[b].used = binds_;
+    current_ = b;
+    return bindings_[b];
+  }
+  current_ = 0;  // a new layout: in the slot used least recently (or never)
+  for (std::size_t b = 1; b < bindings_.size(); ++b)
+    if (bindings_[b].used < bindings_[current_].used) current_ = b;
+  Binding& m = bindings_[current_];
+  m.used = binds_;
+  m.layout = names;
+  const std::size_t n = names.size();
+  m.coordinate_of.assign(n, -1);
+  m.published_of.assign(n, -1);
+  m.known.assign(n, 0);
+  m.mimic_of.assign(n, -1);
+  m.duplicate = -1;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < i && m.duplicate < 0; ++j)
+      if (names[j] == names[i]) m.duplicate = static_cast<int>(i);
+    for (std::size_t k = 0; k < coordinate_names_.size(); ++k)
+      if (coordinate_names_[k] == names[i]) m.coordinate_of[i] = static_cast<int>(k);
+    for (std::size_t j = 0; j < published_joint_names_.size(); ++j)
+      if (published_joint_names_[j] == names[i]) m.published_of[i] = static_cast<int>(j);
+    for (std::size_t u = 0; u < moving_joint_names_.size(); ++u)
+      if (moving_joint_names_[u] == names[i]) {
+        m.known[i] = 1;
+        if (moving_is_mimic_[u]) m.mimic_of[i] = static_cast<int>(u);
+      }
+    if (m.coordinate_of[i] >= 0 || m.published_of[i] >= 0) m.known[i] = 1;
+  }
+  return m;
 }
 
 int JointStateMap::update(const std::vector<std::string>& names,
                           const std::vector<double>& position, const std::vector<double>& velocity,
                           const std::vector<double>& effort) {
   constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
-  if (names != layout_) bind(names);
+  const Binding& m = binding(names);
   int unknown = -1;
   for (std::size_t i = 0; i < names.size(); ++i) {
-    if (!known_[i]) {
+    if (!m.known[i]) {
       if (unknown < 0) unknown = static_cast<int>(i);
       continue;
     }
-    const int k = coordinate_of_[i];
+    const int k = m.coordinate_of[i];
     if (k >= 0) {
       q_[static_cast<std::size_t>(k)] = position[i];
       qd_[static_cast<std::size_t>(k)] =
@@ -72,7 +89,7 @@ int JointStateMap::update(const std::vector<std::string>& names,
       received_[static_cast<std::size_t>(k)] = 1;
       fresh_[static_cast<std::size_t>(k)] = 1;
     }
-    const int j = published_of_[i];
+    const int j = m.published_of[i];
     if (j >= 0 && !effort.empty())
       effort_[static_cast<std::size_t>(j)] = std::isfinite(effort[i]) ? effort[i] : kNone;
   }
@@ -84,13 +101,14 @@ void JointStateMap::checkMimics(const std::vector<double>& position) {
   // Only against a leader in the same message: one from another publisher may be of
   // another instant.
   mimic_contradiction_ = -1;
-  for (std::size_t i = 0; i < mimic_of_.size() && mimic_contradiction_ < 0; ++i) {
-    const int m = mimic_of_[i];
+  const Binding& b = bindings_[current_];
+  for (std::size_t i = 0; i < b.mimic_of.size() && mimic_contradiction_ < 0; ++i) {
+    const int m = b.mimic_of[i];
     if (m < 0) continue;
     const std::size_t u = static_cast<std::size_t>(m);
     const int leader = moving_coordinate_[u];
     bool in_message = false;
-    for (int c : coordinate_of_) in_message = in_message || c == leader;
+    for (int c : b.coordinate_of) in_message = in_message || c == leader;
     if (!in_message) continue;
     const double expected =
         moving_multiplier_[u] * q_[static_cast<std::size_t>(leader)] + moving_offset_[u];
@@ -101,8 +119,7 @@ void JointStateMap::checkMimics(const std::vector<double>& position) {
 }
 
 int JointStateMap::duplicate(const std::vector<std::string>& names) {
-  if (names != layout_) bind(names);
-  return duplicate_;
+  return binding(names).duplicate;
 }
 
 int JointStateMap::firstMissing() const {

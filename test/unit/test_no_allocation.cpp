@@ -218,4 +218,36 @@ TEST(NoAllocation, PipelineWithBothStreams) {
   EXPECT_TRUE(pipeline.record().inputs[0].used);
 }
 
+// Joint states split over two publishers (four joints and two, at one stamp: merged into
+// one sample) alternate between two layouts of names: each bound once, then no
+// allocation either. (One cached layout, rebound at every message, allocated the names
+// longer than a string's small buffer beyond the shorter layout's end at every instant.)
+TEST(NoAllocation, PipelineWithSplitPublishers) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf");
+  jle::Pipeline pipeline(model, jle::Settings(), nullptr);
+  // The publishers' own orders; the names longer than a string's small buffer
+  // (shoulder_pan_joint, shoulder_lift_joint) past the shorter layout's end.
+  const std::vector<std::string> a = {"elbow_joint", "wrist_1_joint", "shoulder_pan_joint",
+                                      "shoulder_lift_joint"},
+                                 b = {"wrist_2_joint", "wrist_3_joint"};
+  std::vector<double> qa(a.size()), qb(b.size());
+  const std::vector<double> none;
+  long published = 0, before = 0;
+  const int n = 3000;
+  for (int k = 0; k < n; ++k) {
+    if (k == 1000) before = g_allocations;
+    const double t = 1e-3 * k;
+    const jle::Stamp stamp = 1700000000000000000 + static_cast<jle::Stamp>(std::llround(1e9 * t));
+    for (std::size_t i = 0; i < qa.size(); ++i) qa[i] = 0.5 * std::sin(t + i);
+    for (std::size_t i = 0; i < qb.size(); ++i) qb[i] = 0.5 * std::sin(t + 4 + i);
+    pipeline.onJointState(stamp, stamp, a, qa, none, none);
+    while (pipeline.takeDrained()) ++published;
+    published += pipeline.onJointState(stamp, stamp, b, qb, none, none) == jle::Outcome::kPublished;
+    while (pipeline.takeDrained()) ++published;
+  }
+  EXPECT_EQ(g_allocations - before, 0);
+  EXPECT_GT(published, n - 50);
+  EXPECT_EQ(pipeline.counters().held_samples, 0);
+}
+
 }  // namespace
