@@ -107,6 +107,10 @@ class ProcessBagTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  // process_bag with kConfig on clean.bag and on NAME.bag, each to its CSV: NAME's run.
+  Result runBesideClean(const std::string& name);
+  // NAME.csv is clean.csv, row for row (more than 100 rows).
+  void expectCleanCsv(const std::string& name);
 
   fs::path dir_;
 };
@@ -187,6 +191,25 @@ wrenches:
     sign: -1
     timeout: 0.5
 )";
+
+Result ProcessBagTest::runBesideClean(const std::string& name) {
+  writeFile(path("config.yaml"), kConfig);
+  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) +
+                           " --config " + quote(path("config.yaml"));
+  const Result clean =
+      run(tool + " --bag " + quote(path("clean.bag")) + " --csv " + quote(path("clean.csv")));
+  EXPECT_EQ(clean.status, 0) << clean.output;
+  return run(tool + " --bag " + quote(path(name + ".bag")) + " --csv " +
+             quote(path(name + ".csv")));
+}
+
+void ProcessBagTest::expectCleanCsv(const std::string& name) {
+  const Table a = readCsv(path("clean.csv")), b = readCsv(path(name + ".csv"));
+  EXPECT_EQ(b.header, a.header);
+  ASSERT_EQ(b.rows.size(), a.rows.size());
+  ASSERT_GT(a.rows.size(), 100u);
+  for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(b.rows[i], a.rows[i]) << "row " << i;
+}
 
 // The estimator of kConfig, configured here by hand (not by the settings parser); with
 // `smoothed`, its smoothed stream's (the default: constant-jerk Kalman smoother, process
@@ -798,23 +821,12 @@ TEST_F(ProcessBagTest, AbsurdAndGlitchedPositionsChangeNoLoad) {
   glitch(100, 1e300);
   glitch(200, position(1, 0.2) + 3.0);
   writeBag(path("hostile.bag"), hostile);
-  writeFile(path("config.yaml"), kConfig);
-  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) +
-                           " --config " + quote(path("config.yaml"));
-  const Result clean =
-      run(tool + " --bag " + quote(path("clean.bag")) + " --csv " + quote(path("clean.csv")));
-  ASSERT_EQ(clean.status, 0) << clean.output;
-  const Result r =
-      run(tool + " --bag " + quote(path("hostile.bag")) + " --csv " + quote(path("hostile.csv")));
+  const Result r = runBesideClean("hostile");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("position of joint 'panda_joint2' is 1e+300"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("2 implausible"), std::string::npos) << r.output;  // the summary
-  const Table a = readCsv(path("clean.csv")), b = readCsv(path("hostile.csv"));
-  EXPECT_EQ(b.header, a.header);
-  ASSERT_EQ(b.rows.size(), a.rows.size());
-  ASSERT_GT(a.rows.size(), 100u);
-  for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(b.rows[i], a.rows[i]) << "row " << i;
+  expectCleanCsv("hostile");
 }
 
 // Measured velocities (issue 37) through process_bag with the default settings: joint
@@ -897,14 +909,7 @@ TEST_F(ProcessBagTest, SplitPublishersGiveTheLoadsOfOnePublisher) {
     split.joints.emplace_back(stamp, b);
   }
   writeBag(path("split.bag"), split);
-  writeFile(path("config.yaml"), kConfig);
-  const std::string tool = std::string(JLE_PROCESS_BAG) + " --urdf " + quote(kPanda) +
-                           " --config " + quote(path("config.yaml"));
-  const Result clean =
-      run(tool + " --bag " + quote(path("clean.bag")) + " --csv " + quote(path("clean.csv")));
-  ASSERT_EQ(clean.status, 0) << clean.output;
-  const Result r =
-      run(tool + " --bag " + quote(path("split.bag")) + " --csv " + quote(path("split.csv")));
+  const Result r = runBesideClean("split");
   ASSERT_EQ(r.status, 0) << r.output;
   // The first message waits for the other half, never received yet; 299 merged.
   EXPECT_NE(r.output.find("process_bag: 299 joint states merged with other publishers'"),
@@ -912,11 +917,7 @@ TEST_F(ProcessBagTest, SplitPublishersGiveTheLoadsOfOnePublisher) {
       << r.output;
   EXPECT_NE(r.output.find("1 waiting for a joint"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("held a joint"), std::string::npos) << r.output;
-  const Table a = readCsv(path("clean.csv")), b = readCsv(path("split.csv"));
-  EXPECT_EQ(b.header, a.header);
-  ASSERT_EQ(b.rows.size(), a.rows.size());
-  ASSERT_GT(a.rows.size(), 100u);
-  for (std::size_t i = 0; i < a.rows.size(); ++i) EXPECT_EQ(b.rows[i], a.rows[i]) << "row " << i;
+  expectCleanCsv("split");
 }
 
 TEST_F(ProcessBagTest, RefusesBadInputNamingTheCulprit) {
