@@ -2,7 +2,7 @@
 // the message path the node runs), over its differentiators, precisions and savings, and
 // of the offline zero-phase smoother (zero_phase.hpp), on scenes whose exact joint loads
 // are known (ground_truth.hpp). Writes one CSV row per configuration and joint plus an
-// overall row per configuration; bench/plot_accuracy.py turns it into docs/accuracy.md
+// overall row per configuration; bench/plot_accuracy.py turns it into docs/studies/accuracy.md
 // and the figures. tools/accuracy.sh runs both.
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/dynamics.hpp>
@@ -138,8 +138,8 @@ std::vector<Differentiator> differentiators(bool quick) {
   const jle::DifferentiatorConfig node = jle::Settings{}.estimator.differentiator;
   out.push_back({kDefaultLabel, kDefaultLabel, node, node.measurement_noise, true, {}, false});
   // And with the joint states' velocities where the scene has them; and the smoothed
-  // stream's default filter (README "Two streams"), without and with them: what the node
-  // publishes on ~joint_loads and ~smoothed/joint_loads.
+  // stream's default filter (docs/how_it_works.md "Two streams"), without and with them: what the
+  // node publishes on ~joint_loads and ~smoothed/joint_loads.
   out.push_back(
       {"default + velocities", kDefaultLabel, node, node.measurement_noise, true, {}, true});
   const jle::DifferentiatorConfig smoothed = jle::Settings{}.smoothed.differentiator;
@@ -1247,7 +1247,7 @@ bool sweepsSavings(const std::string& label) {
   return false;
 }
 
-// The former default filter, which docs/accuracy.md compares with the node's.
+// The former default filter, which docs/studies/accuracy.md compares with the node's.
 jle::DifferentiatorConfig formerDefault() {
   jle::DifferentiatorConfig d;
   d.type = jle::DifferentiatorType::kSavitzkyGolay;  // 9 samples, quadratic, causal

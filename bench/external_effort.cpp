@@ -1,9 +1,10 @@
 // External efforts and contact wrenches against KDL's ChainExternalWrenchEstimator
 // (Debian's liborocos-kdl-dev), on the same chain and the same states.
 //
-//   bench_external_effort [Google Benchmark flags]   time per sample (docs/external_effort.md)
-//   bench_external_effort --table [--quick]          the error table against a known contact
-//   bench_external_effort --friction                 unmodelled friction (issue 40's scene)
+//   bench_external_effort [Google Benchmark flags]   time per sample
+//   (docs/studies/external_effort.md) bench_external_effort --table [--quick]          the error
+//   table against a known contact bench_external_effort --friction                 unmodelled
+//   friction (issue 40's scene)
 //
 // Speed: per sample on the Panda chain (7 joints, a wrench at panda_hand_tcp): our
 // update (forward pass, M by the composite-rigid-body pass, C^T qd and g through the
@@ -437,7 +438,8 @@ int main(int argc, char** argv) {
   const char* const usage =
       "usage: bench_external_effort [--table [--quick] | --friction | Google Benchmark options]\n"
       "--table: the external wrench's error at poses inside the Panda's limits, ours against\n"
-      "KDL's ChainExternalWrenchEstimator (docs/external_effort.md); --friction: unmodelled\n"
+      "KDL's ChainExternalWrenchEstimator (docs/studies/external_effort.md); --friction: "
+      "unmodelled\n"
       "friction against detection; otherwise the time per sample against KDL's (benchmark).\n";
   bool want_table = false, quick = false, friction = false;
   for (int i = 1; i < argc; ++i) {

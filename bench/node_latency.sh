@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end latency of the estimator on one machine (docs/node_latency.md), through
+# End-to-end latency of the estimator on one machine (docs/studies/node_latency.md), through
 # both paths in one run: a private master, the Panda chain with two wrench inputs
 # (bench/node_latency.yaml), and the bench's driver side (bench/node_latency.cpp,
 # joint_load_estimator/LatencyBenchNodelet) at each rate:

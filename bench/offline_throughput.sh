@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Offline throughput (README "Offline: many files at once", docs/offline_throughput.md):
+# Offline throughput (docs/offline_tools.md "Offline: many files at once", docs/studies/offline_throughput.md):
 # samples per second of process_bag (the demo's Panda with its wrist sensor, the
 # demo's configuration) and of joint_loads (the 7-joint Panda chain with a wrench), one
 # file alone and many files through tools/batch.sh, serially (-j 1) and on every core

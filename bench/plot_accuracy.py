@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Turns the CSV of bench/accuracy into docs/accuracy.md and the two figures.
+"""Turns the CSV of bench/accuracy into docs/studies/accuracy.md and the two figures.
 
 usage: plot_accuracy.py ACCURACY.csv --md OUT.md --png-prefix PREFIX [--command TEXT]
 
@@ -279,7 +279,8 @@ def per_rate_section(rows, scenes):
             "differentiator (`default`, untouched), the best online configuration, and the "
             "best offline zero-phase smoothing of the whole record (the cutoff it used: fixed, "
             "or chosen by its rule) on the same readings; *default / offline* = the ratio of "
-            "their RMS effort errors. The README quotes the `arm_*` rows.\n\n"
+            "their RMS effort errors. docs/studies/accuracy_overview.md quotes the `arm_*` "
+            "rows.\n\n"
             + per_rate_table(entries) + "\n")
 
 

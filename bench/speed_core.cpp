@@ -303,7 +303,7 @@ jle::EstimatorConfig savingsVariant(std::string variant) {
   } else if (variant == "float") {
     c.precision = jle::Precision::kFloat;
   } else if (variant.rfind("cov_", 0) == 0) {
-    // Covariance of the loads (docs/uncertainty.md): cov_full = every source, the state
+    // Covariance of the loads (docs/studies/uncertainty.md): cov_full = every source, the state
     // linearised; cov_qdd = its cheap path (q-ddot, wrench and inertial parts only);
     // _diag = only the variances; _pN = uncertainty.period N ms (the step is 1 ms: computed
     // every N-th sample), extrapolated in between (_p1000: the extrapolation alone, nearly).

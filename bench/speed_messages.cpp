@@ -4,7 +4,8 @@
 // before a publish); against the same samples given to the Estimator alone, in the same
 // run, so that the ratio is the message path's overhead. nodeMessagePath/0 has the
 // immediate stream alone (smoothed/enabled: false); /1 both streams, the default, the
-// smoothed record serialised too (README "Two streams": their ratio is the cost of both).
+// smoothed record serialised too (docs/how_it_works.md "Two streams": their ratio is the cost of
+// both).
 #include <joint_load_estimator/JointLoads.h>
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>

@@ -1,6 +1,6 @@
 // Numerical stability of the core and of the filters: sweeps that push one parameter
 // to its extreme and measure the error against a quad-precision reference on the same
-// inputs. Writes docs/stability.md (one table per sweep) and exits non-zero if a
+// inputs. Writes docs/studies/stability.md (one table per sweep) and exits non-zero if a
 // measurement exceeds the bound that test/unit/test_stability.cpp asserts.
 //
 //   stability [--output PATH] [--quick]
@@ -1111,7 +1111,8 @@ const char* kStaticFindings =
 const char* const kUsage =
     "usage: stability [--output PATH] [--quick]\n"
     "Sweeps that push one parameter of the core or the filters to its extreme, each against a\n"
-    "quad-precision reference; writes the report (docs/stability.md, or PATH) and exits 1 if a\n"
+    "quad-precision reference; writes the report (docs/studies/stability.md, or PATH) and exits 1 "
+    "if a\n"
     "measurement exceeds test_stability's bound. --quick: fewer samples (for CI).\n";
 
 }  // namespace

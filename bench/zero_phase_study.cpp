@@ -1,5 +1,5 @@
 // The offline zero-phase smoother's automatic cutoffs against the ground truth
-// (docs/zero_phase.md): Panda chain scenes at 100 Hz, 200 Hz and 1 kHz with encoder noise
+// (docs/studies/zero_phase.md): Panda chain scenes at 100 Hz, 200 Hz and 1 kHz with encoder noise
 // 1e-4 .. 1e-3 rad and a noisy wrist wrench; for Winter's residual analysis, GCV and the
 // best fixed cutoff of a scan (an oracle that knows the truth), the RMS error of the
 // efforts and of qdd. Prints a Markdown table.
@@ -130,7 +130,7 @@ void printRow(const Scene& s, const char* rule, const Errors& e) {
 const char* const kUsage =
     "usage: zero_phase_study [--quick]\n"
     "The offline zero-phase smoother's automatic cutoffs (residual analysis, GCV) against the\n"
-    "best fixed cutoff on Panda scenes at 100 Hz, 200 Hz and 1 kHz (docs/zero_phase.md):\n"
+    "best fixed cutoff on Panda scenes at 100 Hz, 200 Hz and 1 kHz (docs/studies/zero_phase.md):\n"
     "prints a Markdown table. --quick: 2 s scenes instead of 10 s.\n";
 
 int main(int argc, char** argv) {

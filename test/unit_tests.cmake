@@ -29,7 +29,7 @@ jle_add_unit_test(test_measured_velocity unit/test_measured_velocity.cpp)
 jle_add_unit_test(test_two_streams unit/test_two_streams.cpp)
 jle_add_unit_test(test_savings unit/test_savings.cpp)
 jle_add_unit_test(test_ground_truth unit/test_ground_truth.cpp)
-# The bounds of the stability sweeps (bench/stability.cpp, docs/stability.md).
+# The bounds of the stability sweeps (bench/stability.cpp, docs/studies/stability.md).
 jle_add_unit_test(test_stability unit/test_stability.cpp)
 jle_add_unit_test(test_no_allocation unit/test_no_allocation.cpp)
 jle_add_unit_test(test_closed_form unit/test_closed_form.cpp)
@@ -88,7 +88,9 @@ target_compile_definitions(test_settings PRIVATE
   JLE_TEST_CONFIG="${PROJECT_SOURCE_DIR}/test/config"
   JLE_DEFAULT_YAML="${PROJECT_SOURCE_DIR}/config/default.yaml"
   JLE_RECONFIGURE_CFG="${PROJECT_SOURCE_DIR}/cfg/Estimator.cfg"
-  JLE_README="${PROJECT_SOURCE_DIR}/README.md")
+  JLE_README="${PROJECT_SOURCE_DIR}/README.md"
+  JLE_NODE_DOC="${PROJECT_SOURCE_DIR}/docs/node.md"
+  JLE_EXTERNAL_DOC="${PROJECT_SOURCE_DIR}/docs/external_loads.md")
 # savings.planar: the planar 3x3 path against the 6x6 one and the paper's planar foot.
 jle_add_unit_test(test_planar unit/test_planar.cpp)
 # The human body model (make_body_urdf, docs/body_model.md), read by KDL too

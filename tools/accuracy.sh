@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The accuracy study in one command: builds bench/accuracy, runs every scene through
-# jle::Pipeline and the offline zero-phase smoother, and writes docs/accuracy.csv, docs/accuracy.md,
-# docs/accuracy_error_vs_time.png and docs/accuracy_error_vs_delay.png.
+# jle::Pipeline and the offline zero-phase smoother, and writes docs/studies/accuracy.csv, docs/studies/accuracy.md,
+# docs/studies/accuracy_error_vs_time.png and docs/studies/accuracy_error_vs_delay.png.
 #   tools/accuracy.sh           the full study (about 2 min of CPU after the build)
 #   tools/accuracy.sh --quick   a tiny input, into $JLE_WS/accuracy_quick instead of docs/
 #                               (for CI: it fails if the study or the report no longer run,
@@ -13,7 +13,7 @@ ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 export JLE_WS=$ws
 quick=()
 case "${1:-}" in
-  "") out="$repo/docs" ;;
+  "") out="$repo/docs/studies" ;;
   --quick) quick=(--quick); out="$ws/accuracy_quick" ;;
   *) echo "usage: tools/accuracy.sh [--quick]" >&2; exit 2 ;;
 esac

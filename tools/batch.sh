@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Many bags or CSV files at once, one process per file, as many at a time as there are
-# cores (README "Offline: many files at once"):
+# cores (docs/offline_tools.md "Offline: many files at once"):
 #   tools/batch.sh [-j N] OUT_DIR process_bag [process_bag options] -- IN.bag...
 #   tools/batch.sh [-j N] OUT_DIR joint_loads [joint_loads options] -- IN.csv...
 # Each input IN gives OUT_DIR/<IN's name without .bag/.csv>.csv (process_bag --csv,

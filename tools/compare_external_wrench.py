@@ -7,7 +7,7 @@ BAG: made by make_example_bag --effort --sensor-frame LINK (its TOPIC, default
 /ft_sensor/wrench, is the wrench applied at LINK: the truth, not given to the estimator);
 LOADS.csv: process_bag --csv with external_effort/contacts [{link: LINK}]. Compares
 external@LINK.fx .. .mz with the truth at the same stamps, skipping the first 0.5 s
-(the observer's start). README, "External torques and contact wrenches".
+(the observer's start). docs/external_loads.md, "External torques and contact wrenches".
 """
 import csv
 import math

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Makes docs/external_wrench.png (README, "External torques and contact wrenches"): the
+# Makes docs/external_wrench.png (docs/external_loads.md, "External torques and contact wrenches"): the
 # example bag (make_example_bag --effort --sensor-frame panda_hand_tcp) replayed through
 # the node with config/external_demo.yaml, whose wrist wrench is NOT an input; rviz
 # (config/external_demo.rviz, software GL on Xvfb display :23) draws the estimated

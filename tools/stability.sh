@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The numerical-stability study in one command: builds bench/stability.cpp and runs its
-# sweeps, which write docs/stability.md (one table per sweep) and fail if a measured
+# sweeps, which write docs/studies/stability.md (one table per sweep) and fail if a measured
 # error exceeds the bound that test/unit/test_stability.cpp asserts.
 #   tools/stability.sh           the full study (about a minute and a half after the build)
 #   tools/stability.sh --quick   fewer samples, 2e5 instead of 1e7 filter steps, into
@@ -12,7 +12,7 @@ ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 export JLE_WS=$ws
 quick=()
 case "${1:-}" in
-  "") out="$repo/docs/stability.md" ;;
+  "") out="$repo/docs/studies/stability.md" ;;
   --quick) quick=(--quick); out="$ws/stability_quick.md" ;;
   *) echo "usage: tools/stability.sh [--quick]" >&2; exit 2 ;;
 esac

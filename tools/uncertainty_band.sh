@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The README's uncertainty band: the demo bag (make_example_bag, as tools/demo.sh makes
+# The uncertainty band of docs/node.md: the demo bag (make_example_bag, as tools/demo.sh makes
 # it) through process_bag with config/demo.yaml plus the uncertainty of
 # config/demo_uncertainty.yaml, then one joint's effort with +-2 sigma plotted into
-# docs/uncertainty_band.png (bench/plot_uncertainty.py). Needs the package built
+# docs/studies/uncertainty_band.png (bench/plot_uncertainty.py). Needs the package built
 # (tools/build.sh process_bag make_example_bag).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -20,4 +20,4 @@ grep -q force_noise "$config" || { echo "uncertainty_band: no wrench entry in co
 "$bin/process_bag" --bag "$bag" --urdf "$repo/test/data/urdf/panda_demo.urdf" --config "$config" \
   --csv "$demo/uncertainty.csv"
 /usr/bin/python3 "$repo/bench/plot_uncertainty.py" "$demo/uncertainty.csv" "${1:-panda_joint2}" \
-  "$repo/docs/uncertainty_band.png"
+  "$repo/docs/studies/uncertainty_band.png"

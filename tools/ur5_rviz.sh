@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The README "Any robot" commands on the UR5 (test/data/urdf/ur5_robot.urdf), run under
+# The docs/any_robot.md "Any robot" commands on the UR5 (test/data/urdf/ur5_robot.urdf), run under
 # a virtual display, with a screenshot of rviz into docs/ur5_rviz.png, 5 s of
 # ~joint_efforts plotted by plot_efforts into docs/ur5_efforts.png, and what
 # `rostopic echo` shows of ~joint_efforts into docs/ur5_joint_efforts.txt.
@@ -40,7 +40,7 @@ Xvfb :24 -screen 0 1200x800x24 >"$out/xvfb.log" 2>&1 &
 pids+=($!)
 export DISPLAY=:24 LIBGL_ALWAYS_SOFTWARE=1
 
-# --- the README commands -------------------------------------------------------------
+# --- the docs/any_robot.md commands---------------------------------------------------------
 urdf=$(rospack find joint_load_estimator)/test/data/urdf/ur5_robot.urdf
 rosrun joint_load_estimator make_example_bag --urdf "$urdf" --output "$out/ur5.bag" \
   --sensor-frame tool0 --tcp-frame tool0

@@ -70,7 +70,7 @@ struct WrenchInputConfig {
 };
 
 /// The uncertainty of the inputs, propagated to the covariance of every computed joint
-/// wrench (Estimator::covariance; docs/uncertainty.md). All standard deviations are
+/// wrench (Estimator::covariance; docs/studies/uncertainty.md). All standard deviations are
 /// 1 sigma; the errors are taken as independent, zero-mean and (for the sensors) white.
 struct UncertaintyConfig {
   bool enabled = false;
@@ -88,7 +88,7 @@ struct UncertaintyConfig {
   /// reset, a filter restart or a gap of more than 3 periods); the samples in between
   /// get the quadratic through the last three computed ones at their actual times
   /// (variances clamped at 0). 0: computed for every published sample. The error depends
-  /// on the period, not on the joint-state rate. docs/uncertainty.md measures the cost
+  /// on the period, not on the joint-state rate. docs/studies/uncertainty.md measures the cost
   /// and the error. 0.018: the propagation costs at most as much as the loads at 1 kHz
   /// (Panda, Talos), worst sigma error 2.7%.
   double period = 0.018;
@@ -109,7 +109,7 @@ struct UncertaintyConfig {
 /// reaction is the filtered wrench, decoded (COP, free moment) and carried to the foot;
 /// below it the raw wrench at the stamp acts, without a COP (so the filters' memory of a
 /// stance never loads a swinging foot, and the reaction has no step at heel strike or
-/// toe-off; README, "Force plates").
+/// toe-off; docs/biomechanics.md, "Force plates").
 struct PlateInputConfig {
   ForcePlateConfig plate;
   double timeout = 0.1;  ///< [s] > 0; older than this at a joint sample = stale
@@ -174,7 +174,7 @@ struct Savings {
 /// The estimator's settings (the keys of config/default.yaml that the Estimator reads).
 struct EstimatorConfig {
   /// The filter of the joint positions and of the inputs (the node's default: the
-  /// accuracy study's constant-jerk Kalman filter, docs/accuracy.md).
+  /// accuracy study's constant-jerk Kalman filter, docs/studies/accuracy.md).
   DifferentiatorConfig differentiator;
   MeasuredVelocity measured_velocity = MeasuredVelocity::kAuto;
   Precision precision = Precision::kDouble;
@@ -226,7 +226,8 @@ struct FrictionConfig {
 };
 
 /// Which estimate of the external joint efforts drives the contact detection and the
-/// contact wrenches (external_effort.hpp; README, "External torques and contact wrenches").
+/// contact wrenches (external_effort.hpp; docs/external_loads.md, "External torques and contact
+/// wrenches").
 enum class ExternalMethod : std::uint8_t {
   kObserver,  ///< the momentum observer: no q-ddot, a first-order lag of cut-off observer_cutoff
   kResidual,  ///< predicted minus measured effort: uses the filtered q-ddot (the loads' delay)
@@ -286,7 +287,7 @@ struct ExternalEffortConfig {
 void validate(const ExternalEffortConfig& config);
 
 /// How the message stamps of the joint-state stream become the estimator's times
-/// (README, "Time stamps").
+/// (docs/node.md, "Time stamps").
 enum class StampRegularize : std::uint8_t {
   /// A periodic stream whose stamps jitter about a lattice (stamps taken at reception)
   /// is detected, and its samples' instants are estimated from the stamps (SampleClock);
@@ -304,7 +305,7 @@ struct StampSettings {
   /// confirms a jump back at once.
   int jump_confirm = 3;
   /// [s] >= 0: joint states of several publishers (each a subset of the joints) whose
-  /// stamps lie within this of each other are merged into one sample (Pipeline, README
+  /// stamps lie within this of each other are merged into one sample (Pipeline, docs/node.md
   /// "Never silently wrong"); a sample waits for every needed joint until a message of a
   /// later instant comes. 5 ms: two drivers of one robot stamping one cycle up to 200 Hz;
   /// a joint repeated closes an instant anyway, so a faster stream loses nothing by it.
@@ -317,9 +318,9 @@ struct StampSettings {
 /// without noise: the running leg) up to max_bandwidth (1 kHz: 0.45 of the rate);
 /// process noise 1e3 (9 Hz at 1 kHz) until the first choice (4 s; data without noise:
 /// 0.5 s). Measured on the
-/// accuracy study's scenes: docs/accuracy.md, "The defaults against the best of the
-/// study"; README, "Two streams". The same filter with lag 0.25 s (the study's `KS-CJ auto
-/// lag=250ms`, its floor 5.6 Hz) is worse on the whole (geometric mean over the best 1.18
+/// accuracy study's scenes: docs/studies/accuracy.md, "The defaults against the best of the
+/// study"; docs/how_it_works.md, "Two streams". The same filter with lag 0.25 s (the study's `KS-CJ
+/// auto lag=250ms`, its floor 5.6 Hz) is worse on the whole (geometric mean over the best 1.18
 /// against 1.16; panda 1.60x against 1.28x the best, leg_gait_70hz 1.71x against 1.45x).
 inline DifferentiatorConfig defaultSmoother() {
   DifferentiatorConfig c;
@@ -343,8 +344,8 @@ struct SmoothedStreamSettings {
 };
 
 /// Every setting of the node and of the offline front ends (process_bag), with the
-/// parameter names of config/default.yaml (README, "Parameters").
-/// What an input may be before it is refused at the door (Pipeline; README "Never
+/// parameter names of config/default.yaml (docs/node.md, "Parameters").
+/// What an input may be before it is refused at the door (Pipeline; docs/node.md "Never
 /// silently wrong"): a finite absurd value must not reach the filters.
 struct PlausibilityConfig {
   /// [rad or m] >= 0: a position beyond its joint's URDF limits by more than this is
@@ -415,7 +416,7 @@ struct Settings {
   /// driver's publishing thread) instead of being queued for the manager's worker
   /// threads: one thread hand-over less per sample, at the price of the estimate running
   /// in the publisher's thread. Joint states from another process (TCP) are then
-  /// dropped with an error (README "Latency: nodelet or TCP").
+  /// dropped with an error (docs/studies/speed.md "Latency: nodelet or TCP").
   bool inline_callbacks = false;
   /// The node: when the ROS master it registered with is replaced by another (a restarted
   /// roscore, which knows none of its topics), shut down (ros::requestShutdown) so that a

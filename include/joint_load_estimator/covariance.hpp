@@ -1,5 +1,5 @@
 // Covariance of the joint wrenches the Estimator publishes (UncertaintyConfig,
-// docs/uncertainty.md): what is set up once for a model (CovarianceModel), the per-sample
+// docs/studies/uncertainty.md): what is set up once for a model (CovarianceModel), the per-sample
 // matrices (CovarianceWorkspace), and the free functions that fill them. ROS-free; the
 // propagation itself is described in src/core/covariance.cpp.
 #pragma once

@@ -30,7 +30,8 @@ class DifferentiatorBank {
   /// Adaptive: ratio of neighbouring bandwidths of its filters.
   static constexpr double kBandwidthRatio = 2.0;
   /// Adaptive with a lag: its smoother's bandwidth is at least kLagFloor / lag [Hz]: a
-  /// narrower smoother's response is longer than the lag (measured: docs/differentiators.md).
+  /// narrower smoother's response is longer than the lag (measured:
+  /// docs/studies/differentiators.md).
   static constexpr double kLagFloor = 1.4;
   /// The record's GCV choice is used where kLagFloor / lag is at most this [Hz] (lag >=
   /// 0.14 s); with a shorter lag the likelihood's choice, measured better there.
@@ -226,7 +227,7 @@ class DifferentiatorBank {
   // E evaluates the d-th derivative of 1, tau, ..., tau^(n-1) at the stamp. Their
   // error grows like cond(V), where the normal equations' grows like cond(V)^2: with
   // one 1 us interval among 1 ms ones, the 3-point difference (V square) lost a
-  // factor 250 over what its inputs allow, and 1.3e6 at 0.1 ns (docs/stability.md).
+  // factor 250 over what its inputs allow, and 1.3e6 at 0.1 ns (docs/studies/stability.md).
   // The centring and scaling keep cond(V) small for any spacing that is not
   // degenerate, at any offset of the clock. The estimate is a fixed linear
   // combination of the window: coeff row d . x is the d-th derivative at the stamp.

@@ -30,7 +30,7 @@ enum class KalmanModel : std::uint8_t {
 /// The default is what the node runs (config/default.yaml): the constant-jerk Kalman
 /// filter, its default process noise 1e4 (processNoise()), measurement noise 1e-4 rad. The adaptive
 /// filter is an option: better on the accuracy study's scenes of real logs, worse on clean ones,
-/// and its noise gain understates the q'' noise (README "Differentiators").
+/// and its noise gain understates the q'' noise (docs/how_it_works.md "Differentiators").
 struct DifferentiatorConfig {
   DifferentiatorType type = DifferentiatorType::kKalman;
   /// Savitzky-Golay: samples in the fit and degree of the polynomial (2..5). The

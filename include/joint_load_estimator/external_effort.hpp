@@ -1,6 +1,6 @@
 // External joint efforts from the measured ones, contact detection and contact wrenches
-// (README, "External torques and contact wrenches"). ROS-free; the Pipeline feeds it one
-// published sample at a time.
+// (docs/external_loads.md, "External torques and contact wrenches"). ROS-free; the Pipeline feeds
+// it one published sample at a time.
 //
 // Sign convention (DESIGN.md: a wrench is the one applied TO the robot): tau_ext is the
 // generalised force the environment applies, tau_ext = J^T F for a wrench F on the robot,

@@ -1,7 +1,7 @@
 // Force plates: what a plate measures, its centre of pressure, and the reaction it
 // applies to the foot standing on it (as the estimator and joint_loads apply it). ROS-free.
 //
-// Conventions (README, "Force plates"):
+// Conventions (docs/biomechanics.md, "Force plates"):
 // - The plate frame's z axis is the outward normal of the contact surface (pointing
 //   out of the plate, towards the foot). A plate whose own z axis points down (AMTI,
 //   Bertec) is given a plate frame rotated by pi about x in tf2 or in the config.
@@ -35,7 +35,7 @@ struct ForcePlateConfig {
   /// decoded (a division by a small force: sensor noise would throw it anywhere) and the
   /// reading is not a contact; the reaction still acts on the foot, as the exact wrench
   /// the plate measured (force, and moment about the plate origin carried to the foot),
-  /// so heel strike and toe-off have no step (README, "Force plates").
+  /// so heel strike and toe-off have no step (docs/biomechanics.md, "Force plates").
   double contact_threshold = 20.0;
 };
 

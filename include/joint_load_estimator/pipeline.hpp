@@ -48,7 +48,7 @@ enum class Outcome : std::uint8_t {
   /// a joint state that sets no coordinate the computed loads need (empty, or only a
   /// gripper's joints): its positions are kept, but it is not a sample
   kNoJoint,
-  /// A rogue stamp (README, "Time stamps"): far from the joint-state stream's and not
+  /// A rogue stamp (docs/node.md, "Time stamps"): far from the joint-state stream's and not
   /// (yet) a confirmed jump of time, a wrench or plate ahead of the joint states by more
   /// than its timeout, or stamp 0 on a stream that has had stamps
   kRogueStamp,
@@ -92,7 +92,7 @@ struct PipelineCounters {
   long mimic_contradictions = 0;
   /// samples taken with a coordinate the loads need held from an earlier message: an
   /// instant of joint states split over publishers that a later one closed before every
-  /// publisher spoke (a slower or dead publisher; README "Never silently wrong")
+  /// publisher spoke (a slower or dead publisher; docs/node.md "Never silently wrong")
   long held_samples = 0;
 
   long received(InputKind kind) const;
@@ -219,9 +219,9 @@ class Pipeline {
   /// the newest stamp among them, taken when every needed joint has come (kMerged). `clock` is
   /// the front end's clock when the message arrived (the node: ros::Time::now(); a bag: the
   /// message's bag time): it going back confirms a backward jump of time (a looping bag), and it
-  /// stands for stamp 0 on a stream that never had a stamp (README, "Time stamps"). The estimator
-  /// is fed the sample's instant (the stamp, or with stamps/regularize the SampleClock's estimate);
-  /// the loads keep the message's own stamp.
+  /// stands for stamp 0 on a stream that never had a stamp (docs/node.md, "Time stamps"). The
+  /// estimator is fed the sample's instant (the stamp, or with stamps/regularize the SampleClock's
+  /// estimate); the loads keep the message's own stamp.
   Outcome onJointState(Stamp stamp, Stamp clock, const std::vector<std::string>& names,
                        const std::vector<double>& position, const std::vector<double>& velocity,
                        const std::vector<double>& effort);
@@ -243,7 +243,7 @@ class Pipeline {
   bool takeDrained();
   /// A wrench of input k (settings.wrenches[k]) as the message carries it: force [N]
   /// and torque [N m] in `frame_id` (the configured frame, when set, wins), moment about
-  /// its origin. Its stamp follows the rules of README, "Time stamps": stamp 0, and a
+  /// its origin. Its stamp follows the rules of docs/node.md, "Time stamps": stamp 0, and a
   /// reading ahead of the joint states by more than its timeout, are rogue stamps.
   Outcome onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
                    const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
@@ -293,8 +293,8 @@ class Pipeline {
   /// kPublished (or of flush(), takeDrained()).
   const LoadsRecord& record() const { return record_; }
 
-  /// The smoothed stream (settings.smoothed; README, "Two streams"): the loads of the same
-  /// samples, taken through the same checks, by a second estimator whose filter is the
+  /// The smoothed stream (settings.smoothed; docs/how_it_works.md, "Two streams"): the loads of the
+  /// same samples, taken through the same checks, by a second estimator whose filter is the
   /// smoother of settings.smoothed, its loads `lag` seconds of stamps behind the newest
   /// joint state. Its records carry no external efforts or contacts (the immediate
   /// stream's). False when smoothed/enabled is false, and then nothing below applies.

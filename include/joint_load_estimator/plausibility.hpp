@@ -1,4 +1,4 @@
-// Plausibility at the door (Settings::plausibility, README "Never silently wrong"): what no
+// Plausibility at the door (Settings::plausibility, docs/node.md "Never silently wrong"): what no
 // joint of the model produces. One set of rules for every front end: jle::Pipeline (the
 // node, process_bag, Python) drops such a message, joint_loads refuses such a row. ROS-free.
 #pragma once

@@ -2,7 +2,7 @@
 // joint states, and the wrench and plate columns filtered alike): a Butterworth low-pass
 // run forward and backward, its cutoff given in Hz or chosen from the data. ROS-free.
 // The method, its padding, its handling of irregular stamps and its measured errors are in
-// docs/zero_phase.md.
+// docs/studies/zero_phase.md.
 #pragma once
 
 #include <joint_load_estimator/eigen_abi.hpp>
@@ -45,7 +45,7 @@ bool parseCutoffRule(const std::string& text, CutoffRule& rule);
 /// cutoff is where one pass is at -3 dB (the whole at -6 dB).
 struct ZeroPhaseConfig {
   double cutoff = 0.0;  ///< [Hz] low-pass cutoff; used when rule == kFixed
-  /// kAuto by default: the measured-best rule (docs/zero_phase.md, the table of chosen
+  /// kAuto by default: the measured-best rule (docs/studies/zero_phase.md, the table of chosen
   /// cutoffs and errors over the accuracy study's scenes).
   CutoffRule rule = CutoffRule::kAuto;
   /// [Hz] the highest cutoff an automatic rule chooses (what the bodies that the loads are
@@ -84,7 +84,7 @@ struct ZeroPhaseResult {
 /// Samples x channels in, at the stamps t [s] (strictly increasing, possibly irregular;
 /// at least 3); one cutoff for all channels (kinematics and forces filtered alike),
 /// returned in `cutoff`. Irregular stamps are resampled on a uniform grid at the median
-/// period, filtered there and evaluated back at t (docs/zero_phase.md). Throws
+/// period, filtered there and evaluated back at t (docs/studies/zero_phase.md). Throws
 /// std::invalid_argument naming what is wrong (sizes, stamps, config).
 /// `velocities`: empty, or measured rates of the same channels at the same stamps
 /// (samples x channels, [u/s]; non-finite entries left out): the evidence of kVelocity and

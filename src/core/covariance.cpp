@@ -1,4 +1,4 @@
-// Covariance of the joint wrenches the Estimator publishes (docs/uncertainty.md).
+// Covariance of the joint wrenches the Estimator publishes (docs/studies/uncertainty.md).
 //
 // The wrench y_i of segment i (force, moment: child frame, about the joint origin)
 // depends on
@@ -523,7 +523,7 @@ void keepForExtrapolation(const CovarianceModel& cm, CovarianceWorkspace& ws,
 // The covariance is a smooth function of the state, so this is exact to third order in
 // the time since t_0 (holding C_0: first order; the straight line through the last two:
 // second order, which overshoots where a variance turns round near its minimum;
-// docs/uncertainty.md measures the three). Elementwise, so as symmetric as the computed
+// docs/studies/uncertainty.md measures the three). Elementwise, so as symmetric as the computed
 // ones. A variance extrapolated below 0 is set to 0, and its row and column with it (no
 // covariance without variance).
 void quadraticThroughLastThree(const CovarianceModel& cm, CovarianceWorkspace& ws, double t) {

@@ -236,7 +236,7 @@ void readUncertainty(Section& s, UncertaintyConfig& u) {
                   {"gain_tolerance", &u.gain_tolerance}});
   if (s.has("decimation"))  // the sample count it replaced
     throw SettingsError("parameter '" + s.name("decimation") + "' is replaced by '" +
-                        s.name("period") + "' [s] (docs/uncertainty.md)");
+                        s.name("period") + "' [s] (docs/studies/uncertainty.md)");
 }
 
 void readFriction(Section& s, FrictionConfig& f) {

@@ -1,4 +1,4 @@
-// Zero-phase Butterworth smoothing of a whole record (docs/zero_phase.md).
+// Zero-phase Butterworth smoothing of a whole record (docs/studies/zero_phase.md).
 #include <joint_load_estimator/zero_phase.hpp>
 
 #include <algorithm>

@@ -11,7 +11,7 @@ The C++ core of the ROS package, over numpy arrays (docs/python.md):
     loads.effort                                   # N x joints
     loads["panda_joint2"].effort                   # one joint's column
 
-Conventions are the package's (README, "What it computes, and the conventions"): the
+Conventions are the package's (docs/how_it_works.md, "What it computes, and the conventions"): the
 wrench the parent link exerts on the child link through the joint, moment about the
 joint origin, in the child link frame by default; SI units. The generated messages stay
 where ROS puts them: ``from joint_load_estimator.msg import JointLoads``.
@@ -109,7 +109,7 @@ def inverse_dynamics(model, q, qd, qdd, wrenches=None, frame="child", gravity=No
 
 def smooth_zero_phase(t, x, cutoff=None, rule="auto", order=4, padding=0):
     """Zero-phase Butterworth smoothing and differentiation of a whole record
-    (docs/zero_phase.md; joint_loads' positions-only path).
+    (docs/studies/zero_phase.md; joint_loads' positions-only path).
 
     t: N stamps [s], increasing; x: N x channels. cutoff [Hz], or None to choose it by
     ``rule`` ('auto': the noise spectrum of the positions, 'spectrum', 'gcv' or
@@ -135,7 +135,7 @@ def process_bag(bag, urdf, config="", zero_phase=None, cutoff_rule="auto", summa
     ``wrench`` (child frame), ``effort``, ``position``, ``velocity``, ``acceleration``
     (the filter's estimate), ``measured_effort``, and, when the config enables them,
     ``effort_stddev`` and ``motor_effort`` (else N x 0): the immediate stream. Its
-    ``smoothed`` is the smoothed stream's Loads (the config's smoothed/...; README "Two
+    ``smoothed`` is the smoothed stream's Loads (the config's smoothed/...; docs/how_it_works.md "Two
     streams"), None when it is off or with zero_phase.
     """
     from . import _bag  # the one part that needs ROS (rosbag, tf2)

@@ -25,7 +25,7 @@ robot in the parameter robot_description (URDF), and publishes them:
   /diagnostics
 Input: joint_states (sensor_msgs/JointState), the wrench and force plate topics of the
 parameters. Parameters: the private namespace (config/default.yaml lists every key
-with its default; README "Parameters"). Live tuning: ~reconfigure (dynamic_reconfigure).
+with its default; docs/node.md "Parameters"). Live tuning: ~reconfigure (dynamic_reconfigure).
 
 Options (handled before ROS starts):
   --help, -h   this text

@@ -1,5 +1,5 @@
 // ~reconfigure: live tuning of the differentiator, the decimation and the node's
-// thresholds through dynamic_reconfigure (cfg/Estimator.cfg, README "Live tuning").
+// thresholds through dynamic_reconfigure (cfg/Estimator.cfg, docs/node.md "Live tuning").
 // A change is mapped onto the parameters read at start and read again by the one reader
 // (parseSettings, which checks it); the decimation and the thresholds apply in place,
 // a new differentiator restarts the filters (Pipeline::retune).

@@ -96,7 +96,7 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    accept link inertias no rigid body has (an identified parameter
                    set: not positive semi-definite, triangle inequality broken) with a
                    warning per link: the efforts are the identified model's, the
-                   joints' full 3-D force and moment are not physical (README
+                   joints' full 3-D force and moment are not physical (docs/how_it_works.md
                    "Model"). Default: such a model is refused
   --plate NAME=LINK,X,Y,Z[,YAW_DEG]
                    a force plate (repeatable): its frame (z up, the contact surface
@@ -137,7 +137,7 @@ origin) and the joint effort (axis . moment, or axis . force for a prismatic joi
                    none: measured velocities only guide the cutoff): q, and with the
                    same filter every wrench@ and plate@ column, are smoothed by a
                    Butterworth low-pass run forward and backward (zero phase), and
-                   q is differentiated (docs/zero_phase.md); the cutoff [Hz] given
+                   q is differentiated (docs/studies/zero_phase.md); the cutoff [Hz] given
                    (> 0 and below half the sampling rate),
                    or chosen from the q columns by --cutoff-rule (default: auto).
                    The cutoff used is printed on standard error.
@@ -424,7 +424,7 @@ void checkPlausible(const jle::CsvReader& reader, const jle::Model<double>& mode
                     const std::vector<double>* previous) {
   static const jle::PlausibilityConfig p;
   static const std::string kWhy =
-      ": refused (no such joint moves so; README \"Never silently wrong\")";
+      ": refused (no such joint moves so; docs/node.md \"Never silently wrong\")";
   const std::vector<int> segment = jle::coordinateSegments(model);
   const double dt = previous ? cells[columns.t] - (*previous)[columns.t] : 0.0;
   for (std::size_t k = 0; k < columns.q.size(); ++k) {

@@ -54,7 +54,7 @@ bag is played to it, without the timing of a live system.
   --output PATH        write joint_load_estimator/JointLoads messages on
                        PREFIX/joint_loads, bag time = the estimate's stamp, and
                        the smoothed stream's on PREFIX/smoothed/joint_loads (as the
-                       node publishes them; README "Two streams")
+                       node publishes them; docs/how_it_works.md "Two streams")
   --csv PATH           write the loads as CSV instead: t, then for every published
                        joint JOINT.fx, .fy, .fz, .mx, .my, .mz, .effort (the columns of
                        joint_loads; wrenches in the child link frame, moment about the
@@ -80,10 +80,10 @@ bag is played to it, without the timing of a live system.
                        success only. With none, the loads are computed and counted.
   --topic-prefix NS    namespace of the output topic (default /joint_load_estimator)
   --accept-nonphysical-inertia
-                       as the setting accept_nonphysical_inertia: true (README
+                       as the setting accept_nonphysical_inertia: true (docs/how_it_works.md
                        "Model"): link inertias no rigid body has (an identified
                        parameter set) are accepted with a warning per link
-  --zero-phase HZ|auto smooth offline first (docs/zero_phase.md): the whole bag's
+  --zero-phase HZ|auto smooth offline first (docs/studies/zero_phase.md): the whole bag's
                        joint positions, and with the same filter every wrench and
                        plate message, by a Butterworth low-pass (order 4 per pass)
                        run forward and backward, cutoff HZ or chosen from the
@@ -96,7 +96,7 @@ bag is played to it, without the timing of a live system.
   --cutoff-rule R      with --zero-phase auto: auto (default: the joint states'
                        velocities as evidence when every message has them, else
                        the positions' noise spectrum), spectrum, velocity, gcv or
-                       residual (docs/zero_phase.md)
+                       residual (docs/studies/zero_phase.md)
   --help               this text
 
 Frames: a wrench's frame that is not a URDF link rigid to its link, a floating base's

@@ -6,7 +6,7 @@
 // whole range a ROS stamp holds), wrench messages (frames known and unknown) and jumps
 // of the clock. Checks the documented outcome of every message against a shadow of
 // the rules (invalid sizes and values, stamp 0, stamp order, rogue stamps, confirmed
-// jumps and resets: README, "Time stamps"; joint states of several publishers merged
+// jumps and resets: docs/node.md, "Time stamps"; joint states of several publishers merged
 // into one sample per instant, stamps/merge_window), that every message is counted once,
 // and the published records. Built by build_and_run.sh.
 #include "fuzz_check.hpp"
@@ -165,7 +165,7 @@ void advance(Bytes& in, jle::Stamp& stamp, jle::Stamp& clock) {
   clock = std::min(kMaxStamp, clock + 1000000);
 }
 
-// The shadow of the pipeline's rules on stamps (README, "Time stamps"; the settings'
+// The shadow of the pipeline's rules on stamps (docs/node.md, "Time stamps"; the settings'
 // time_jump_threshold 1 s, stamps/jump_confirm 3, the wrench's timeout 0.05 s): stamp 0
 // per input, the last joint state taken, rogue stamps (a gap the clock saw too is none)
 // and the jumps they confirm, the clock going back.
@@ -326,7 +326,7 @@ void checkJointOutcome(jle::Pipeline& p, const JointMessage& js, jle::Stamp stam
     return;
   }
   // The first joint state of a timeline whose axis the wrenches set more than its reach
-  // (2^52 ns) away restarts it (README, "Time stamps"); the clock going back resets
+  // (2^52 ns) away restarts it (docs/node.md, "Time stamps"); the clock going back resets
   // only when the stamps do not go forward, so not here.
   if (first && p.jumped()) {
     JLE_FUZZ_CHECK(shadow.origin >= 0 && std::abs(stamp - shadow.origin) > jle::Stamp{1} << 52);

@@ -61,7 +61,7 @@ def random_states(model, n, seed):
 
 
 def plausible_states(model, n, seed):
-    """Random states that joint_loads takes (README "Never silently wrong": a position
+    """Random states that joint_loads takes (docs/node.md "Never silently wrong": a position
     beyond the URDF limits by more than 1 rad, or a velocity beyond 3 times the limit, is
     refused): within [-0.9, 0.9] rad (every Panda and body joint's limits widened by the
     margin hold it) and [-0.5, 0.5] rad/s (the Panda's fingers: 3 x 0.2 m/s)."""
@@ -303,7 +303,7 @@ def test_process_bag_is_the_tool(tmp_path, example_bag, smoothing):
 
 def test_external_outputs_are_the_tools(tmp_path):
     """The example bag's payload and push at panda_hand_tcp left out of the inputs
-    (config/external_demo.yaml, README's worked example): Python's contact outputs are
+    (config/external_demo.yaml, docs/external_loads.md's worked example): Python's contact outputs are
     the process_bag tool's ~contact events and ~external_wrench/panda_hand_tcp messages,
     sample for sample, and the wrench is the bag's applied one (/ft_sensor/wrench, not
     given to the estimator) after the observer's first 0.5 s."""
@@ -344,7 +344,7 @@ def test_external_outputs_are_the_tools(tmp_path):
                        applied[loads.stamp_ns[i]].force.z] for i in late])
     error = np.sqrt(np.mean(np.sum((w[late, :3] - truth) ** 2, axis=1)))
     size = np.sqrt(np.mean(np.sum(truth ** 2, axis=1)))
-    assert size > 10.0 and error < 0.05 * size, (error, size)  # README: 0.26 N of 20 N
+    assert size > 10.0 and error < 0.05 * size, (error, size)  # docs/external_loads.md: 0.26 N of 20 N
 
 SENSOR_CONFIG = """wrenches:
   - topic: /ft_sensor/wrench
@@ -519,7 +519,7 @@ def test_estimator_defaults_are_the_nodes(tmp_path):
 
 
 def test_estimate_refuses_an_absurd_position_and_says_what_to_trust():
-    """Never silently wrong (README): a joint state with a position of 1e300 or one joint
+    """Never silently wrong (docs/node.md): a joint state with a position of 1e300 or one joint
     3 rad off for one sample is refused (status "implausible") and changes no load (the
     loads equal those of the same samples without it, to the bit); each record's status
     bits (loads_status) say settling at the start, trusted after."""

@@ -1,5 +1,5 @@
-"""The gait demo's peak-moment table (tools/gait_peaks.py): README.md and
-docs/gait_demo.md hold what the script prints today (regenerated, never edited by hand);
+"""The gait demo's peak-moment table (tools/gait_peaks.py):
+docs/biomechanics.md and docs/gait_demo.md hold what the script prints today (regenerated, never edited by hand);
 every moment table of theirs has the sign convention beside it; and the table's peaks
 have the signs and instants that the trial's mechanics demand, argued here without the
 tools: in the heel rocker (0 - 10 % of the cycle) the ground reaction acts at the heel,
@@ -18,7 +18,7 @@ REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 SCRIPT = os.path.join(REPO, "tools", "gait_peaks.py")
 BEGIN = "<!-- tools/gait_peaks.py: begin (generated; do not edit) -->"
 END = "<!-- tools/gait_peaks.py: end -->"
-DOCS = [os.path.join(REPO, "README.md"), os.path.join(REPO, "docs", "gait_demo.md")]
+DOCS = [os.path.join(REPO, "docs", "biomechanics.md"), os.path.join(REPO, "docs", "gait_demo.md")]
 
 
 @pytest.fixture(scope="module")

@@ -91,8 +91,8 @@ class SensorNode {
   // Sends samples 1 ms apart from `origin` (each wrench `kLead` samples ahead
   // of the joint state of its stamp, so that the node holds it when the joint
   // state comes; no more than its timeout plus ten joint periods ahead of the
-  // joint states, or it is a rogue stamp: README "Time stamps") and calls check(t, residual) for
-  // every residual, until `samples` are sent or stop() holds. Returns the number of residuals
+  // joint states, or it is a rogue stamp: docs/node.md "Time stamps") and calls check(t, residual)
+  // for every residual, until `samples` are sent or stop() holds. Returns the number of residuals
   // checked (all but the warm-up and the first few that came before their reading).
   static constexpr int kLead = 5;
   int run(
@@ -110,7 +110,7 @@ class SensorNode {
       wrench_pub.publish(w);
     };
     // The run's first joint state before its first readings: a reading is taken only
-    // within its timeout plus ten joint periods ahead of the joint states (README "Time
+    // within its timeout plus ten joint periods ahead of the joint states (docs/node.md "Time
     // stamps"), and a run starts seconds after the last one, so readings sent first
     // would be rogue or not depending on which connection the node serves first.
     node.send(jointState(stamp(0), names, at(stamp(0)).q));

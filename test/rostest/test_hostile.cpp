@@ -153,7 +153,7 @@ const std::vector<Kind>& kinds() {
          gripper.position = {0.02};
          send.joint(gripper);
        }},
-      // Joint states split over two publishers (README "Never silently wrong"): the arm's
+      // Joint states split over two publishers (docs/node.md "Never silently wrong"): the arm's
       // first three joints 0.3 ms before the other three, the same positions as the clean
       // sample: merged into one sample, stamped with the newer stamp, the clean loads.
       {"SplitPublishers", "the sample split over two publishers, 0.3 ms apart",
@@ -176,7 +176,7 @@ const std::vector<Kind>& kinds() {
        [](sensor_msgs::JointState& js, const HostileSend&) {
          js.effort[2] = std::numeric_limits<double>::quiet_NaN();
        }},
-      // Stamps (README, "Time stamps"): a single outlier is not a jump of time.
+      // Stamps (docs/node.md, "Time stamps"): a single outlier is not a jump of time.
       {"JointStateTwoHoursAhead", "a joint state stamped 2 h ahead", "dropped: rogue stamp",
        [](sensor_msgs::JointState& js, const HostileSend& send) {
          send.joint(offBy(js, js.header.stamp + kTwoHours));

@@ -240,7 +240,7 @@ TEST(Inputs, BackwardTimeJumpRestartsTheFilters) {
   const int window = 9, samples = 30;
   // After a jump, the first joint states of the new timeline may reach the node before
   // the /clock message that moved the clock with them: until it comes they are rogue
-  // stamps (README "Time stamps"), at most stamps/jump_confirm - 1 = 2 of them, and the
+  // stamps (docs/node.md "Time stamps"), at most stamps/jump_confirm - 1 = 2 of them, and the
   // first publication is up to 2 samples later.
   const int late = 2;
 
@@ -314,7 +314,7 @@ class BadInput : public ::testing::Test {
 
   // Good samples 3 s after the last stamp used, with the clock standing still: a jump of
   // time forward, which the first two confirm as rogue stamps (stamps/jump_confirm 3,
-  // README "Time stamps") and the third restarts the filter from; two more make the
+  // docs/node.md "Time stamps") and the third restarts the filter from; two more make the
   // three the fit needs. Waits for the publication of the last, and for the
   // diagnostics that count them.
   void prime() {

@@ -3,7 +3,7 @@
 
 The reference is scipy.signal.butter (second-order sections) run forward and backward by
 scipy.signal.sosfiltfilt, with the end treatment, resampling and differentiation that
-docs/zero_phase.md defines written here again in numpy, and the inverse dynamics of the
+docs/studies/zero_phase.md defines written here again in numpy, and the inverse dynamics of the
 planar arm (test/data/urdf/planar_arm.urdf) written here in closed form. Positions-only
 CSVs are built here (regular and jittered stamps with a gap, a wrench and a force plate),
 joint_loads smooths them (--write-kinematics) and computes the loads, and every number is
@@ -37,7 +37,7 @@ J2_ORIGIN, J3_ORIGIN, J3_YAW, TOOL = np.array([0.4, 0.0]), np.array([0.05, 0.0])
     [0.3, 0.0])
 
 
-# --- the smoother (docs/zero_phase.md) ------------------------------------------------
+# --- the smoother (docs/studies/zero_phase.md) ------------------------------------------------
 def padding_of(order, samples, padding=0):
     return min(max(2, padding if padding > 0 else 3 * (order + 1)), samples - 1)
 

@@ -1,5 +1,5 @@
 // The error bounds the core and the filters guarantee, derived from the sweeps of
-// bench/stability.cpp (docs/stability.md) with the margin stated. test_stability.cpp
+// bench/stability.cpp (docs/studies/stability.md) with the margin stated. test_stability.cpp
 // asserts them on representative points; the bench checks every measured point and
 // fails if one exceeds its bound. Change a bound only with new measurements.
 #pragma once

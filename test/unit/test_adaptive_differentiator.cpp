@@ -113,9 +113,9 @@ DifferentiatorConfig kalman(double process_noise) {
   return c;
 }
 
-// The node's default stays the fixed constant-jerk filter (README "Differentiators": the
-// accuracy study's scenes of clean data, impacts and the noise gain); adaptive is chosen
-// by type, its keys' defaults are these.
+// The node's default stays the fixed constant-jerk filter (docs/how_it_works.md "Differentiators":
+// the accuracy study's scenes of clean data, impacts and the noise gain); adaptive is chosen by
+// type, its keys' defaults are these.
 TEST(AdaptiveDifferentiator, IsAnOptionWithItsDefaults) {
   EXPECT_EQ(DifferentiatorConfig().type, DifferentiatorType::kKalman);
   const DifferentiatorConfig c = adaptiveConfig();
@@ -281,7 +281,7 @@ TEST(AdaptiveDifferentiator, NoiseGainAgainstAMonteCarlo) {
   // says. Measured ratios 1.20, 1.50, 1.86 (value, rate, acceleration; a single fixed
   // filter of the same bandwidth: 1.08, 1.20, 1.21, within the 8% sampling error of 300
   // draws, 3 sigma). Bounds: the value within 1 +- 0.35, rate and acceleration in
-  // [0.8, 2.5]. A known limitation (docs/differentiators.md): the covariance module
+  // [0.8, 2.5]. A known limitation (docs/studies/differentiators.md): the covariance module
   // understates the noise of q-dot and q-ddot by up to about 2 with the adaptive filter.
   constexpr int kDraws = 300;
   constexpr double kSigma = 1e-4;

@@ -590,7 +590,7 @@ TEST_F(BodyTool, SagittalBodyGoesThroughJointLoadsWithPlanarOn) {
   for (int r = 1; r < 6; ++r) {
     std::vector<double> row{0.01 * r};
     // q within every joint's URDF limits widened by 1 rad (joint_loads refuses what no
-    // joint reaches: README "Never silently wrong"), q-dot and q-ddot within 2.
+    // joint reaches: docs/node.md "Never silently wrong"), q-dot and q-ddot within 2.
     for (std::size_t k = 0; k < 3 * kSagittalJoints.size(); ++k)
       row.push_back((k % 3 == 0 ? 0.9 : 2.0) * u(gen));
     // A ground reaction in the plane: force (x, z), moment about y.

@@ -338,7 +338,7 @@ TEST_F(CliTest, ParentAndWorldFramesAndGravityMatchTheLibrary) {
 
 // ------------------------------------------------------------------ input layout
 
-// Positions only (docs/zero_phase.md; the numbers themselves are checked against scipy by
+// Positions only (docs/studies/zero_phase.md; the numbers themselves are checked against scipy by
 // test_zero_phase_reference): the smoothed inputs that --write-kinematics writes are a
 // CSV with the derivatives given, whose loads are the positions-only run's, digit for
 // digit; the smoothing options are refused where they do not apply, naming them.
@@ -529,7 +529,7 @@ TEST_F(CliBadInputTest, BadCellsNameFileLineAndColumn) {
                 {"overflow", 1, {file + ":7: column 'panda_joint1.qdd': '1e400' is not a finite"}});
 }
 
-// Plausibility at the door (README "Never silently wrong"), the rules of the node and
+// Plausibility at the door (docs/node.md "Never silently wrong"), the rules of the node and
 // process_bag: a position no joint reaches (1e300), a velocity of 1e6 rad/s, and in a
 // CSV of positions only (differentiated across rows) a one-row glitch of 1 rad (the
 // Panda's joint 3 moves 2.175 rad/s: 0.11 rad in a 1 ms row with the margin): the file

@@ -67,10 +67,9 @@ void expectAll(const std::vector<Change>& changes, bool ok) {
 }
 
 TEST(Config, DefaultsAreTheNodes) {
-  // The differentiator the node runs (README "Differentiators"): the constant-jerk Kalman
-  // filter, q = 1e4, r = 1e-4 rad; the adaptive filter's keys default to 0.5 to 50 Hz,
-  // the noise estimated, a 1 s likelihood. An Estimator built from EstimatorConfig{} runs
-  // the same.
+  // The differentiator the node runs (docs/how_it_works.md "Differentiators"): the constant-jerk
+  // Kalman filter, q = 1e4, r = 1e-4 rad; the adaptive filter's keys default to 0.5 to 50 Hz, the
+  // noise estimated, a 1 s likelihood. An Estimator built from EstimatorConfig{} runs the same.
   const jle::DifferentiatorConfig d;
   EXPECT_EQ(d.type, jle::DifferentiatorType::kKalman);
   EXPECT_EQ(d.kalman_model, jle::KalmanModel::kConstantJerk);

@@ -563,7 +563,7 @@ ExtrapolationError extrapolationError(const std::vector<double>& stamps,
 }
 
 // The default (config/default.yaml) and the bounds asserted on its worst sigma error.
-// Measured at 1 kHz (docs/uncertainty.md): 0.0020 (Panda), 0.0265 (Talos); per robot,
+// Measured at 1 kHz (docs/studies/uncertainty.md): 0.0020 (Panda), 0.0265 (Talos); per robot,
 // 0.003 and 0.03 (the 3% the default was chosen by). At 100 Hz (the same trajectory):
 // 0.0030 (Panda) and 0.0021 (Talos), held to the 1 kHz bound over both robots, 0.03
 // (the composition of the variances differs with the rate: at 100 Hz the q-ddot noise is
@@ -750,7 +750,7 @@ TEST(CovariancePeriod, ExtrapolatesAtAnyRateWithinTheBound) {
 // +- 1%. The errors printed are not bounded: the filter's weights, so its noise gain and
 // the exact covariance, change with every spacing (by about the jitter, sample to
 // sample), and most with the gap inside the window; that, not the extrapolation, is most
-// of the error (holding C_0 does about as badly). docs/uncertainty.md gives the numbers.
+// of the error (holding C_0 does about as badly). docs/studies/uncertainty.md gives the numbers.
 TEST(CovariancePeriod, IrregularStampsAndAGap) {
   for (const std::string urdf : {"panda.urdf", "talos_reduced.urdf"}) {
     for (double jitter : {0.5, 0.01}) {
@@ -879,7 +879,7 @@ TEST(CovarianceMonteCarlo, InertialParametersTalos) {
 // within the tolerance of its successor, so a variance off by up to the tolerance per
 // node) carried by the quadratic's weights (|w0| + |w1| + |w2| <= 3 + 3 + 1 = 7 for up
 // to a period ahead) and halved for sigma: + 3.5 x tolerance = 7% for 0.02. Without the
-// guard the error reached 164% (docs/uncertainty.md). With regular stamps the guard
+// guard the error reached 164% (docs/studies/uncertainty.md). With regular stamps the guard
 // never fires: one sample in a period is computed.
 TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
   int robot = 0;

@@ -375,7 +375,7 @@ TEST_F(DhToUrdf, RandomModifiedTablesMatchCraigsNewtonEuler) {
   worst.print("modified");
 }
 
-// The bundled examples (README, docs/dh_to_urdf.md) convert and load.
+// The bundled examples (docs/offline_tools.md, docs/dh_to_urdf.md) convert and load.
 TEST_F(DhToUrdf, BundledPumaTablesConvert) {
   for (const char* file : {"puma560_standard.yaml", "puma560_modified.yaml"}) {
     const Result r = run({"--input", kData + "/dh/" + file, "--output", path("out/puma.urdf")});

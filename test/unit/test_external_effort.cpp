@@ -593,14 +593,14 @@ TEST(Issue40Scene, StartUpDropsDoNotInflateTheThresholds) {
 }
 
 // The fingertip configured as a full 6-D wrench (a tool that takes moments too, as in
-// README's worked example). The most distal joint loaded is then often not the last one (a
-// wrench need not turn joint 7): a 6-D wrench distal to the detected joint can leave the
+// docs/external_loads.md's worked example). The most distal joint loaded is then often not the last
+// one (a wrench need not turn joint 7): a 6-D wrench distal to the detected joint can leave the
 // joints between unloaded, so it is reported where its wrench fits the external efforts
 // (every joint within its threshold) and no configured contact is on the detected link:
 // during the fingertip's contact always, never in free motion or during link 5's (the
 // link-5 contact is there). During link 4's, where no configured contact is, the tool's
 // wrench fits (one condition short of any effort on 7 joints) and is reported: the
-// ambiguity README states.
+// ambiguity docs/external_loads.md states.
 TEST(Issue40Scene, AFullWrenchContactIsReportedWhereItFits) {
   for (jle::ExternalMethod method :
        {jle::ExternalMethod::kObserver, jle::ExternalMethod::kResidual}) {

@@ -89,7 +89,7 @@ TEST_F(GaitCsv, JointLoadsExplainsTheTrialWithThePlates) {
   EXPECT_LT(max_moment, 3.0);
 }
 
-// The demo's claim (README, "For biomechanists"; issue 18): the trial's peak joint
+// The demo's claim (docs/biomechanics.md, "For biomechanists"; issue 18): the trial's peak joint
 // moments per kg fall in the ranges of normal walking at natural cadence (Winter 2009,
 // ch. 5, for the sagittal ones). Today's peaks (docs/gait_demo.md): ankle 1.75, knee
 // 1.14, hip flexion 1.33, hip adduction 1.14, hip rotation 0.48; a change of the

@@ -1,4 +1,4 @@
-// Never silently wrong (README): what jle::Pipeline does with values no robot produces
+// Never silently wrong (docs/node.md): what jle::Pipeline does with values no robot produces
 // (a finite absurd position, a glitch inside the limits, an absurd wrench, loads that are
 // not finite) and how every record says whether it can be trusted (LoadsRecord::status:
 // settling after the filters start, a stale input, an implausible load). References: a

@@ -222,7 +222,7 @@ TEST_F(OfflineFormatsTest, PoseOnlyBaseMotionIsEstimatedWithinTheMethodsOrder) {
 // (0.3 sin pi t, 0.2 sin 0.8 pi t, 0.9 + 0.1 cos pi t), a turn 0.3 sin pi t about the
 // fixed axis u, the quaternion's sign flipped on every other row; 4 s at 1 kHz, compared
 // over the middle 2 s: the zero-phase filter's end transients (its own, as for the
-// joints: docs/zero_phase.md) are still 0.4 N at 0.4 s from the ends, far below 1e-3
+// joints: docs/studies/zero_phase.md) are still 0.4 N at 0.4 s from the ends, far below 1e-3
 // after 1 s (they decay as exp(-19 t) at 8 Hz).
 TEST_F(OfflineFormatsTest, PositionsOnlyFloatingBaseDifferentiatesThePose) {
   const double w = M_PI;

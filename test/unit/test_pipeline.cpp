@@ -77,7 +77,7 @@ TEST(Pipeline, PartialMessagesGiveTheExactLoads) {
   const jle::Model<double> model = ur5();
   jle::Settings settings = finiteDifferences();
   // The stamps are the sampling instants (q is evaluated at them), jittered about a
-  // lattice: what stamps/regularize auto takes for receive-time stamps (README, "Time
+  // lattice: what stamps/regularize auto takes for receive-time stamps (docs/node.md, "Time
   // stamps"). Off, they are the instants.
   settings.stamps.regularize = jle::StampRegularize::kOff;
   addWrenchInput(settings, "tool0");
@@ -557,7 +557,7 @@ TEST(Pipeline, MalformedMessagesAreCountedAndNamed) {
   EXPECT_EQ(c.count(InputKind::kJointState, Outcome::kInvalid), 3);
   EXPECT_EQ(c.unknown_joints, 1);
   EXPECT_EQ(c.received(InputKind::kWrench), 2);
-  // Stamp 0 on a stream that has had stamps: dropped (README, "Time stamps").
+  // Stamp 0 on a stream that has had stamps: dropped (docs/node.md, "Time stamps").
   EXPECT_EQ(pipeline.onJointState(0, kStart, names, std::vector<double>(6), kNone, kNone),
             Outcome::kRogueStamp);
 }

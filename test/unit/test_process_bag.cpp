@@ -213,7 +213,7 @@ void ProcessBagTest::expectCleanCsv(const std::string& name) {
 
 // The estimator of kConfig, configured here by hand (not by the settings parser); with
 // `smoothed`, its smoothed stream's (the default: constant-jerk Kalman smoother, process
-// noise 1e3, measurement noise 1e-4, lag 0.2 s; README "Two streams").
+// noise 1e3, measurement noise 1e-4, lag 0.2 s; docs/how_it_works.md "Two streams").
 jle::Estimator referenceEstimator(const jle::Model<double>& model, bool smoothed) {
   jle::EstimatorConfig config;
   if (smoothed) {
@@ -544,7 +544,7 @@ TEST_F(ProcessBagTest, AgreesWithTheExactEffortsOfTheExampleBag) {
 // --zero-phase: the whole bag smoothed zero-phase first, then the message path with
 // central differences. The example bag's sines (below 0.4 Hz) pass a 10 Hz cutoff with a
 // gain of 1 - 7e-12; central differences at 1 kHz err by (w h)^2 / 12 < 1e-6 relative.
-// Near the ends, odd reflection pulls the acceleration towards zero (docs/zero_phase.md):
+// Near the ends, odd reflection pulls the acceleration towards zero (docs/studies/zero_phase.md):
 // the comparison leaves out 0.5 s (five periods of the cutoff) at each end, where that
 // transient has decayed from 16 N m at the ends to below 1e-4 N m (measured: 6.3e-5; 0.016
 // at 0.25 s). 1e-3 N m leaves a margin and is far below what a wrench left unfiltered,
@@ -804,7 +804,7 @@ TEST_F(ProcessBagTest, IdentifiedInertiaNeedsTheFlagOrTheSetting) {
   EXPECT_TRUE(fs::exists(path("o.csv")));
 }
 
-// Never silently wrong (README): joint states no arm produces between the samples (a
+// Never silently wrong (docs/node.md): joint states no arm produces between the samples (a
 // position of 1e300 rad, one joint 3 rad off) are refused, counted and named; the loads
 // are those of the bag without them, to the bit, and the tool exits 0.
 TEST_F(ProcessBagTest, AbsurdAndGlitchedPositionsChangeNoLoad) {

@@ -2,7 +2,7 @@
 // key onto its field of jle::Settings and refuses what validate() refuses, naming the key: per key
 // family an ok and a ko YAML (test/config/ok_*.yaml, ko_*.yaml), as ros_controllers'
 // joint_state_controller tests do. And the documentation cannot drift: config/default.yaml and the
-// defaults stated by README.md's parameter table parse to Settings{}.
+// defaults stated by the parameter tables of README.md and docs/ parse to Settings{}.
 #include <joint_load_estimator/ros/settings.hpp>
 
 #include <gtest/gtest.h>
@@ -565,16 +565,17 @@ TEST(SettingsDocs, DefaultYamlListsEveryKey) {
   }
 }
 
-// The README's parameter table: each row of one key and one stated default, e.g.
-// "| `savings/prune` | `true` | ...", parsed as that key's YAML, is Settings{}; and every
-// key of default.yaml has a row.
-TEST(SettingsDocs, ReadmeTableStatesTheDefaults) {
-  std::ifstream readme(JLE_README);
-  ASSERT_TRUE(readme.good());
+// The parameter tables of the docs (README.md's "at a glance", docs/node.md's whole one,
+// docs/external_loads.md's): each row of one key and one stated default, e.g.
+// "| `savings/prune` | `true` | ...", parsed as that key's YAML, is Settings{}. Returns the
+// keys of the rows, one "`key`" per line; counts the rows in `checked`.
+std::string checkParameterTable(const std::string& path, int& checked) {
+  std::ifstream doc(path);
+  EXPECT_TRUE(doc.good()) << path;
   const std::regex row(R"(^\| `([a-z_]+)(/([a-z_]+))?(/([a-z_]+))?` \| `([^`]*)`)");
   std::string line, rows;
-  int checked = 0;
-  while (std::getline(readme, line)) {
+  checked = 0;
+  while (std::getline(doc, line)) {
     std::smatch m;
     if (!std::regex_search(line, m, row)) continue;
     rows += "`" + m[1].str() + (m[2].matched ? m[2].str() : "") + "`\n";
@@ -583,17 +584,29 @@ TEST(SettingsDocs, ReadmeTableStatesTheDefaults) {
         m[4].matched   ? m[1].str() + ":\n  " + m[3].str() + ":\n    " + m[5].str() + ": " + value
         : m[2].matched ? m[1].str() + ":\n  " + m[3].str() + ": " + value
                        : m[1].str() + ": " + value;
-    SCOPED_TRACE("README row " + line.substr(0, 60));
+    SCOPED_TRACE(path + " row " + line.substr(0, 60));
     expectSame(parseText(yaml + "\n"), Settings{});
     ++checked;
   }
-  EXPECT_GE(checked, 35);  // the rows of one key (38 when written)
+  return rows;
+}
+
+// docs/node.md has a row for every key of default.yaml; README.md's short table and
+// docs/external_loads.md's state the same defaults.
+TEST(SettingsDocs, ParameterTablesStateTheDefaults) {
+  int checked = 0;
+  const std::string rows = checkParameterTable(JLE_NODE_DOC, checked);
+  EXPECT_GE(checked, 60);  // the rows of one key (66 when written)
   const jle::ParamValue defaults = jle::loadYaml(JLE_DEFAULT_YAML);
   for (std::size_t i = 0; i < defaults.size(); ++i) {
     if (defaults[i].type() == jle::ParamValue::Type::kMap) continue;  // rows per key
     EXPECT_NE(rows.find("`" + defaults.key(i) + "`"), std::string::npos)
-        << defaults.key(i) << ": no README row";
+        << defaults.key(i) << ": no row in docs/node.md";
   }
+  checkParameterTable(JLE_README, checked);
+  EXPECT_GE(checked, 20);  // README's "Parameters at a glance" (24 when written)
+  checkParameterTable(JLE_EXTERNAL_DOC, checked);
+  EXPECT_GE(checked, 12);  // the external_effort/... table (14 when written)
 }
 
 }  // namespace

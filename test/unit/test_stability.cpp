@@ -1,5 +1,5 @@
 // Numerical stability: the error bounds of the core and of the filters under the
-// extremes that bench/stability.cpp sweeps (docs/stability.md), asserted on
+// extremes that bench/stability.cpp sweeps (docs/studies/stability.md), asserted on
 // representative points. The bounds and their margins are stated in
 // stability_bounds.hpp, from the sweeps' measurements.
 //
@@ -183,7 +183,7 @@ TEST(StabilityCore, AWorldOffsetDoesNotEnterTheLoads) {
   // world position never enters it, nor does it enter wrenches given in the world frame
   // (rotated, not moved). So the loads at 1e5 m from the origin are the loads at the
   // origin, to the last bit, in double and in float (the paper's formulation taken
-  // literally loses 8 digits of the moments there: docs/stability.md).
+  // literally loses 8 digits of the moments there: docs/studies/stability.md).
   RandomModelSpec spec;
   spec.joints = 8;
   spec.seed = 2000;

@@ -1,4 +1,4 @@
-// The two streams of one pipeline (settings.smoothed; README, "Two streams"): the
+// The two streams of one pipeline (settings.smoothed; docs/how_it_works.md, "Two streams"): the
 // immediate (causal) loads and the smoothed ones, `lag` seconds of stamps behind, from
 // the same messages. Against the exact loads of an analytic motion: the smoothed stream
 // is closer to the truth; every joint state reaches it once, across a jump back of time

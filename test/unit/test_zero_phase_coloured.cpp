@@ -149,7 +149,7 @@ const Oracle& oracle() {
 
 // The best fixed cutoff lies where the motion meets the noise (a few Hz: the noise is
 // flat to 50 Hz), its error tens of mN m; GCV, which takes noise flat to 50 Hz for
-// motion, climbs to its bound and errs a hundred times more (docs/zero_phase.md).
+// motion, climbs to its bound and errs a hundred times more (docs/studies/zero_phase.md).
 TEST(ColouredNoise, TheOracleAndGcvAreWhatTheStudyFound) {
   EXPECT_GT(oracle().cutoff, 2.0);
   EXPECT_LT(oracle().cutoff, 10.0);

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Joint loads of a Panda arm from Python, plotted to a PNG (README, "Python").
+"""Joint loads of a Panda arm from Python, plotted to a PNG (docs/python.md, "Python").
 
 The arm follows an analytic trajectory for 4 s; its exact loads come from
 joint_load_estimator.inverse_dynamics with the exact derivatives, and its estimated
