@@ -133,6 +133,9 @@ struct InputRecord {
   /// the reading's sign [N, N m]. Zero when unused or not a sensor.
   bool used = false;
   Wrench<double> residual;
+  /// The wrench the model predicts at the sensor's joint (same frame, point and sign as
+  /// `residual`; the reading is residual + predicted). Zero when unused or not a sensor.
+  Wrench<double> predicted;
   std::string frame;  ///< the reading's frame (the input's link when it has none)
 };
 

@@ -1002,6 +1002,9 @@ void Pipeline::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) {
     in.residual =
         in.used ? residualInReading(estimator.sensorResidual(input), X.linear(), X.translation())
                 : Wrench<double>();
+    in.predicted =
+        in.used ? residualInReading(estimator.predictedWrench(input), X.linear(), X.translation())
+                : Wrench<double>();
   }
   for (std::size_t k = 0; k < rec.plates.size(); ++k) {
     PlateRecord& p = rec.plates[k];

@@ -65,8 +65,10 @@ void EstimatorNode::publishConsistency(const LoadsRecord& record, const ros::Tim
     base_force_max_ = std::max(base_force_max_, record.base_force.norm());
     base_moment_max_ = std::max(base_moment_max_, record.base_moment.norm());
   }
-  for (std::size_t k : sensor_topics_)
+  for (std::size_t k : sensor_topics_) {
+    tallySign(record.inputs[k], settings_.wrenches[k].force_threshold, wrench_topics_[k].sign);
     if (record.inputs[k].used) publishResidual(record.inputs[k], k, stamp);
+  }
   if (!sensor_topics_.empty() && calibrating_.load()) collectBiasSample(record);
 }
 
@@ -123,6 +125,11 @@ void EstimatorNode::diagnoseConsistency(diagnostic_updater::DiagnosticStatusWrap
       std::snprintf(text, sizeof text, "sensor %s: residual moment %.3g N m > %.3g N m",
                     joint.c_str(), topic.max_moment, limits.moment_threshold);
       warn(text);
+    }
+    const std::string sign = signWarning(joint, settings_.estimator.wrenches[k].sign, topic.sign);
+    if (!sign.empty()) {
+      warn(sign);
+      ROS_WARN_THROTTLE(10.0, "%s", sign.c_str());
     }
     status.add(joint + ": max |residual force| [N]", topic.max_force);
     status.add(joint + ": max |residual moment| [N m]", topic.max_moment);

@@ -5,6 +5,7 @@
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
+#include <joint_load_estimator/sensor_sign.hpp>
 #include <joint_load_estimator/settings_reader.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 #include <joint_load_estimator/zero_phase.hpp>
@@ -213,6 +214,7 @@ class BagProcessor {
     joint_topic_ = globalName(settings.joint_states_topic);
     for (const jle::WrenchTopicSettings& w : settings.wrenches)
       wrench_topics_.push_back(globalName(w.topic));
+    signs_.resize(settings.wrenches.size());
     for (const jle::PlateTopicSettings& p : settings.force_plates)
       plate_topics_.push_back(globalName(p.topic));
     jle::applyBiasFile(pipeline_);
@@ -245,6 +247,7 @@ class BagProcessor {
   bool have_tf_ = false;                                   // the bag has /tf or /tf_static
   long written_ = 0;                                       // loads given to the sink
   long smoothed_written_ = 0;                              // the smoothed stream's
+  std::vector<jle::SignTally> signs_;  // per wrench input: its readings against the model
   ReuseBuffer buffer_;
   sensor_msgs::JointState joint_msg_;
   geometry_msgs::WrenchStamped wrench_msg_;
@@ -335,7 +338,12 @@ void BagProcessor::dispatch(const rosbag::MessageInstance& m) {
   while (pipeline_.takeDrainedSmoothed()) writeSmoothed();
 }
 
-void BagProcessor::write() { sink_.write(pipeline_.record(), written_++); }
+void BagProcessor::write() {
+  const jle::LoadsRecord& record = pipeline_.record();
+  for (std::size_t k = 0; k < signs_.size(); ++k)
+    jle::tallySign(record.inputs[k], pipeline_.settings().wrenches[k].force_threshold, signs_[k]);
+  sink_.write(record, written_++);
+}
 
 void BagProcessor::writeSmoothed() {
   sink_.writeSmoothed(pipeline_.smoothedRecord(), smoothed_written_++);
@@ -474,6 +482,11 @@ void BagProcessor::summarize(double total_s) const {
                  pipeline_.settings().smoothed.differentiator.lag, smoothed_written_,
                  pipeline_.smoothedBandwidth(),
                  pipeline_.smoothedVelocities() ? "measured velocities" : "positions");
+  for (std::size_t k = 0; k < signs_.size(); ++k) {
+    const jle::WrenchInputConfig& input = pipeline_.settings().estimator.wrenches[k];
+    const std::string sign = jle::signWarning(input.sensor_joint, input.sign, signs_[k]);
+    if (!sign.empty()) std::fprintf(stderr, "process_bag: warning: %s\n", sign.c_str());
+  }
   const std::string bound = pipeline_.smoothedBandwidthBound();
   if (!bound.empty())
     std::fprintf(stderr, "process_bag: warning: smoothed stream's bandwidth on a bound: %s\n",

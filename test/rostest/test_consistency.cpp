@@ -271,6 +271,24 @@ TEST(Consistency, UnmodelledContact) {
                                        "residual force"));
 }
 
+// (2b) The sensor of (1) declared with sign -1: its still readings, negated by the
+// sign, are the opposite of the prediction, and the diagnostics name the sensor and its
+// sign (sensor_sign.hpp; the same readings with sign 1 agree, test (1)).
+TEST(Consistency, AWrongSignIsNamed) {
+  SensorNode flipped("flipped");
+  ASSERT_TRUE(flipped.connect());
+  auto still = [](const ros::Time&) {
+    Sample s{kStill, {}, {}};
+    staticReading(kStill[1], s.f, s.m);
+    return s;
+  };
+  const int n =
+      flipped.run(ros::Time(15, 0), 40, still, [](const ros::Time&, const WrenchStamped&) {});
+  EXPECT_GE(n, 30);
+  EXPECT_TRUE(waitForConsistencyStatus(flipped.node.name(), diagnostic_msgs::DiagnosticStatus::WARN,
+                                       "sign wrong"));
+}
+
 // ---------------------------------------------------------------------------------
 // (3), (4) Bias calibration on /calib; the node started afterwards with the
 // bias file.

@@ -10,6 +10,8 @@
 #include <joint_load_estimator/dynamics.hpp>
 #include <joint_load_estimator/estimator.hpp>
 #include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/sensor_sign.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 namespace {
@@ -186,6 +188,50 @@ TEST(SensorJoint, MovingWithContact) {
     ++checked;
   }
   EXPECT_GE(checked, 45);
+}
+
+// The sign check (sensor_sign.hpp) through the message path: a still arm whose sensor
+// reads the tool's weight. Declared with the right sign its readings agree with the
+// prediction; a sensor that reports the other side's load (the same readings negated)
+// is named; a push on the tool (a reading the prediction does not explain) is not taken
+// for a wrong sign.
+TEST(SensorJoint, AWrongSignIsNamedFromTheStillReadings) {
+  const jle::Model<double> model = arm();
+  jle::Settings settings;
+  settings.estimator.wrenches = sensorConfig().wrenches;
+  jle::WrenchTopicSettings topic;
+  topic.topic = "ft";
+  settings.wrenches.push_back(topic);
+  const std::vector<double> q = {0.4, 0.3};
+  Vector3d f, m;
+  staticReading(q[1], f, m);
+  const auto tally = [&](const Vector3d& force, const Vector3d& moment) {
+    jle::Pipeline pipeline(model, settings, nullptr);
+    jle::SignTally t;
+    const std::vector<double> none;
+    for (int k = 0; k < 200; ++k) {
+      const jle::Stamp stamp = 1000000000 + 1000000 * static_cast<jle::Stamp>(k);
+      pipeline.onWrench(0, stamp, stamp, "ft_sensor", force, moment);
+      if (pipeline.onJointState(stamp, stamp, model.coordinate_names, q, none, none) ==
+          jle::Outcome::kPublished)
+        jle::tallySign(pipeline.record().inputs[0], topic.force_threshold, t);
+    }
+    return t;
+  };
+  const jle::SignTally right = tally(f, m);
+  EXPECT_GE(right.decisive, 150);
+  EXPECT_EQ(right.opposed, 0);
+  EXPECT_EQ(jle::signWarning("ft_joint", 1.0, right), "");
+  const jle::SignTally wrong = tally(-f, -m);
+  EXPECT_EQ(wrong.opposed, wrong.decisive);
+  const std::string warning = jle::signWarning("ft_joint", 1.0, wrong);
+  EXPECT_NE(warning.find("sensor ft_joint"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("sign wrong"), std::string::npos) << warning;
+  // A push of 3 N on the tool against its 7.8 N weight: a residual, not a wrong sign.
+  const Vector3d push(0.0, 3.0, 0.0);
+  const jle::SignTally pushed = tally(f - push, m - kTip.cross(push));
+  EXPECT_EQ(pushed.opposed, 0);
+  EXPECT_EQ(jle::signWarning("ft_joint", 1.0, pushed), "");
 }
 
 TEST(SensorJoint, RefusedConfigurations) {

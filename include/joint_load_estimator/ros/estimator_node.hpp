@@ -14,6 +14,7 @@
 #include <joint_load_estimator/ros/master_watch.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
 #include <joint_load_estimator/sensor_bias.hpp>
+#include <joint_load_estimator/sensor_sign.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
@@ -59,6 +60,7 @@ class EstimatorNode {
     // its extremes.
     ros::Publisher consistency_pub;
     double max_force = 0.0, max_moment = 0.0;  // |residual| since the last diagnosis
+    SignTally sign;  // readings against the prediction since the last diagnosis
   };
 
   // ~calibrate_bias in progress: fed by publishConsistency(), read by the service
