@@ -27,8 +27,10 @@ endif()
 # --- The Python bindings (pytest, python3-pytest) ----------------------------------
 # joint_load_estimator (src/python) against joint_loads and process_bag on the same inputs
 # (to 1e-12) and a closed form; the gait demo's peak table (tools/gait_peaks.py, with
-# make_gait_bag) against the docs; run in the workspace's environment (devel/env.sh puts the
-# devel Python path first), its JUnit file where catkin_test_results reads it.
+# make_gait_bag) against the docs; rviz for any robot (estimator.launch rviz:=true, on Xvfb,
+# its screenshot's pixels: test_rviz.py, with make_example_bag); run in the workspace's
+# environment (devel/env.sh puts the devel Python path first), its JUnit file where
+# catkin_test_results reads it.
 set(JLE_PYTEST_RESULT ${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-bindings.xml)
 catkin_run_tests_target(pytest bindings pytest-bindings.xml
   COMMAND "JLE_TEST_DATA=${JLE_TEST_DATA} JLE_JOINT_LOADS=$<TARGET_FILE:joint_loads> \

@@ -52,7 +52,7 @@ set(JLE_EXECUTABLES joint_load_estimator_node joint_loads make_trajectory make_b
 add_dependencies(test_cli ${JLE_EXECUTABLES})
 list(TRANSFORM JLE_EXECUTABLES REPLACE "(.+)" "$<TARGET_FILE:\\1>")
 list(APPEND JLE_EXECUTABLES ${PROJECT_SOURCE_DIR}/scripts/rviz_config
-  ${PROJECT_SOURCE_DIR}/scripts/plot_efforts)
+  ${PROJECT_SOURCE_DIR}/scripts/joint_labels ${PROJECT_SOURCE_DIR}/scripts/plot_efforts)
 string(REPLACE ";" "|" JLE_EXECUTABLES_LIST "${JLE_EXECUTABLES}")
 target_compile_definitions(test_cli PRIVATE
   "JLE_EXECUTABLES=\"${JLE_EXECUTABLES_LIST}\""

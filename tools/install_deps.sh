@@ -17,6 +17,8 @@ packages=(
   python3-matplotlib        # tools/examples/plot_loads.py, bench/plot_*.py
   pybind11-dev python3-pybind11 python3-numpy   # the Python bindings (docs/python.md)
   python3-pytest            # test/python (the bindings' tests)
+  rviz python3-visualization-msgs  # estimator.launch rviz:=true (joint_labels: MarkerArray)
+  xvfb imagemagick          # test/python/test_rviz.py: rviz on a virtual display, screenshots
   python3-scipy             # test/scripts/zero_phase_reference.py (the independent reference)
   clang libclang-rt-14-dev  # libFuzzer for test/fuzz/build_and_run.sh
   clang-format              # tools/format.sh (the style is tuned on Debian's 14)

@@ -955,7 +955,7 @@ TEST_F(CliTest, EveryExecutableHasHelpAndVersion) {
     programs.push_back(std::string(JLE_EXECUTABLES).substr(begin, end - begin));
     if (end == std::string::npos) break;
   }
-  ASSERT_EQ(programs.size(), 13u);  // the node, 10 tools, rviz_config, plot_efforts
+  ASSERT_EQ(programs.size(), 14u);  // the node, 10 tools, rviz_config, joint_labels, plot_efforts
   for (const std::string& program : programs) {
     const std::string name = fs::path(program).filename().string();
     for (const char* option : {"--help", "--version"}) {
@@ -1001,9 +1001,9 @@ TEST_F(CliTest, EveryStudyProgramAnswersHelp) {
 // -------------------------------------------------------------------------- rviz_config
 
 // rviz_config on the UR5 (its meshes are in a package that is not installed): a Wrench
-// display per moving joint on the node's topics, the torque scale 1 / (2 W) with W the
-// weight of the model as the package's C++ reader finds it, and a shapes URDF that
-// liburdf reads with the same joints.
+// display per moving joint on the node's topics, the torque scale 1 / (2 W_j) with W_j the
+// weight the joint carries (at least 2 % of the robot's) as the package's C++ reader finds
+// it, and a shapes URDF that liburdf reads with the same joints.
 TEST_F(CliTest, RvizConfigForTheUr5) {
   const std::string urdf = kData + "/urdf/ur5_robot.urdf";
   const Result r = run(JLE_RVIZ_CONFIG, {"--urdf", urdf, "--output", path("ur5.rviz"), "--node",
@@ -1013,19 +1013,24 @@ TEST_F(CliTest, RvizConfigForTheUr5) {
   const YAML::Node config = YAML::LoadFile(path("ur5.rviz"));
   const YAML::Node displays = config["Visualization Manager"]["Displays"];
   ASSERT_TRUE(displays.IsSequence());
-  std::vector<std::string> moving;
+  // carried[i]: the mass of segment i and of every segment after it [kg] (parent[i] < i).
+  std::vector<double> carried(model.mass.begin(), model.mass.end());
+  for (int i = model.nsegments() - 1; i > 0; --i) carried[model.parent[i]] += carried[i];
+  std::vector<int> moving;
   for (int i = 1; i < model.nsegments(); ++i)
-    if (model.joint_type[i] != jle::JointType::kFixed) moving.push_back(model.joint_name[i]);
+    if (model.joint_type[i] != jle::JointType::kFixed) moving.push_back(i);
   ASSERT_EQ(moving.size(), 6u);
   const YAML::Node wrenches = displays[2]["Displays"];
   ASSERT_EQ(wrenches.size(), moving.size());
-  const double weight = model.totalMass() * 9.80665;
   for (std::size_t k = 0; k < moving.size(); ++k) {
+    const std::string& joint = model.joint_name[moving[k]];
     EXPECT_EQ(wrenches[k]["Class"].as<std::string>(), "rviz/WrenchStamped");
     EXPECT_EQ(wrenches[k]["Topic"].as<std::string>(),
-              "/arm/joint_load_estimator/smoothed/wrench/" + moving[k]);
+              "/arm/joint_load_estimator/smoothed/wrench/" + joint);
+    const double weight =
+        std::max(carried[moving[k]], 0.02 * model.totalMass()) * 9.80665;  // W_j [N]
     // 6 significant digits printed.
-    EXPECT_NEAR(wrenches[k]["Torque Arrow Scale"].as<double>() * 2.0 * weight, 1.0, 1e-5);
+    EXPECT_NEAR(wrenches[k]["Torque Arrow Scale"].as<double>() * 2.0 * weight, 1.0, 1e-5) << joint;
   }
   EXPECT_EQ(displays[1]["Robot Description"].as<std::string>(), "robot_description_shapes");
   EXPECT_EQ(config["Visualization Manager"]["Global Options"]["Fixed Frame"].as<std::string>(),
