@@ -33,6 +33,12 @@ if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests -j1 >"$ws/run_te
   echo "run_tests failed (log: $ws/run_tests.log)"
   exit 1
 fi
+stage fresh_workspace
+# The package as a user builds it: a new catkin workspace, plain catkin_make, every
+# program rosrun finds answering --help, the node run from it (README, step 1).
+bash "$repo/test/scripts/fresh_workspace.sh" >"$ws/fresh_workspace.log" 2>&1 ||
+  { tail -30 "$ws/fresh_workspace.log"; echo "fresh workspace failed (log: $ws/fresh_workspace.log)"; bench_status=1; }
+tail -4 "$ws/fresh_workspace.log" || true
 stage benchmarks
 # The benchmarks, once each on a tiny input, so that they cannot rot (no timing is
 # judged here).
