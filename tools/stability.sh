@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The numerical-stability study in one command: builds bench/stability.cpp and runs its
 # sweeps, which write docs/studies/stability.md (one table per sweep) and fail if a measured
-# error exceeds the bound that test/unit/test_stability.cpp asserts.
+# error exceeds the bound that test/algorithms/test_stability.cpp asserts.
 #   tools/stability.sh           the full study (about a minute and a half after the build)
 #   tools/stability.sh --quick   fewer samples, 2e5 instead of 1e7 filter steps, into
 #                                $JLE_WS/stability_quick.md instead of docs/ (for CI)

@@ -11,7 +11,7 @@
 
 #include <jle_testing/ground_truth.hpp>
 
-#include "tool_test.hpp"
+#include <jle_testing/tool_test.hpp>
 
 #include <gtest/gtest.h>
 

@@ -16,7 +16,7 @@
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
-#include "papers_foot.hpp"
+#include <jle_testing/papers_foot.hpp>
 #include <jle_testing/random_models.hpp>
 
 #include <Eigen/Core>

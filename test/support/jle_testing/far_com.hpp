@@ -1,7 +1,7 @@
 // A link whose centre of mass lies D out along its own joint axis, and its effort in
 // closed form: the case where a parallel-axis round trip of the inertia (m D^2 added
 // to Ixx and taken away again) costs the effort its digits. Shared by
-// test/unit/test_stability.cpp and bench/stability.cpp (docs/studies/stability.md).
+// test/algorithms/test_stability.cpp and bench/stability.cpp (docs/studies/stability.md).
 #pragma once
 
 #include <cmath>

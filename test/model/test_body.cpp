@@ -10,7 +10,7 @@
 #include <joint_load_estimator/planar.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
-#include "tool_test.hpp"
+#include <jle_testing/tool_test.hpp>
 
 #include <gtest/gtest.h>
 #include <kdl/frames.hpp>

@@ -6,8 +6,8 @@
 // The reference of the core's tests is the same computation in long double on the
 // same inputs (the model and state in double, converted). Against quad precision its
 // own error is below 2.5e-17 in every sweep, under 1/2000 of any double bound here.
-#include "far_com.hpp"
-#include "stability_bounds.hpp"
+#include <jle_testing/far_com.hpp>
+#include <jle_testing/stability_bounds.hpp>
 
 #include <joint_load_estimator/differentiation.hpp>
 #include <joint_load_estimator/dynamics.hpp>

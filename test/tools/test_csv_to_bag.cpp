@@ -14,7 +14,7 @@
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "tool_test.hpp"
+#include <jle_testing/tool_test.hpp>
 
 #include <gtest/gtest.h>
 

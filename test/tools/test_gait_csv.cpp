@@ -2,7 +2,7 @@
 // (joint_loads --floating-base --plate ...): the path a biomechanist takes with a trial
 // of their own (docs/gait_demo.md). The plates explain the motion, so the pelvis residual
 // is what the generator's numerical derivatives leave.
-#include "tool_test.hpp"
+#include <jle_testing/tool_test.hpp>
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // files of joint_loads and process_bag, run as processes. Expected values are worked by
 // hand in the tests (Newton-Euler of one rigid body; the statics of a standing body),
 // not taken from the library.
-#include "tool_test.hpp"
+#include <jle_testing/tool_test.hpp>
 
 #include <gtest/gtest.h>
 

@@ -13,7 +13,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "papers_foot.hpp"
+#include <jle_testing/papers_foot.hpp>
 
 namespace {
 
