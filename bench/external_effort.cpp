@@ -16,7 +16,7 @@
 // the residual and the observer; KDL's estimator is fed the same filtered q, qd and the
 // same measured efforts at the same stamps. RMS of the force and moment error over the
 // contact after 0.3 s of settling, per scenario: exact, encoder noise, effort noise,
-// jittered stamps; at two poses inside the Panda's joint limits and at the historic one
+// jittered stamps; at two poses inside the Panda's joint limits and at a near-singular one
 // beyond them, each row with the range of the tool Jacobian's condition number over the
 // window (sigma_max / sigma_min of its 6 x 7 [m/s; rad/s] rows, as the solve uses it).
 #include <joint_load_estimator/dynamics.hpp>
@@ -197,14 +197,15 @@ struct Scenario {
 };
 
 // The poses the Panda moves about (ContactScene::center; 0.3 rad of motion keeps the
-// first two inside every joint limit), and the historic one beyond joints 4 and 6's.
+// first two inside every joint limit), and ContactScene's own, near-singular, beyond
+// joints 4 and 6's limits.
 struct Pose {
   const char* name;
-  std::vector<double> q;  // empty: ContactScene's historic pose
+  std::vector<double> q;  // empty: ContactScene's own pose
 };
 const Pose kPoses[] = {{"ready", {0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785}},
                        {"reach", {0.5, 0.3, -0.4, -1.8, 0.6, 2.2, -0.5}},
-                       {"near-singular (before issue 40)", {}}};
+                       {"near-singular", {}}};
 
 struct Errors {
   double force2 = 0.0, moment2 = 0.0;

@@ -618,8 +618,8 @@ std::vector<Quad> quadWeights(const std::vector<double>& t, int order, double st
   return c;
 }
 
-/// The bank's weights as they were before this sweep found them wanting: normal
-/// equations V^T V solved by LDLT (the code of differentiation.hpp up to this change).
+/// The weights by the normal equations, for comparison with the bank's QR: normal
+/// equations V^T V solved by LDLT.
 std::vector<double> normalEquationWeights(const std::vector<double>& t, int order, double stamp) {
   using Matrix = Eigen::MatrixXd;
   const int w = static_cast<int>(t.size()), n = order + 1;
@@ -649,8 +649,8 @@ void shortIntervalSweep() {
       "partial messages can produce). Error of qdd over 400 samples against the same fit "
       "computed in quad precision from the same (double) samples, divided by the error "
       "that rounding the samples alone causes (eps sum |c_k q_k|, c the exact weights): 1 "
-      "is as accurate as the inputs allow. *before*: the weights by the normal equations "
-      "(LDLT of V^T V, the code until this sweep); *after*: the bank (Householder QR of "
+      "is as accurate as the inputs allow. *normal equations*: the weights by the normal "
+      "equations (LDLT of V^T V), for comparison; *QR*: the bank (Householder QR of "
       "V). *inherent, 3-point*: the error of the 3-point difference that the samples' "
       "rounding causes, in rad/s^2 (a short interval amplifies it whatever the method). "
       "*Kalman*: the worst |qdd - 1.4| [rad/s^2] of the constant-acceleration and "
@@ -662,8 +662,8 @@ void shortIntervalSweep() {
                                             {"SG 7/5 centred", savitzkyGolay(7, 5, 3)}};
   t.header = {"d [s]"};
   for (const NamedFilter& f : filters) {
-    t.header.push_back(f.name + " before");
-    t.header.push_back("after");
+    t.header.push_back(f.name + " normal equations");
+    t.header.push_back("QR");
   }
   t.header.push_back("inherent, 3-point [rad/s^2]");
   t.header.push_back("bound after");
@@ -1088,12 +1088,12 @@ const char* kStaticFindings =
   taken literally (world coordinates, lever arms from world positions) loses about
   log10(D / link size) digits of the moments: 1e-8 relative at 1e5 m in double, nothing
   left in float. The same happens to tiny links on a base 1 m from the world origin.
-- The least-squares weights of the Savitzky-Golay and finite-difference filters were
+- The least-squares weights of the Savitzky-Golay and finite-difference filters, if
   computed by the normal equations, which square the conditioning of the Vandermonde
   matrix: with one short interval among 1 ms ones (two nearly simultaneous samples),
-  the 3-point difference lost up to 6 digits more than its inputs allow. They now come
-  from a Householder QR factorisation and stay within a factor 1.1 of the inputs'
-  rounding.
+  the 3-point difference loses up to 6 digits more than its inputs allow (the table
+  below). The bank's come from a Householder QR factorisation and stay within a factor
+  1.1 of the inputs' rounding.
 - Absolute stamps (Unix time, 1.8e9 s) are rounded to 2.4e-7 s before any filter sees
   them, which at 1 kHz is a timing error of 2.4e-4 of the interval: the 3-point qdd of a
   1 rad, 1 Hz sine moves by 1.5 rad/s^2. Nothing inside the filter can undo a rounding
