@@ -238,7 +238,7 @@ bool DifferentiatorBank::takeSmoothed(bool ready) {
 }
 
 bool DifferentiatorBank::autoBandwidth() const {
-  return config_.type == DifferentiatorType::kKalman && config_.auto_bandwidth && config_.lag > 0.0;
+  return config_.type == DifferentiatorType::kKalman && config_.auto_bandwidth;
 }
 
 void DifferentiatorBank::chooseNoise(double dt) {
@@ -248,11 +248,12 @@ void DifferentiatorBank::chooseNoise(double dt) {
 }
 
 void DifferentiatorBank::setBandwidth(double f, double dt) {
-  f = std::max(f, kLagFloor / config_.lag);
+  if (smoothing()) f = std::max(f, kLagFloor / config_.lag);
   const double h = spacing_ > 0.0 ? spacing_ : dt;
   const double r = config_.measurement_noise;
   const double q = r * r * h * std::pow(2.0 * M_PI * f, 2 * n_);
-  setProcessNoise(raise_only_ ? std::max(q, default_q_) : q);
+  // The causal filter only ever raises its bandwidth: lowered, its lag grows with it.
+  setProcessNoise(raise_only_ || !smoothing() ? std::max(q, default_q_) : q);
   auto_bandwidth_ = bandwidthOf(config_.process_noise, h);
 }
 
