@@ -71,6 +71,8 @@ class DifferentiatorBank {
   void finish();
   bool next();
 
+  /// A fresh start: as constructed (auto_bandwidth: the spectra and the process noise
+  /// too, so that a jump of time restarts as a new filter would).
   void reset();
 
  private:
@@ -346,6 +348,9 @@ class DifferentiatorBank {
   double spacing_ = 0.0;
   double auto_bandwidth_ = 0.0;               // [Hz] auto_bandwidth: the spectrum's (0: none yet)
   double default_q_ = processNoise(config_);  // auto_bandwidth: the least process noise
+  double initial_q_ = config_.process_noise;  // auto_bandwidth: as configured (reset())
+  int spectral_channels_ = 0;                 // auto_bandwidth: chooseBandwidthFrom's
+  bool spectra_used_ = false;                 // auto_bandwidth: a sample since the last reset
   bool raise_only_ = false;  // auto_bandwidth: never below process_noise's (raiseOnly)
   SmallMatrix backward_gain_;
   // Per remembered sample (column: slot index % ring_size_): the filtered state

@@ -80,6 +80,12 @@ void DifferentiatorBank::reset() {
   recent_count_ = 0;
   spacing_ = 0.0;
   for (DifferentiatorBank& s : smoother_) s.reset();
+  if (autoBandwidth() && spectra_used_) {
+    spectra_used_ = false;
+    auto_bandwidth_ = 0.0;
+    setProcessNoise(initial_q_);
+    chooseBandwidthFrom(spectral_channels_);  // fresh spectra (allocates: a jump is rare)
+  }
   resetFilter();
 }
 
@@ -147,13 +153,14 @@ bool DifferentiatorBank::emitCarry() {
 
 double DifferentiatorBank::bandwidth() const {
   if (autoBandwidth() && auto_bandwidth_ > 0.0) return auto_bandwidth_;
-  if (autoBandwidth()) return spacing_ > 0.0 ? bandwidthOf(config_.process_noise, spacing_) : 0.0;
+  if (autoBandwidth()) return spacing_ > 0.0 ? bandwidthOf(processNoise(config_), spacing_) : 0.0;
   if (delegating() && spectral_.bandwidth() > 0.0) return spectral_.bandwidth();
   return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
 }
 
 void DifferentiatorBank::chooseBandwidthFrom(int channels) {
   if (autoBandwidth()) {
+    spectral_channels_ = channels;
     spectral_ = SpectralCutoff(std::min(channels, channels_), config_.min_bandwidth,
                                config_.max_bandwidth, SpectralCutoff::Rule::kNoiseFloor);
     probe_ =
@@ -258,6 +265,7 @@ void DifferentiatorBank::setBandwidth(double f, double dt) {
 }
 
 void DifferentiatorBank::addSpectra(double t, const double* x, double dt) {
+  spectra_used_ = true;
   if (spectral_.add(t, x, state_.data() + 1, n_)) chooseNoise(dt);
   if (spectral_.cutoff() > 0.0 || auto_bandwidth_ > 0.0) return;
   if (probe_.add(t, x, state_.data() + 1, n_) && probe_.fallsThroughout())
