@@ -153,7 +153,8 @@ bool DifferentiatorBank::emitCarry() {
 
 double DifferentiatorBank::bandwidth() const {
   if (autoBandwidth() && auto_bandwidth_ > 0.0) return auto_bandwidth_;
-  if (autoBandwidth()) return spacing_ > 0.0 ? bandwidthOf(processNoise(config_), spacing_) : 0.0;
+  const double h = spacing_ > 0.0 ? spacing_ : dt_prev_;  // the causal filter: the last interval
+  if (autoBandwidth()) return h > 0.0 ? bandwidthOf(processNoise(config_), h) : 0.0;
   if (delegating() && spectral_.bandwidth() > 0.0) return spectral_.bandwidth();
   return bandwidths_.empty() ? 0.0 : bandwidths_[selection_.selected()];
 }
@@ -251,6 +252,11 @@ bool DifferentiatorBank::autoBandwidth() const {
 void DifferentiatorBank::chooseNoise(double dt) {
   if (!(spectral_.cutoff() > 0.0)) return;
   if (spectral_.blocks() < 2 && spectral_.atHighest() && !spectral_.fallsThroughout()) return;
+  // The causal filter of positions takes only a spectrum without a floor (data without
+  // noise: the highest); a crossing (noisy impacts) costs it more noise than its lag gains
+  // (accuracy study, positions only: arm_impact_200hz 3.87 -> 4.88 N m, overshoot 85 ->
+  // 315 %). That of the measured velocities (raiseOnly) takes it.
+  if (!smoothing() && !raise_only_ && !spectral_.fallsThroughout()) return;
   setBandwidth(spectral_.cutoff(), dt);
 }
 
