@@ -27,8 +27,9 @@ enum class KalmanModel : std::uint8_t {
   kConstantJerk,          ///< state (x, x', x'', x'''), white noise on x''''
 };
 
-/// The default is what the node runs (config/default.yaml): the constant-jerk Kalman
-/// filter, its default process noise 1e4 (processNoise()), measurement noise 1e-4 rad. The adaptive
+/// The node's default (config/default.yaml) is defaultDifferentiator() (config.hpp): the
+/// constant-jerk Kalman filter, its default process noise 1e4 (processNoise()), measurement
+/// noise 1e-4 rad, auto_bandwidth. The adaptive
 /// filter is an option: better on the accuracy study's scenes of real logs, worse on clean ones,
 /// and its noise gain understates the q'' noise (docs/how_it_works.md "Differentiators").
 struct DifferentiatorConfig {
@@ -66,7 +67,11 @@ struct DifferentiatorConfig {
   /// of the rate, averaged to 500 Hz); as the process noise r^2 h (2 pi f)^(2n) (r
   /// measurement_noise, h the recent interval: the smoother's gain is 1/2 at f, as the
   /// zero-phase Butterworth of order n's at its cutoff), process_noise until the first
-  /// choice. false: process_noise throughout.
+  /// choice. Without a lag (the causal filter) alike, but the bandwidth only ever raised
+  /// above process_noise's, never lowered (its lag would grow with it), no lag floor, and
+  /// for positions only where the spectrum shows no floor (DifferentiatorBank::raiseOnly:
+  /// a rate's filter takes the crossing too).
+  /// false: process_noise throughout.
   bool auto_bandwidth = false;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
   /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position

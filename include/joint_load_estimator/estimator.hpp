@@ -77,8 +77,8 @@ class Estimator {
   /// How many coordinates take their q-dot from the measured velocities.
   int velocitiesUsed() const;
   /// Whether the measured velocities are the better evidence of the rates: true but where
-  /// the filter sets its bandwidth from the data (differentiator.auto_bandwidth, the
-  /// smoothed stream) and both spectra have chosen; there, where the velocities' noise
+  /// a smoother (lag > 0) sets its bandwidth from the data (differentiator.auto_bandwidth,
+  /// the smoothed stream) and both spectra have chosen; there, where the velocities' noise
   /// floor is below the positions' times (2 pi f)^2, f the positions' bandwidth (at f, the
   /// velocities' share of noise is the smaller). Where it is false, the coordinates of
   /// velocityUsed() take q-dot and q-ddot from the positions too (accuracy study: the

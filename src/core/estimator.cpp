@@ -341,6 +341,9 @@ int Estimator::velocitiesUsed() const {
 }
 
 bool Estimator::velocitiesBetter() const {
+  // The causal filter takes them wherever measured (accuracy study, the immediate default
+  // with this rule: panda 0.049 -> 0.063 N m, the positions chosen over the velocities).
+  if (!(config_.differentiator.lag > 0.0)) return true;
   if (!(bank_.spectralCutoff() > 0.0) || !(velocity_bank_.spectralCutoff() > 0.0)) return true;
   const double f = bank_.bandwidth();
   const double floor_q = bank_.noiseFloor(), floor_v = velocity_bank_.noiseFloor();

@@ -303,7 +303,9 @@ TEST(NeverSilent, AbsurdWrenchesAreRefusedAndImplausibleLoadsFlagged) {
 
 // Loads that are not finite are never published: the filters restart, the message is
 // counted 'non-finite loads', and the loads come back finite. (The door is opened wide
-// here so that an absurd position reaches the filters.)
+// here so that an absurd position reaches the filters.) 1.5 s: the restarted filter
+// sets its bandwidth anew (auto_bandwidth, 0.5 s after the restart) before it forgets the
+// restart (the last 0.1 s of 1 s: 9.9e-9 N m from the clean run; of 1.5 s: 9.1e-11).
 TEST(NeverSilent, NonFiniteLoadsAreNeverPublished) {
   const jle::Model<double> model = ur5();
   jle::Settings settings;
@@ -313,7 +315,7 @@ TEST(NeverSilent, NonFiniteLoadsAreNeverPublished) {
   const double factor = settings.plausibility.effort_factor;
   int published_after = 0, flagged = 0;
   double worst_late = 0.0;  // the last 100 records against the clean run's
-  for (int k = 0; k < 1000; ++k) {
+  for (int k = 0; k < 1500; ++k) {
     std::vector<double> position = positions(1e-3 * k);
     const Stamp stamp = kStart + k * kMs;
     const Outcome reference =
@@ -333,7 +335,7 @@ TEST(NeverSilent, NonFiniteLoadsAreNeverPublished) {
       }
     }
     published_after += k > 200;
-    if (k >= 900 && reference == Outcome::kPublished)
+    if (k >= 1400 && reference == Outcome::kPublished)
       for (std::size_t i = 0; i < r.effort.size(); ++i)
         worst_late = std::max(worst_late, std::abs(r.effort[i] - clean.record().effort[i]));
   }
@@ -461,7 +463,11 @@ double medianError(const jle::Model<double>& model, const Records& r) {
 // merge, (c) fed as every message a sample with the other half held.
 TEST(NeverSilent, SplitPublishersAreMergedIntoOneSamplePerInstant) {
   const jle::Model<double> model = ur5();
-  const jle::Settings settings;
+  // The filter's bandwidth fixed: by default it is raised on these noise-free positions
+  // (auto_bandwidth) until the 2 ms staleness of the arm's positions in (c), not the
+  // filter, sets (c)'s error (measured 0.0361 N m against 0.0053 for (a)).
+  jle::Settings settings;
+  settings.estimator.differentiator.auto_bandwidth = false;
   const std::vector<std::string>& all = model.coordinate_names;
   const std::vector<std::string> arm = part(all, 0, 3), wrist = part(all, 3, 6);
   jle::Pipeline pa(model, settings, nullptr), pb(model, settings, nullptr),
