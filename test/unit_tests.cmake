@@ -65,6 +65,8 @@ jle_add_unit_test(test_sensor_bias unit/test_sensor_bias.cpp)
 jle_add_unit_test(test_pipeline unit/test_pipeline.cpp)
 # The message path's frame resolver against a fake frame source and the URDF's numbers.
 jle_add_unit_test(test_frame_resolver unit/test_frame_resolver.cpp)
+# The time axis of the message path: jumps, rogue stamps, order, ns round trip.
+jle_add_unit_test(test_timeline unit/test_timeline.cpp)
 jle_add_unit_test(test_never_silent unit/test_never_silent.cpp)
 jle_add_unit_test(test_sample_clock unit/test_sample_clock.cpp)
 # The estimator's parts, each against closed forms.

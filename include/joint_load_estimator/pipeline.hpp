@@ -13,6 +13,7 @@
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>
 #include <joint_load_estimator/sample_clock.hpp>
+#include <joint_load_estimator/timeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <Eigen/Core>
@@ -283,11 +284,11 @@ class Pipeline {
   std::string stoppingInputs() const;
   /// Whether the last message reset the filters (a confirmed jump of time, back or
   /// forward, or the clock going back), and from when to when [ns].
-  bool jumped() const { return jumped_; }
-  Stamp jumpFrom() const { return jump_from_; }
-  Stamp jumpTo() const { return jump_to_; }
+  bool jumped() const { return timeline_.jumped(); }
+  Stamp jumpFrom() const { return timeline_.jumpFrom(); }
+  Stamp jumpTo() const { return timeline_.jumpTo(); }
   /// Whether that jump went forward (stamps far ahead, confirmed), not back.
-  bool jumpedForward() const { return jumped_ && jump_from_ != 0 && jump_to_ > jump_from_; }
+  bool jumpedForward() const { return timeline_.jumpedForward(); }
 
   /// The immediate stream's record: the loads of the last joint state that returned
   /// kPublished (or of flush(), takeDrained()).
@@ -347,15 +348,15 @@ class Pipeline {
   /// The external-effort estimator (external_effort/enabled), or null.
   const ExternalEffort* externalEffort() const { return external_.get(); }
   /// The joint-state stream's sample clock (stamps/regularize).
-  const SampleClock& sampleClock() const { return clock_; }
+  const SampleClock& sampleClock() const { return timeline_.sampleClock(); }
   const Model<double>& model() const { return estimator_.model(); }
   /// The stamp [ns] of the estimator's time t [s].
   Stamp absolute(double t) const;
   /// The origin of the estimator's time axis [ns]: the first stamp after the start, after
   /// a reset, or after a stamp more than 2^52 ns (52 days) away from the previous origin.
   /// None until a message has been taken.
-  bool hasTimeOrigin() const { return have_ref_; }
-  Stamp timeOrigin() const { return time_ref_; }
+  bool hasTimeOrigin() const { return timeline_.hasOrigin(); }
+  Stamp timeOrigin() const { return timeline_.origin(); }
 
   /// Wrench input k's last resolved frame (the frame of its sensor residual), or empty.
   const std::string& wrenchFrame(int k) const { return frame_resolver_.wrenchFrame(k); }
@@ -403,17 +404,15 @@ class Pipeline {
   };
 
   static std::size_t ix(int k) { return static_cast<std::size_t>(k); }
-  double relative(Stamp stamp);
   Outcome count(InputKind kind, Outcome outcome);
   Outcome fail(InputKind kind, Outcome outcome, const std::string& why);
   bool movesNeeded() const;
-  void anchor(Stamp stamp);
-  bool clockWentBack(Stamp stamp, Stamp clock);
-  void resetTimeline(Stamp stamp);
-  void resetTimeline(Stamp from, Stamp stamp);  // reported as a jump from `from`
-  Outcome checkJointStamp(Stamp stamp, Stamp clock);
-  Outcome checkInputStamp(InputKind kind, const std::string& input, double timeout, Stamp stamp,
-                          Stamp clock);
+  // A message's stamp as the timeline found it: kUsed to go on (after a jump, the filters
+  // reset first), or the rogue stamp counted.
+  Outcome stampOutcome(InputKind kind, StampVerdict verdict);
+  // A jump of time: what holds the old timeline's samples taken or forgotten, then the
+  // timeline restarted.
+  void resetTimeline();
   bool checkJointState(const std::vector<std::string>& names, const std::vector<double>& position,
                        const std::vector<double>& velocity, const std::vector<double>& effort);
   void mapJointState(const std::vector<std::string>& names, const std::vector<double>& position,
@@ -469,6 +468,7 @@ class Pipeline {
   Settings settings_;
   Estimator estimator_;
   FrameResolver frame_resolver_;
+  Timeline timeline_;
   std::unique_ptr<ExternalEffort> external_;  // external_effort/enabled
   std::vector<double> external_variance_;     // the model efforts' variances, per joint
   JointStateMap joints_;
@@ -482,28 +482,13 @@ class Pipeline {
   std::vector<WrenchInput> wrenches_;
   std::vector<PlateInput> plates_;
   double body_mass_ = 0.0;  // [kg] effort_per_kg divisor; 0: none
-  // The time axis: seconds since the first stamp seen after the start or a reset (a
-  // double holds epoch seconds only to 2.4e-7 s).
-  Stamp time_ref_ = 0;
-  bool have_ref_ = false;
-  bool axis_used_ = false;  // a time on the axis was handed out (relative) since its origin
-  Stamp last_stamp_ = 0;    // last joint state taken (0 after a reset)
-  Stamp last_clock_ = 0;
-  Stamp last_taken_clock_ = 0;  // the clock when the last joint state was taken
-  SampleClock clock_;           // the joint-state stream's
   bool joints_stamped_ = false;
-  // Joint states on another timeline, in a row: the last one's stamp and how many.
-  Stamp pending_stamp_ = 0;
-  int pending_ = 0;
-  int clock_back_ = 0;  // joint states taken since the clock went back that it confirms
   // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
   std::vector<Sample> ring_;
   std::size_t ring_head_ = 0, ring_count_ = 0;
   std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
   std::string mimic_contradiction_;
   bool any_needed_ = false;  // the loads need at least one coordinate
-  bool jumped_ = false;
-  Stamp jump_from_ = 0, jump_to_ = 0;
   // Plausibility: per coordinate its joint's segment (limits), the joint states refused
   // in a row for moving too fast, and the velocities with the implausible ones as NaN.
   std::vector<int> coordinate_segment_;

@@ -20,7 +20,6 @@ namespace {
 // any Savitzky-Golay delay; a smoother grows the ring to its own (remember()).
 constexpr std::size_t kRing = 128;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr Stamp kReach = Stamp{1} << 52;  // [ns] of the time axis around its origin
 
 bool allFinite(const std::vector<double>& v, std::size_t& bad) {
   for (std::size_t i = 0; i < v.size(); ++i)
@@ -31,22 +30,9 @@ bool allFinite(const std::vector<double>& v, std::size_t& bad) {
   return true;
 }
 
-std::string seconds(Stamp stamp) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9f", static_cast<double>(stamp) * 1e-9);
-  return text;
-}
-
-// Stamp 0 on an input that has never had a stamp (a live driver that stamps nothing) is
-// the clock; on one that has, it is dropped: a bag's missing stamp is no reception time.
-bool zeroStamp(bool& stamped, Stamp& stamp, Stamp clock) {
-  if (stamp != 0) {
-    stamped = true;
-    return true;
-  }
-  if (stamped) return false;
-  stamp = clock;
-  return true;
+// A stamp out of order, in the words of the estimator's refusals.
+SampleStatus sampleStatus(StampVerdict order) {
+  return order == StampVerdict::kDuplicate ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder;
 }
 
 const char* const kZeroStamp = ": stamp 0 on a stream that has had stamps: dropped";
@@ -155,11 +141,11 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     : settings_(checkedSettings(model, settings)),
       estimator_(model, settings_.estimator),
       frame_resolver_(estimator_.model(), settings_, frames),
+      timeline_(settings_),
       joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints),
               settings_.plausibility.mimic_tolerance),
       wrenches_(settings_.estimator.wrenches.size()),
       plates_(settings_.estimator.plates.size()),
-      clock_(settings_.stamps.regularize == StampRegularize::kAuto),
       ring_(kRing) {
   const Model<double>& m = estimator_.model();
   record_.segment = publishedSegments(m, settings_.estimator.joints);
@@ -241,17 +227,6 @@ void Pipeline::fillExternal() {
   record_.contact_link = external_->contactLink();
 }
 
-void Pipeline::anchor(Stamp stamp) {
-  // The time axis resolves 1 ns within 2^52 ns (52 days) of its origin: a stamp farther
-  // away starts it again, but only while no time on it has been handed out since the
-  // start or the last reset. Under the estimator's samples a new origin would turn time
-  // back, and every later sample would be refused as out of order; on the axis kept,
-  // times beyond the reach stay in order and lose resolution slowly (2 ns to 104 days).
-  if (have_ref_ && (axis_used_ || std::abs(stamp - time_ref_) <= kReach)) return;
-  time_ref_ = stamp;
-  have_ref_ = true;
-}
-
 std::string Pipeline::smoothedBandwidthBound() const {
   if (!smoothed_) return "";
   const Estimator& e = smoothed_->estimator;
@@ -272,15 +247,9 @@ std::string Pipeline::smoothedBandwidthBound() const {
   return text;
 }
 
-double Pipeline::relative(Stamp stamp) {
-  anchor(stamp);
-  axis_used_ = true;
-  return static_cast<double>(stamp - time_ref_) * 1e-9;
-}
-
 Stamp Pipeline::absolute(double t) const {
   const Sample* s = sampleAt(t);
-  return s ? s->stamp : time_ref_ + static_cast<Stamp>(std::llround(t * 1e9));
+  return s ? s->stamp : timeline_.absolute(t);
 }
 
 Outcome Pipeline::count(InputKind kind, Outcome outcome) {
@@ -293,20 +262,13 @@ Outcome Pipeline::fail(InputKind kind, Outcome outcome, const std::string& why) 
   return count(kind, outcome);
 }
 
-bool Pipeline::clockWentBack(Stamp stamp, Stamp clock) {
-  // The clock and the stamps come on different connections, so the clock may go back
-  // one message after the stamps did (or before): a clock going back is a jump only
-  // while the stamps do not go forward, else one jump would reset twice; going back
-  // first, it confirms the stamps' jump back when they follow.
-  const bool back = last_clock_ != 0 && clock < last_clock_;
-  last_clock_ = clock;
-  if (back) clock_back_ = settings_.stamps.jump_confirm;
-  return back && !(stamp > last_stamp_);
+Outcome Pipeline::stampOutcome(InputKind kind, StampVerdict verdict) {
+  if (verdict == StampVerdict::kRogue) return count(kind, Outcome::kRogueStamp);
+  if (verdict == StampVerdict::kJump) resetTimeline();
+  return Outcome::kUsed;
 }
 
-void Pipeline::resetTimeline(Stamp stamp) { resetTimeline(last_stamp_, stamp); }
-
-void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
+void Pipeline::resetTimeline() {
   // A looping bag (rosbag play -l), a restarted simulation, a driver's clock set: the
   // filters' memory belongs to another timeline, and so does the time axis. An instant
   // still waiting for a publisher is taken first, on its own timeline.
@@ -316,9 +278,6 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
     stashed_ = stashed_smoothed_ = false;
   }
   held_t_ = -1e300;
-  jumped_ = true;
-  jump_from_ = from;
-  jump_to_ = stamp;
   drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
@@ -326,69 +285,10 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   if (smoothed_) smoothed_->settle.restarted = true;
   implausible_run_ = 0;
   if (external_) external_->reset();
-  clock_.reset();
   ring_count_ = 0;
-  last_stamp_ = 0;
-  have_ref_ = axis_used_ = false;
-  pending_ = clock_back_ = 0;
+  timeline_.restart();
   ++counters_.resets;
-  if (jumpedForward()) ++counters_.forward_jumps;
-}
-
-Outcome Pipeline::checkJointStamp(Stamp stamp, Stamp clock) {
-  constexpr InputKind kind = InputKind::kJointState;
-  if (clockWentBack(stamp, clock)) resetTimeline(stamp);
-  if (last_stamp_ == 0) {
-    // The first joint state of the timeline, on an axis whose origin the wrenches or
-    // plates set (and used) more than its reach away: their clock is another one (a
-    // simulation's from 0 beside a wall clock). Kept, the axis would resolve these stamps
-    // to no better than its rounding there (240 ns at 54 years) and take samples a few ns
-    // apart for duplicates; the timeline restarts from the joint states, their readings
-    // before it left behind (one warning, a jump in the diagnostics).
-    if (axis_used_ && std::abs(stamp - time_ref_) > kReach) resetTimeline(time_ref_, stamp);
-    return Outcome::kUsed;
-  }
-  const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
-  const double threshold = settings_.time_jump_threshold;
-  // Forward, a gap of 10 periods is no jump either (a slow stream).
-  const double forward = std::max(threshold, 10e-9 * clock_.period());
-  // A gap that the clock saw as well (a driver or a bag paused) keeps the stream's lag
-  // behind the clock: no jump either.
-  const double lag = static_cast<double>((stamp - clock) - (last_stamp_ - last_taken_clock_));
-  if ((ahead >= -threshold && ahead <= forward) ||
-      (ahead > 0.0 && std::abs(lag) * 1e-9 <= threshold)) {
-    pending_ = 0;
-    return Outcome::kUsed;
-  }
-  // On another timeline: a jump once jump_confirm in a row agree (in order, each within
-  // `forward` of the one before), or at once back after the clock went back.
-  const bool follows = pending_ > 0 && stamp > pending_stamp_ &&
-                       static_cast<double>(stamp - pending_stamp_) * 1e-9 <= forward;
-  pending_ = follows ? pending_ + 1 : 1;
-  pending_stamp_ = stamp;
-  if (pending_ >= settings_.stamps.jump_confirm || (ahead < 0.0 && clock_back_ > 0)) {
-    resetTimeline(stamp);
-    return Outcome::kUsed;
-  }
-  return fail(kind, Outcome::kRogueStamp,
-              settings_.joint_states_topic + ": stamp " + seconds(stamp) + " is " +
-                  std::to_string(ahead) + " s from the stream's (" + seconds(last_stamp_) +
-                  "): dropped (a jump of time takes " +
-                  std::to_string(settings_.stamps.jump_confirm) + " in a row)");
-}
-
-Outcome Pipeline::checkInputStamp(InputKind kind, const std::string& input, double timeout,
-                                  Stamp stamp, Stamp clock) {
-  if (clockWentBack(stamp, clock)) resetTimeline(stamp);
-  if (last_stamp_ == 0) return Outcome::kUsed;  // no joint state on this timeline yet
-  // The joint states may lag a reading that is on time by a few periods (a sensor whose
-  // readings arrive before the joint states of their time): ten are allowed.
-  const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
-  if (ahead <= timeout + 1e-8 * clock_.period() && ahead >= -settings_.time_jump_threshold)
-    return Outcome::kUsed;
-  return fail(kind, Outcome::kRogueStamp,
-              input + ": stamp " + seconds(stamp) + " is " + std::to_string(ahead) +
-                  " s from the joint states' (" + seconds(last_stamp_) + "): dropped");
+  if (timeline_.jumpedForward()) ++counters_.forward_jumps;
 }
 
 bool Pipeline::checkJointState(const std::vector<std::string>& names,
@@ -479,7 +379,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   nonfinite_velocity_.clear();
   mimic_contradiction_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
-  jumped_ = false;
+  timeline_.clearJump();
   // Neither a sample nor a time: its stamp and clock are not the stream's.
   if (!movesNeeded()) {
     mapJointState(names, position, velocity, effort);
@@ -487,24 +387,26 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
                 settings_.joint_states_topic +
                     ": a message with none of the joints the loads need: not a sample");
   }
-  if (!zeroStamp(joints_stamped_, stamp, clock))
+  if (!Timeline::zeroStamp(joints_stamped_, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, settings_.joint_states_topic + kZeroStamp);
-  const Outcome timeline = checkJointStamp(stamp, clock);
+  const Outcome timeline = stampOutcome(
+      kind, timeline_.checkJointStamp(stamp, clock, settings_.joint_states_topic, problem_));
   if (timeline != Outcome::kUsed) return timeline;
   // The order before anything is stored: a message of an instant already taken, or older
   // than the one being assembled, is dropped whole.
   const bool joins = joinsGroup(stamp);
-  const Stamp newest = std::max(last_stamp_, group_.open && !joins ? group_.newest : Stamp{0});
-  if (newest != 0 && stamp <= newest)
-    return fail(
-        kind, Outcome::kOrder,
-        settings_.joint_states_topic + ": " +
-            toString(stamp == newest ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder) + " " +
-            seconds(stamp) + " (previous " + seconds(newest) + "): message dropped");
+  const Stamp assembling = group_.open && !joins ? group_.newest : Stamp{0};
+  const StampVerdict order = timeline_.order(stamp, assembling);
+  if (order != StampVerdict::kOnTime)
+    return fail(kind, Outcome::kOrder,
+                settings_.joint_states_topic + ": " + toString(sampleStatus(order)) + " " +
+                    secondsText(stamp) + " (previous " +
+                    secondsText(std::max(timeline_.lastStamp(), assembling)) +
+                    "): message dropped");
   if (!plausibleJointState(stamp, names, position)) return count(kind, Outcome::kImplausible);
   if (group_.open && !joins) closeGroup();  // a later instant: the open one is complete as is
   mapJointState(names, position, plausibleVelocities(names, velocity), effort);
-  anchor(stamp);
+  timeline_.anchor(stamp);
   group_.oldest = group_.open ? std::min(group_.oldest, stamp) : stamp;
   group_.newest = group_.open ? std::max(group_.newest, stamp) : stamp;
   group_.has_effort = (group_.open && group_.has_effort) || !effort.empty();
@@ -617,13 +519,13 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   constexpr InputKind kind = InputKind::kJointState;
   const auto order = [&](SampleStatus status) {
     return fail(kind, Outcome::kOrder,
-                settings_.joint_states_topic + ": " + toString(status) + " " + seconds(stamp) +
-                    " (previous " + seconds(last_stamp_) + "): message dropped");
+                settings_.joint_states_topic + ": " + toString(status) + " " + secondsText(stamp) +
+                    " (previous " + secondsText(timeline_.lastStamp()) + "): message dropped");
   };
   // The order of the stamps, not of the instants (which the sample clock makes increase).
-  if (last_stamp_ != 0 && stamp <= last_stamp_)
-    return order(stamp == last_stamp_ ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder);
-  const double t = relative(clock_.add(stamp));
+  const StampVerdict in_order = timeline_.order(stamp);
+  if (in_order != StampVerdict::kOnTime) return order(sampleStatus(in_order));
+  const double t = timeline_.sampleTime(stamp);
   const SampleStatus status =
       estimator_.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
   noteStart(settle_, status, t);
@@ -635,9 +537,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
                   settings_.joint_states_topic + ": non-finite stamp or base pose: dropped");
     default: break;
   }
-  last_stamp_ = stamp;
-  last_taken_clock_ = last_clock_;
-  if (clock_back_ > 0) --clock_back_;
+  timeline_.taken(stamp);
   remember(t, stamp, has_effort);
   countHeld(t);
   if (smoothed_) sampleSmoothed(t, base);
@@ -649,7 +549,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   if (!finiteLoads(record_)) {
     restartFilters(false);  // what made them not finite is in the filters' state
     return fail(kind, Outcome::kNonFinite,
-                settings_.joint_states_topic + ": the loads at " + seconds(stamp) +
+                settings_.joint_states_topic + ": the loads at " + secondsText(stamp) +
                     " are not finite: not published, the filters restart");
   }
   return count(kind, Outcome::kPublished);
@@ -935,7 +835,8 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   const PlausibilityConfig& p = settings_.plausibility;
   const Model<double>& m = model();
   const std::vector<int>& coordinate = joints_.coordinates();  // bound by checkJointState
-  const double dt = last_stamp_ != 0 ? 1e-9 * static_cast<double>(stamp - last_stamp_) : -1.0;
+  const Stamp last = timeline_.lastStamp();
+  const double dt = last != 0 ? 1e-9 * static_cast<double>(stamp - last) : -1.0;
   bool too_fast = false;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const int c = coordinate[i];
@@ -1066,12 +967,13 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   if (frame.empty())
     return fail(kind, Outcome::kFrame,
                 "wrench '" + topic + "': empty header.frame_id and no 'frame' configured: dropped");
-  jumped_ = false;
-  if (!zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
+  timeline_.clearJump();
+  if (!Timeline::zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, "wrench '" + topic + "'" + kZeroStamp);
   // The stamps first, as for a joint state: the clock is followed whatever the values.
-  const Outcome timeline = checkInputStamp(
-      kind, "wrench '" + topic + "'", settings_.estimator.wrenches[ix(k)].timeout, stamp, clock);
+  const Outcome timeline = stampOutcome(
+      kind, timeline_.checkInputStamp(stamp, clock, settings_.estimator.wrenches[ix(k)].timeout,
+                                      "wrench '" + topic + "'", problem_));
   if (timeline != Outcome::kUsed) return timeline;
   if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
     return count(kind, Outcome::kImplausible);
@@ -1083,12 +985,12 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   const Eigen::Isometry3d& X = frame_resolver_.wrenchPose(k);
   Eigen::Vector3d f_link, m_link;
   wrenchInLink(X.linear(), X.translation(), f, m, f_link, m_link);
-  const double t = relative(stamp);
+  const double t = timeline_.relative(stamp);
   if (smoothed_) smoothed_->estimator.addWrench(k, t, f_link, m_link);  // the same order
   if (!estimator_.addWrench(k, t, f_link, m_link))
-    return fail(
-        kind, Outcome::kOrder,
-        "wrench '" + topic + "': stamp " + seconds(stamp) + " not newer than the last: dropped");
+    return fail(kind, Outcome::kOrder,
+                "wrench '" + topic + "': stamp " + secondsText(stamp) +
+                    " not newer than the last: dropped");
   return count(kind, Outcome::kUsed);
 }
 
@@ -1120,20 +1022,21 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
     return fail(
         kind, Outcome::kFrame,
         "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
-  jumped_ = false;
-  if (!zeroStamp(plates_[ix(k)].stamped, stamp, clock))
+  timeline_.clearJump();
+  if (!Timeline::zeroStamp(plates_[ix(k)].stamped, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, "force plate '" + name + "'" + kZeroStamp);
-  const Outcome timeline = checkInputStamp(kind, "force plate '" + name + "'",
-                                           settings_.estimator.plates[ix(k)].timeout, stamp, clock);
+  const Outcome timeline = stampOutcome(
+      kind, timeline_.checkInputStamp(stamp, clock, settings_.estimator.plates[ix(k)].timeout,
+                                      "force plate '" + name + "'", problem_));
   if (timeline != Outcome::kUsed) return timeline;
   if (!plausibleWrench(kind, "force plate '" + name + "'", force, moment))
     return count(kind, Outcome::kImplausible);
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
-  const double t = relative(stamp);
+  const double t = timeline_.relative(stamp);
   if (smoothed_) smoothed_->estimator.addPlateSample(k, t, force, moment);  // the same order
   if (!estimator_.addPlateSample(k, t, force, moment))
     return fail(kind, Outcome::kOrder,
-                "force plate '" + name + "': stamp " + seconds(stamp) +
+                "force plate '" + name + "': stamp " + secondsText(stamp) +
                     " not newer than the last: dropped");
   return count(kind, Outcome::kUsed);
 }
