@@ -67,6 +67,8 @@ jle_add_unit_test(test_pipeline unit/test_pipeline.cpp)
 jle_add_unit_test(test_frame_resolver unit/test_frame_resolver.cpp)
 # The time axis of the message path: jumps, rogue stamps, order, ns round trip.
 jle_add_unit_test(test_timeline unit/test_timeline.cpp)
+# The result record: a delayed estimate's own stamp and efforts; the status bits.
+jle_add_unit_test(test_record_builder unit/test_record_builder.cpp)
 jle_add_unit_test(test_never_silent unit/test_never_silent.cpp)
 jle_add_unit_test(test_sample_clock unit/test_sample_clock.cpp)
 # The estimator's parts, each against closed forms.

@@ -12,6 +12,7 @@
 #include <joint_load_estimator/frame_resolver.hpp>
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/record_builder.hpp>
 #include <joint_load_estimator/sample_clock.hpp>
 #include <joint_load_estimator/timeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
@@ -104,106 +105,9 @@ struct PipelineCounters {
   long count(Outcome outcome) const;
 };
 
-/// Why a record's loads are not to be trusted: LoadsRecord::status holds these bits, 0
-/// (kTrusted) when none applies. The node's JointLoads.status carries the same bits.
-enum LoadsStatus : std::uint8_t {
-  kTrusted = 0,
-  /// Within plausibility/settle_time after the filters (re)started (a start, a jump of
-  /// time, a gap, a retune, a confirmed jump of a position): the filters are settling.
-  kSettling = 1,
-  /// A needed wrench input or force plate was stale at the sample (its stale_policy
-  /// applied: held, read as zero).
-  kStaleInput = 2,
-  /// An effort beyond plausibility/effort_factor times its joint's URDF effort limit.
-  kImplausibleLoad = 4,
-  /// Within plausibility/settle_time of a sample that held a needed joint's position from
-  /// an earlier message (a publisher of split joint states slower than the others, or dead).
-  kHeldJoint = 8,
-};
-
-/// The bits of `status` in words ("settling, stale input"); "trusted" for 0.
-std::string describeStatus(std::uint8_t status);
-
-/// A wrench input (settings.wrenches[k]) as it entered one published sample.
-struct InputRecord {
-  bool stale = false;  ///< stale at the sample (its stale_policy applied)
-  /// A force/torque sensor (sensor_joint set): whether its reading was used (not while it
-  /// is stale with the zero policy), and the reading minus the model's prediction: the
-  /// load the distal side exerts beyond what the model and the other inputs explain (a
-  /// tool's contact, or a bias), in the reading's frame `frame`, moment about its origin,
-  /// the reading's sign [N, N m]. Zero when unused or not a sensor.
-  bool used = false;
-  Wrench<double> residual;
-  std::string frame;  ///< the reading's frame (the input's link when it has none)
-};
-
-/// A force plate (settings.force_plates[k]) as it entered one published sample.
-struct PlateRecord {
-  bool stale = false;  ///< stale at the sample
-  /// Contact, centre of pressure and free moment (plate frame), reaction on the foot.
-  PlateReading reading;
-  std::string frame;  ///< the frame of the centre of pressure (the plate's)
-};
-
-/// The whole result of one published sample, sized at construction (no allocation per
-/// sample): every front end (node, process_bag, joint_loads, the writers) reads this and
-/// nothing else. Index i runs over the published joints.
-struct LoadsRecord {
-  Stamp stamp = 0;                 ///< the stamp of the joint state the loads describe
-  std::vector<std::string> joint;  ///< URDF joint names
-  std::vector<std::string> link;   ///< child link: the frame of force and moment
-  std::vector<int> segment;        ///< model segment of each joint
-  /// Joint wrench (on the child, by the parent), child link frame, moment about the
-  /// joint origin [N], [N m].
-  std::vector<Eigen::Vector3d> force, moment;
-  std::vector<double> effort;           ///< [N m or N] projection on the joint axis
-  std::vector<double> measured_effort;  ///< from the joint state at `stamp`; NaN: none
-  /// With uncertainty enabled: 1-sigma effort [N m or N] and the wrench covariance per
-  /// joint, row-major, 36 numbers (fx fy fz mx my mz), or 6 variances (diagonal_only).
-  std::vector<double> effort_stddev, covariance;
-  std::vector<double> effort_per_kg;  ///< effort / body_mass; empty when not configured
-  /// The q, q-dot, q-ddot the loads were computed from (the filter's estimate at `stamp`,
-  /// a mimic joint's mapped from its leader's) [rad or m, /s, /s^2]; 0 for a fixed joint.
-  std::vector<double> position, velocity, acceleration;
-  /// With settings.friction.enabled: effort + damping velocity + friction tanh(velocity /
-  /// velocity_scale) (friction.hpp) [N m or N]; empty when off.
-  std::vector<double> motor_effort;
-  /// With external_effort/enabled (external_effort.hpp; empty when off): per joint the
-  /// external effort of the configured method, the environment's generalised force on the
-  /// robot [N m or N] (NaN where no effort was measured or the joint does not move), and
-  /// with uncertainty its 1-sigma from external_effort/effort_noise.
-  std::vector<double> external_effort, external_effort_stddev;
-  /// The wrench at each external_effort/contacts link (link frame, about its origin).
-  std::vector<ContactEstimate> contacts;
-  /// Contact detection at this sample: in contact, it started / ended here, its joint
-  /// changed here while it lasts, and the contact's joint (the most distal over its
-  /// threshold, ExternalEffort::contactJoint), with its child link. A contact event (the
-  /// node's ~contact) is a sample where it started, changed or ended.
-  bool in_contact = false, contact_started = false, contact_ended = false, contact_changed = false;
-  std::string contact_joint, contact_link;
-  /// The estimated q, q-dot, q-ddot of every coordinate (model coordinate order) [rad or
-  /// m, /s, /s^2].
-  Eigen::VectorXd q, qd, qdd;
-  /// Per wrench input and per force plate (settings order).
-  std::vector<InputRecord> inputs;
-  std::vector<PlateRecord> plates;
-  /// A floating base: the wrench the model needs at the base beyond every input (root
-  /// link frame, about its origin) [N, N m], zero when the inputs explain the motion (a
-  /// check of the model and the inputs). Zero for a fixed base.
-  Eigen::Vector3d base_force = Eigen::Vector3d::Zero(), base_moment = Eigen::Vector3d::Zero();
-  bool planar = false;             ///< computed by the planar 3x3 path (savings.planar)
-  std::uint8_t status = kTrusted;  ///< LoadsStatus bits: why the loads are not to be trusted
-};
-
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints,
 /// accept_nonphysical_inertia).
 ModelOptions modelOptions(const Settings& settings);
-
-/// Segments whose loads are published: `joints` (URDF names of moving joints, or of
-/// fixed joints kept as segments), or every moving segment when it is empty. Throws
-/// SettingsError naming the joint.
-std::vector<int> publishedSegments(const Model<double>& model,
-                                   const std::vector<std::string>& joints);
 
 class Pipeline {
  public:
@@ -395,13 +299,6 @@ class Pipeline {
     bool has_effort = false;
     bool last_merged = false;
   };
-  // One joint sample entering the filters: its time, stamp and measured efforts.
-  struct Sample {
-    double t = 0.0;
-    Stamp stamp = 0;
-    bool has_effort = false;
-    std::vector<double> effort;
-  };
 
   static std::size_t ix(int k) { return static_cast<std::size_t>(k); }
   Outcome count(InputKind kind, Outcome outcome);
@@ -434,15 +331,12 @@ class Pipeline {
   void unstash(bool immediate_published);
   Outcome staleProblem();
   void remember(double t, Stamp stamp, bool has_effort);
-  void growRing(std::size_t size);
   bool resolvePlatePose(int k, const std::string& frame);
+  // The record of the loads `estimator` (either stream's) published last, with the
+  // external outputs in the immediate stream's record_.
   void fillRecord(const Estimator& estimator, LoadsRecord& rec);
-  void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
-  std::uint8_t statusOf(const Estimator& estimator, double settle_from,
-                        const LoadsRecord& rec) const;
   static void noteStart(Settle& settle, SampleStatus status, double t);
   void countHeld(double t);
-  static bool finiteLoads(const LoadsRecord& rec);
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
   bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
                            const std::vector<double>& position);
@@ -455,9 +349,6 @@ class Pipeline {
   void restartFilters(bool drain);
   void setUpExternal();
   void fillExternal();
-  void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
-                       std::size_t segment);
-  const Sample* sampleAt(double t) const;
   void drainSmoother();
   static bool takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, std::size_t& next);
   void sampleSmoothed(double t, const BasePose* base);
@@ -469,6 +360,7 @@ class Pipeline {
   Estimator estimator_;
   FrameResolver frame_resolver_;
   Timeline timeline_;
+  RecordBuilder builder_;
   std::unique_ptr<ExternalEffort> external_;  // external_effort/enabled
   std::vector<double> external_variance_;     // the model efforts' variances, per joint
   JointStateMap joints_;
@@ -481,11 +373,7 @@ class Pipeline {
   PipelineCounters counters_;
   std::vector<WrenchInput> wrenches_;
   std::vector<PlateInput> plates_;
-  double body_mass_ = 0.0;  // [kg] effort_per_kg divisor; 0: none
   bool joints_stamped_ = false;
-  // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
-  std::vector<Sample> ring_;
-  std::size_t ring_head_ = 0, ring_count_ = 0;
   std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
   std::string mimic_contradiction_;
   bool any_needed_ = false;  // the loads need at least one coordinate
@@ -498,7 +386,6 @@ class Pipeline {
   Group group_;
   bool group_record_ = false;  // record_ holds a closed instant's loads (takeDrained)
   bool stashed_ = false, stashed_smoothed_ = false;  // by stashGroupRecords, this call
-  double held_t_ = -1e300;  // estimator time of the last sample that held a joint
 };
 
 }  // namespace jle

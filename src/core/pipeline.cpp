@@ -1,24 +1,17 @@
 #include <joint_load_estimator/frames.hpp>
-#include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/plausibility.hpp>
-#include <joint_load_estimator/sensor_bias.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
-#include <stdexcept>
 #include <utility>
 
 namespace jle {
 namespace {
 
-// Joint samples remembered (to publish a delayed estimate with its own stamp): more than
-// any Savitzky-Golay delay; a smoother grows the ring to its own (remember()).
-constexpr std::size_t kRing = 128;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool allFinite(const std::vector<double>& v, std::size_t& bad) {
@@ -99,25 +92,6 @@ ModelOptions modelOptions(const Settings& settings) {
   return options;
 }
 
-std::vector<int> publishedSegments(const Model<double>& model,
-                                   const std::vector<std::string>& joints) {
-  if (joints.empty()) return model.moving_segments;
-  std::vector<int> segments;
-  for (const std::string& j : joints) {
-    int segment = -1;
-    for (int s = 1; s < model.nsegments(); ++s) {
-      const JointType type = model.joint_type[static_cast<std::size_t>(s)];
-      if (model.joint_name[static_cast<std::size_t>(s)] == j &&
-          (isMoving(type) || type == JointType::kFixed))
-        segment = s;
-    }
-    if (segment < 0)
-      throw SettingsError("parameter 'joints': '" + j + "' is not a joint of the model");
-    segments.push_back(segment);
-  }
-  return segments;
-}
-
 namespace {
 
 // The link of every force/torque sensor input (sensor_joint set, link empty) is its
@@ -142,46 +116,13 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
       estimator_(model, settings_.estimator),
       frame_resolver_(estimator_.model(), settings_, frames),
       timeline_(settings_),
+      builder_(estimator_.model(), settings_, frame_resolver_, timeline_),
       joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints),
               settings_.plausibility.mimic_tolerance),
+      record_(builder_.sizedRecord()),
       wrenches_(settings_.estimator.wrenches.size()),
-      plates_(settings_.estimator.plates.size()),
-      ring_(kRing) {
+      plates_(settings_.estimator.plates.size()) {
   const Model<double>& m = estimator_.model();
-  record_.segment = publishedSegments(m, settings_.estimator.joints);
-  const std::size_t n = record_.segment.size();
-  for (int s : record_.segment) {
-    record_.joint.push_back(m.joint_name[static_cast<std::size_t>(s)]);
-    record_.link.push_back(m.link_name[static_cast<std::size_t>(s)]);
-  }
-  record_.force.assign(n, Eigen::Vector3d::Zero());
-  record_.moment.assign(n, Eigen::Vector3d::Zero());
-  record_.effort.assign(n, 0.0);
-  record_.measured_effort.assign(n, kNaN);
-  record_.position.assign(n, 0.0);
-  record_.velocity.assign(n, 0.0);
-  record_.acceleration.assign(n, 0.0);
-  if (settings_.friction.enabled) record_.motor_effort.assign(n, 0.0);
-  const UncertaintyConfig& u = settings_.estimator.uncertainty;
-  if (u.enabled) {
-    record_.effort_stddev.assign(n, 0.0);
-    record_.covariance.assign((u.diagonal_only ? 6 : 36) * n, 0.0);
-  }
-  if (settings_.body_mass != 0.0) {
-    body_mass_ = settings_.body_mass > 0.0 ? settings_.body_mass : m.totalMass();
-    if (!(body_mass_ > 0.0))
-      throw SettingsError("parameter 'body_mass' is -1 but the URDF's total mass is " +
-                          std::to_string(body_mass_) + " kg");
-    record_.effort_per_kg.assign(n, 0.0);
-  }
-  record_.q.setZero(m.nq);
-  record_.qd.setZero(m.nq);
-  record_.qdd.setZero(m.nq);
-  record_.inputs.resize(wrenches_.size());
-  for (std::size_t k = 0; k < wrenches_.size(); ++k)
-    record_.inputs[k].frame = settings_.estimator.wrenches[k].link;
-  record_.plates.resize(plates_.size());
-  for (Sample& s : ring_) s.effort.assign(n, kNaN);
   coordinate_segment_ = coordinateSegments(m);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
@@ -247,10 +188,7 @@ std::string Pipeline::smoothedBandwidthBound() const {
   return text;
 }
 
-Stamp Pipeline::absolute(double t) const {
-  const Sample* s = sampleAt(t);
-  return s ? s->stamp : timeline_.absolute(t);
-}
+Stamp Pipeline::absolute(double t) const { return builder_.stampAt(t); }
 
 Outcome Pipeline::count(InputKind kind, Outcome outcome) {
   ++counters_.outcomes[static_cast<int>(kind)][static_cast<int>(outcome)];
@@ -277,7 +215,7 @@ void Pipeline::resetTimeline() {
     stashGroupRecords();
     stashed_ = stashed_smoothed_ = false;
   }
-  held_t_ = -1e300;
+  builder_.clearHeld();
   drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
@@ -285,7 +223,7 @@ void Pipeline::resetTimeline() {
   if (smoothed_) smoothed_->settle.restarted = true;
   implausible_run_ = 0;
   if (external_) external_->reset();
-  ring_count_ = 0;
+  builder_.forget();
   timeline_.restart();
   ++counters_.resets;
   if (timeline_.jumpedForward()) ++counters_.forward_jumps;
@@ -546,7 +484,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged)
     return count(kind, Outcome::kUnchanged);
   fillRecord(estimator_, record_);
-  if (!finiteLoads(record_)) {
+  if (!RecordBuilder::finiteLoads(record_)) {
     restartFilters(false);  // what made them not finite is in the filters' state
     return fail(kind, Outcome::kNonFinite,
                 settings_.joint_states_topic + ": the loads at " + secondsText(stamp) +
@@ -565,7 +503,8 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
   smoothed_published_ = status == SampleStatus::kPublished &&
                         !(e.lastWasReused() && !settings_.estimator.savings.republish_unchanged);
   if (smoothed_published_) fillRecord(e, stream.record);
-  if (smoothed_published_ && !finiteLoads(stream.record)) {  // counted by the immediate stream
+  if (smoothed_published_ &&
+      !RecordBuilder::finiteLoads(stream.record)) {  // counted by the immediate stream
     e.reset();
     stream.settle.restarted = true;
     smoothed_published_ = false;
@@ -627,7 +566,7 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
     if (status != SampleStatus::kPublished) continue;
     if (estimator.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
     fillRecord(estimator, record);
-    if (!finiteLoads(record)) continue;  // never published
+    if (!RecordBuilder::finiteLoads(record)) continue;  // never published
     return true;
   }
   return false;
@@ -674,89 +613,16 @@ Outcome Pipeline::staleProblem() {
 
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
   // The estimates still to come are of the newest sample and the delaySamples() before
-  // it (a smoother's pending samples, its carry over a gap included), in either stream:
-  // grown to twice that when they do not fit (rarely after the warm-up: a faster rate, a
-  // gap).
+  // it (a smoother's pending samples, its carry over a gap included), in either stream.
   const int delay =
       std::max(estimator_.delaySamples(), smoothed_ ? smoothed_->estimator.delaySamples() : 0);
-  const std::size_t needed = static_cast<std::size_t>(delay) + 1;
-  if (needed > ring_.size()) growRing(2 * needed);
-  Sample& s = ring_[ring_head_];
-  s.t = t;
-  s.stamp = stamp;
-  s.has_effort = has_effort;
-  if (has_effort) s.effort = joints_.effort();  // same size: no allocation
-  ring_head_ = (ring_head_ + 1) % ring_.size();
-  if (ring_count_ < ring_.size()) ++ring_count_;
-}
-
-void Pipeline::growRing(std::size_t size) {
-  // Every slot's effort at its size now: none allocated when first used.
-  std::vector<Sample> grown(size);
-  for (Sample& slot : grown) slot.effort.assign(ring_.front().effort.size(), kNaN);
-  for (std::size_t i = 0; i < ring_count_; ++i)  // oldest first
-    grown[i] = std::move(ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()]);
-  ring_head_ = ring_count_;
-  ring_.swap(grown);
-}
-
-const Pipeline::Sample* Pipeline::sampleAt(double t) const {
-  // The estimate's time is one of the samples' own times (the filter's delay is a whole
-  // number of samples); half a nanosecond separates it from any other.
-  for (std::size_t i = 0; i < ring_count_; ++i) {
-    const Sample& s = ring_[(ring_head_ + ring_.size() - 1 - i) % ring_.size()];
-    if (std::abs(s.t - t) < 0.5e-9) return &s;
-  }
-  return nullptr;
+  builder_.remember(t, stamp, has_effort ? &joints_.effort() : nullptr, delay);
 }
 
 void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
-  const Data<double>& data = estimator.data();
-  const Sample* s = sampleAt(estimator.stamp());
-  rec.stamp = s ? s->stamp : absolute(estimator.stamp());
-  const bool measured = s && s->has_effort;
-  const UncertaintyConfig& u = settings_.estimator.uncertainty;
-  const std::size_t per_joint = u.diagonal_only ? 6 : 36;
-  for (std::size_t i = 0; i < rec.segment.size(); ++i) {
-    const int segment = rec.segment[i];
-    const std::size_t j = static_cast<std::size_t>(segment);
-    rec.force[i] = data.force[j];
-    rec.moment[i] = data.moment[j];
-    rec.effort[i] = data.effort[j];
-    rec.measured_effort[i] = measured ? s->effort[i] : kNaN;
-    if (!rec.effort_per_kg.empty()) rec.effort_per_kg[i] = data.effort[j] / body_mass_;
-    fillCoordinates(estimator, rec, i, j);
-    if (!u.enabled) continue;
-    const Eigen::Matrix<double, 6, 6>& C = estimator.covariance(segment);
-    double* cov = &rec.covariance[per_joint * i];
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c)
-        if (!u.diagonal_only)
-          cov[6 * r + c] = C(r, c);
-        else if (r == c)
-          cov[r] = C(r, r);
-    rec.effort_stddev[i] = std::sqrt(estimator.effortVariance(segment));
-  }
-  fillSideOutputs(estimator, rec);
-  rec.status =
-      statusOf(estimator, &estimator == &estimator_ ? settle_.from : smoothed_->settle.from, rec);
+  const Settle& settle = &estimator == &estimator_ ? settle_ : smoothed_->settle;
+  builder_.fill(estimator, settle.from, rec);
   if (external_ && &rec == &record_) fillExternal();
-}
-
-std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
-                                const LoadsRecord& rec) const {
-  const PlausibilityConfig& p = settings_.plausibility;
-  std::uint8_t status = kTrusted;
-  if (estimator.stamp() < settle_from + p.settle_time) status |= kSettling;
-  if (std::abs(estimator.stamp() - held_t_) <= p.settle_time) status |= kHeldJoint;
-  for (const InputRecord& in : rec.inputs) status |= in.stale ? kStaleInput : 0;
-  for (std::size_t k = 0; k < rec.plates.size(); ++k)
-    if (rec.plates[k].stale && estimator.plateNeeded(static_cast<int>(k))) status |= kStaleInput;
-  const Model<double>& m = model();
-  for (std::size_t i = 0; i < rec.segment.size(); ++i)
-    if (implausibleEffort(m, p, static_cast<std::size_t>(rec.segment[i]), rec.effort[i]))
-      status |= kImplausibleLoad;
-  return status;
 }
 
 void Pipeline::countHeld(double t) {
@@ -766,7 +632,7 @@ void Pipeline::countHeld(double t) {
     held = estimator_.coordinateNeeded(k) && !joints_.fresh(k);
   if (held) {
     ++counters_.held_samples;
-    held_t_ = t;
+    builder_.heldAt(t);
   }
   joints_.clearFresh();
 }
@@ -783,13 +649,6 @@ void Pipeline::noteStart(Settle& settle, SampleStatus status, double t) {
   settle.warming = warming;
 }
 
-bool Pipeline::finiteLoads(const LoadsRecord& rec) {
-  for (std::size_t i = 0; i < rec.effort.size(); ++i)
-    if (!std::isfinite(rec.effort[i]) || !rec.force[i].allFinite() || !rec.moment[i].allFinite())
-      return false;
-  return rec.base_force.allFinite() && rec.base_moment.allFinite();
-}
-
 void Pipeline::restartFilters(bool drain) {
   // The wrench and plate readings are forgotten too (Estimator::reset): the next ones
   // refill them.
@@ -798,20 +657,7 @@ void Pipeline::restartFilters(bool drain) {
   if (smoothed_) smoothed_->estimator.reset();
   settle_.restarted = true;
   if (smoothed_) smoothed_->settle.restarted = true;
-  ring_count_ = 0;  // the stamps of the samples the filters held; the stamps' order stays
-}
-
-std::string describeStatus(std::uint8_t status) {
-  if (status == kTrusted) return "trusted";
-  std::string words;
-  const auto add = [&](std::uint8_t bit, const char* word) {
-    if (status & bit) words += (words.empty() ? "" : ", ") + std::string(word);
-  };
-  add(kSettling, "settling");
-  add(kStaleInput, "stale input");
-  add(kImplausibleLoad, "implausible load");
-  add(kHeldJoint, "held joint");
-  return words;
+  builder_.forget();  // the samples the filters held; the stamps' order stays
 }
 
 bool Pipeline::plausibleWrench(InputKind kind, const std::string& input,
@@ -885,52 +731,6 @@ const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<std::
   }
   (void)names;
   return any ? velocity_checked_ : velocity;
-}
-
-void Pipeline::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) {
-  rec.q = estimator.q();  // same sizes: no allocation
-  rec.qd = estimator.qd();
-  rec.qdd = estimator.qdd();
-  rec.planar = estimator.lastWasPlanar();
-  for (std::size_t k = 0; k < rec.inputs.size(); ++k) {
-    const int input = static_cast<int>(k);
-    InputRecord& in = rec.inputs[k];
-    in.stale = estimator.stale(input);
-    in.used = estimator.sensorSegment(input) >= 0 && estimator.sensorUsed(input);
-    const std::string& frame = frame_resolver_.wrenchFrame(input);
-    if (!frame.empty() && in.frame != frame) in.frame = frame;  // rare: a new frame
-    const Eigen::Isometry3d& X = frame_resolver_.wrenchPose(input);
-    in.residual =
-        in.used ? residualInReading(estimator.sensorResidual(input), X.linear(), X.translation())
-                : Wrench<double>();
-  }
-  for (std::size_t k = 0; k < rec.plates.size(); ++k) {
-    PlateRecord& p = rec.plates[k];
-    p.stale = estimator.plateStale(static_cast<int>(k));
-    p.reading = estimator.plateReading(static_cast<int>(k));
-    const std::string& frame = frame_resolver_.plateFrame(static_cast<int>(k));
-    if (p.frame != frame) p.frame = frame;  // rare: a new frame
-  }
-  if (model().floating_base) {
-    rec.base_force = estimator.data().force[0];
-    rec.base_moment = estimator.data().moment[0];
-  }
-}
-
-void Pipeline::fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
-                               std::size_t segment) {
-  const Model<double>& m = model();
-  const int c = m.coordinate[segment];
-  if (c < 0) return;  // a fixed joint kept as a segment: 0 from the constructor
-  // As forwardKinematics maps them (a mimic joint follows its leader).
-  const double k = m.multiplier[segment];
-  rec.position[i] = k * estimator.q()[c] + m.offset[segment];
-  rec.velocity[i] = k * estimator.qd()[c];
-  rec.acceleration[i] = k * estimator.qdd()[c];
-  if (!rec.motor_effort.empty())
-    rec.motor_effort[i] =
-        rec.effort[i] + frictionEffort(m.damping[segment], m.friction[segment], rec.velocity[i],
-                                       settings_.friction.velocity_scale);
 }
 
 bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation) {
