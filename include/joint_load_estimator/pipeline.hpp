@@ -2,7 +2,12 @@
 // each with its stamp) in, one result record out. Every front end drives it: the node,
 // the nodelet, process_bag, the soaks and the fuzzers; a front end converts messages to
 // its arguments and its record to messages, and decides nothing. Offline and online give
-// the same loads for the same samples in the same order.
+// the same loads for the same samples in the same order. Its parts, each with its own
+// tests: FrameResolver (where the inputs are), Timeline (the time axis, rogue stamps and
+// jumps of time), JointStateMap (joint states onto the model's coordinates), the Estimator
+// of each stream, ExternalEffort, and RecordBuilder (the result record); the Pipeline
+// orders them, merges the instants of split publishers, applies the plausibility rules and
+// counts every message under its outcome.
 #pragma once
 
 #include <joint_load_estimator/config.hpp>
