@@ -65,6 +65,10 @@ jle_add_unit_test(test_sensor_bias algorithms/test_sensor_bias.cpp)
 jle_add_unit_test(test_pipeline pipeline/test_pipeline.cpp)
 # The message path's frame resolver against a fake frame source and the URDF's numbers.
 jle_add_unit_test(test_frame_resolver pipeline/test_frame_resolver.cpp)
+# The time axis of the message path: jumps, rogue stamps, order, ns round trip.
+jle_add_unit_test(test_timeline pipeline/test_timeline.cpp)
+# The result record: a delayed estimate's own stamp and efforts; the status bits.
+jle_add_unit_test(test_record_builder pipeline/test_record_builder.cpp)
 jle_add_unit_test(test_never_silent pipeline/test_never_silent.cpp)
 jle_add_unit_test(test_sample_clock filters/test_sample_clock.cpp)
 # The estimator's parts, each against closed forms.

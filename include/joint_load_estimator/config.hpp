@@ -212,9 +212,14 @@ struct EstimatorConfig {
 };
 
 /// One measured wrench topic of a front end (wrenches[k]): where the messages come
-/// from. Pairs by index with EstimatorConfig::wrenches[k], which holds the input itself
-/// (link, sign, timeout, sensor_joint, noises).
+/// from. Pairs with EstimatorConfig::wrenches[k], which holds the input itself (link,
+/// sign, timeout, sensor_joint, noises): validate() refuses a `name` that is not that
+/// input's (lists in different orders).
 struct WrenchTopicSettings {
+  /// The name of the input these settings are for (WrenchInputConfig::name: the settings
+  /// reader names an input by its topic and sets both). Empty (settings made in code): the
+  /// input at the same index.
+  std::string name;
   std::string topic;  ///< required
   std::string frame;  ///< expressed-in frame; empty: the message's header.frame_id
   /// Sensor inputs (sensor_joint set): the residual (measured - predicted) above either
@@ -223,10 +228,14 @@ struct WrenchTopicSettings {
   double moment_threshold = 0.5;  ///< [N m], > 0
 };
 
-/// One force plate topic of a front end (force_plates[k]). Pairs by index with
+/// One force plate topic of a front end (force_plates[k]). Pairs with
 /// EstimatorConfig::plates[k], which holds the plate itself (name, link, surface_height,
-/// contact_threshold, pose, timeout, stale_policy).
+/// contact_threshold, pose, timeout, stale_policy): validate() refuses a `name` that is not
+/// that plate's.
 struct PlateTopicSettings {
+  /// The name of the plate these settings are for (ForcePlateConfig::name); the settings
+  /// reader sets it. Empty (settings made in code): the plate at the same index.
+  std::string name;
   std::string topic;  ///< required
   std::string frame;  ///< tf2 frame of the plate; empty: the message's header.frame_id
   /// The pose (position, orientation) was configured: the estimator holds it, no tf2
@@ -449,8 +458,9 @@ struct Settings {
   /// whose loads are published.
   EstimatorConfig estimator;
   SmoothedStreamSettings smoothed;
-  std::vector<WrenchTopicSettings> wrenches;     ///< pairs with estimator.wrenches
-  std::vector<PlateTopicSettings> force_plates;  ///< pairs with estimator.plates
+  /// Pair by index with estimator.wrenches and estimator.plates, and by name (checked).
+  std::vector<WrenchTopicSettings> wrenches;
+  std::vector<PlateTopicSettings> force_plates;
 };
 
 /// Checks every model-independent setting of `config` (the differentiator, decimation,
@@ -465,7 +475,8 @@ EstimatorConfig smoothedEstimatorConfig(const Settings& settings);
 void validate(const PlausibilityConfig& config);
 
 /// Checks `settings`: validate(settings.estimator), the front end's own settings, and
-/// that wrenches and force_plates pair with estimator.wrenches and estimator.plates.
+/// that wrenches and force_plates pair with estimator.wrenches and estimator.plates (as
+/// many, and element k of each names the same input or plate).
 /// Throws SettingsError naming the key.
 void validate(const Settings& settings);
 

@@ -9,6 +9,7 @@
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/eigen_abi.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/timeline.hpp>
 
 #include <Eigen/Geometry>
 
@@ -17,9 +18,6 @@
 #include <vector>
 
 namespace jle {
-
-/// A message stamp [ns since the epoch]: a ROS header's sec * 1e9 + nsec.
-using Stamp = std::int64_t;
 
 /// Frames the URDF does not hold rigidly (tf2 in the ROS layer: the node's listener, or
 /// process_bag's buffer filled from a bag's /tf and /tf_static).

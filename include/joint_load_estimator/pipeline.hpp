@@ -2,7 +2,12 @@
 // each with its stamp) in, one result record out. Every front end drives it: the node,
 // the nodelet, process_bag, the soaks and the fuzzers; a front end converts messages to
 // its arguments and its record to messages, and decides nothing. Offline and online give
-// the same loads for the same samples in the same order.
+// the same loads for the same samples in the same order. Its parts, each with its own
+// tests: FrameResolver (where the inputs are), Timeline (the time axis, rogue stamps and
+// jumps of time), JointStateMap (joint states onto the model's coordinates), the Estimator
+// of each stream, ExternalEffort, and RecordBuilder (the result record); the Pipeline
+// orders them, merges the instants of split publishers, applies the plausibility rules and
+// counts every message under its outcome.
 #pragma once
 
 #include <joint_load_estimator/config.hpp>
@@ -12,7 +17,9 @@
 #include <joint_load_estimator/frame_resolver.hpp>
 #include <joint_load_estimator/joint_state_map.hpp>
 #include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/record_builder.hpp>
 #include <joint_load_estimator/sample_clock.hpp>
+#include <joint_load_estimator/timeline.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <Eigen/Core>
@@ -103,109 +110,9 @@ struct PipelineCounters {
   long count(Outcome outcome) const;
 };
 
-/// Why a record's loads are not to be trusted: LoadsRecord::status holds these bits, 0
-/// (kTrusted) when none applies. The node's JointLoads.status carries the same bits.
-enum LoadsStatus : std::uint8_t {
-  kTrusted = 0,
-  /// Within plausibility/settle_time after the filters (re)started (a start, a jump of
-  /// time, a gap, a retune, a confirmed jump of a position): the filters are settling.
-  kSettling = 1,
-  /// A needed wrench input or force plate was stale at the sample (its stale_policy
-  /// applied: held, read as zero).
-  kStaleInput = 2,
-  /// An effort beyond plausibility/effort_factor times its joint's URDF effort limit.
-  kImplausibleLoad = 4,
-  /// Within plausibility/settle_time of a sample that held a needed joint's position from
-  /// an earlier message (a publisher of split joint states slower than the others, or dead).
-  kHeldJoint = 8,
-};
-
-/// The bits of `status` in words ("settling, stale input"); "trusted" for 0.
-std::string describeStatus(std::uint8_t status);
-
-/// A wrench input (settings.wrenches[k]) as it entered one published sample.
-struct InputRecord {
-  bool stale = false;  ///< stale at the sample (its stale_policy applied)
-  /// A force/torque sensor (sensor_joint set): whether its reading was used (not while it
-  /// is stale with the zero policy), and the reading minus the model's prediction: the
-  /// load the distal side exerts beyond what the model and the other inputs explain (a
-  /// tool's contact, or a bias), in the reading's frame `frame`, moment about its origin,
-  /// the reading's sign [N, N m]. Zero when unused or not a sensor.
-  bool used = false;
-  Wrench<double> residual;
-  /// The wrench the model predicts at the sensor's joint (same frame, point and sign as
-  /// `residual`; the reading is residual + predicted). Zero when unused or not a sensor.
-  Wrench<double> predicted;
-  std::string frame;  ///< the reading's frame (the input's link when it has none)
-};
-
-/// A force plate (settings.force_plates[k]) as it entered one published sample.
-struct PlateRecord {
-  bool stale = false;  ///< stale at the sample
-  /// Contact, centre of pressure and free moment (plate frame), reaction on the foot.
-  PlateReading reading;
-  std::string frame;  ///< the frame of the centre of pressure (the plate's)
-};
-
-/// The whole result of one published sample, sized at construction (no allocation per
-/// sample): every front end (node, process_bag, joint_loads, the writers) reads this and
-/// nothing else. Index i runs over the published joints.
-struct LoadsRecord {
-  Stamp stamp = 0;                 ///< the stamp of the joint state the loads describe
-  std::vector<std::string> joint;  ///< URDF joint names
-  std::vector<std::string> link;   ///< child link: the frame of force and moment
-  std::vector<int> segment;        ///< model segment of each joint
-  /// Joint wrench (on the child, by the parent), child link frame, moment about the
-  /// joint origin [N], [N m].
-  std::vector<Eigen::Vector3d> force, moment;
-  std::vector<double> effort;           ///< [N m or N] projection on the joint axis
-  std::vector<double> measured_effort;  ///< from the joint state at `stamp`; NaN: none
-  /// With uncertainty enabled: 1-sigma effort [N m or N] and the wrench covariance per
-  /// joint, row-major, 36 numbers (fx fy fz mx my mz), or 6 variances (diagonal_only).
-  std::vector<double> effort_stddev, covariance;
-  std::vector<double> effort_per_kg;  ///< effort / body_mass; empty when not configured
-  /// The q, q-dot, q-ddot the loads were computed from (the filter's estimate at `stamp`,
-  /// a mimic joint's mapped from its leader's) [rad or m, /s, /s^2]; 0 for a fixed joint.
-  std::vector<double> position, velocity, acceleration;
-  /// With settings.friction.enabled: effort + damping velocity + friction tanh(velocity /
-  /// velocity_scale) (friction.hpp) [N m or N]; empty when off.
-  std::vector<double> motor_effort;
-  /// With external_effort/enabled (external_effort.hpp; empty when off): per joint the
-  /// external effort of the configured method, the environment's generalised force on the
-  /// robot [N m or N] (NaN where no effort was measured or the joint does not move), and
-  /// with uncertainty its 1-sigma from external_effort/effort_noise.
-  std::vector<double> external_effort, external_effort_stddev;
-  /// The wrench at each external_effort/contacts link (link frame, about its origin).
-  std::vector<ContactEstimate> contacts;
-  /// Contact detection at this sample: in contact, it started / ended here, its joint
-  /// changed here while it lasts, and the contact's joint (the most distal over its
-  /// threshold, ExternalEffort::contactJoint), with its child link. A contact event (the
-  /// node's ~contact) is a sample where it started, changed or ended.
-  bool in_contact = false, contact_started = false, contact_ended = false, contact_changed = false;
-  std::string contact_joint, contact_link;
-  /// The estimated q, q-dot, q-ddot of every coordinate (model coordinate order) [rad or
-  /// m, /s, /s^2].
-  Eigen::VectorXd q, qd, qdd;
-  /// Per wrench input and per force plate (settings order).
-  std::vector<InputRecord> inputs;
-  std::vector<PlateRecord> plates;
-  /// A floating base: the wrench the model needs at the base beyond every input (root
-  /// link frame, about its origin) [N, N m], zero when the inputs explain the motion (a
-  /// check of the model and the inputs). Zero for a fixed base.
-  Eigen::Vector3d base_force = Eigen::Vector3d::Zero(), base_moment = Eigen::Vector3d::Zero();
-  bool planar = false;             ///< computed by the planar 3x3 path (savings.planar)
-  std::uint8_t status = kTrusted;  ///< LoadsStatus bits: why the loads are not to be trusted
-};
-
 /// The ModelOptions that `settings` ask for (floating_base, keep_fixed_joints,
 /// accept_nonphysical_inertia).
 ModelOptions modelOptions(const Settings& settings);
-
-/// Segments whose loads are published: `joints` (URDF names of moving joints, or of
-/// fixed joints kept as segments), or every moving segment when it is empty. Throws
-/// SettingsError naming the joint.
-std::vector<int> publishedSegments(const Model<double>& model,
-                                   const std::vector<std::string>& joints);
 
 class Pipeline {
  public:
@@ -286,11 +193,11 @@ class Pipeline {
   std::string stoppingInputs() const;
   /// Whether the last message reset the filters (a confirmed jump of time, back or
   /// forward, or the clock going back), and from when to when [ns].
-  bool jumped() const { return jumped_; }
-  Stamp jumpFrom() const { return jump_from_; }
-  Stamp jumpTo() const { return jump_to_; }
+  bool jumped() const { return timeline_.jumped(); }
+  Stamp jumpFrom() const { return timeline_.jumpFrom(); }
+  Stamp jumpTo() const { return timeline_.jumpTo(); }
   /// Whether that jump went forward (stamps far ahead, confirmed), not back.
-  bool jumpedForward() const { return jumped_ && jump_from_ != 0 && jump_to_ > jump_from_; }
+  bool jumpedForward() const { return timeline_.jumpedForward(); }
 
   /// The immediate stream's record: the loads of the last joint state that returned
   /// kPublished (or of flush(), takeDrained()).
@@ -350,15 +257,15 @@ class Pipeline {
   /// The external-effort estimator (external_effort/enabled), or null.
   const ExternalEffort* externalEffort() const { return external_.get(); }
   /// The joint-state stream's sample clock (stamps/regularize).
-  const SampleClock& sampleClock() const { return clock_; }
+  const SampleClock& sampleClock() const { return timeline_.sampleClock(); }
   const Model<double>& model() const { return estimator_.model(); }
   /// The stamp [ns] of the estimator's time t [s].
   Stamp absolute(double t) const;
   /// The origin of the estimator's time axis [ns]: the first stamp after the start, after
   /// a reset, or after a stamp more than 2^52 ns (52 days) away from the previous origin.
   /// None until a message has been taken.
-  bool hasTimeOrigin() const { return have_ref_; }
-  Stamp timeOrigin() const { return time_ref_; }
+  bool hasTimeOrigin() const { return timeline_.hasOrigin(); }
+  Stamp timeOrigin() const { return timeline_.origin(); }
 
   /// Wrench input k's last resolved frame (the frame of its sensor residual), or empty.
   const std::string& wrenchFrame(int k) const { return frame_resolver_.wrenchFrame(k); }
@@ -397,26 +304,17 @@ class Pipeline {
     bool has_effort = false;
     bool last_merged = false;
   };
-  // One joint sample entering the filters: its time, stamp and measured efforts.
-  struct Sample {
-    double t = 0.0;
-    Stamp stamp = 0;
-    bool has_effort = false;
-    std::vector<double> effort;
-  };
 
   static std::size_t ix(int k) { return static_cast<std::size_t>(k); }
-  double relative(Stamp stamp);
   Outcome count(InputKind kind, Outcome outcome);
   Outcome fail(InputKind kind, Outcome outcome, const std::string& why);
   bool movesNeeded() const;
-  void anchor(Stamp stamp);
-  bool clockWentBack(Stamp stamp, Stamp clock);
-  void resetTimeline(Stamp stamp);
-  void resetTimeline(Stamp from, Stamp stamp);  // reported as a jump from `from`
-  Outcome checkJointStamp(Stamp stamp, Stamp clock);
-  Outcome checkInputStamp(InputKind kind, const std::string& input, double timeout, Stamp stamp,
-                          Stamp clock);
+  // A message's stamp as the timeline found it: kUsed to go on (after a jump, the filters
+  // reset first), or the rogue stamp counted.
+  Outcome stampOutcome(InputKind kind, StampVerdict verdict);
+  // A jump of time: what holds the old timeline's samples taken or forgotten, then the
+  // timeline restarted.
+  void resetTimeline();
   bool checkJointState(const std::vector<std::string>& names, const std::vector<double>& position,
                        const std::vector<double>& velocity, const std::vector<double>& effort);
   void mapJointState(const std::vector<std::string>& names, const std::vector<double>& position,
@@ -438,15 +336,12 @@ class Pipeline {
   void unstash(bool immediate_published);
   Outcome staleProblem();
   void remember(double t, Stamp stamp, bool has_effort);
-  void growRing(std::size_t size);
   bool resolvePlatePose(int k, const std::string& frame);
+  // The record of the loads `estimator` (either stream's) published last, with the
+  // external outputs in the immediate stream's record_.
   void fillRecord(const Estimator& estimator, LoadsRecord& rec);
-  void fillSideOutputs(const Estimator& estimator, LoadsRecord& rec);
-  std::uint8_t statusOf(const Estimator& estimator, double settle_from,
-                        const LoadsRecord& rec) const;
   static void noteStart(Settle& settle, SampleStatus status, double t);
   void countHeld(double t);
-  static bool finiteLoads(const LoadsRecord& rec);
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
   bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
                            const std::vector<double>& position);
@@ -459,9 +354,6 @@ class Pipeline {
   void restartFilters(bool drain);
   void setUpExternal();
   void fillExternal();
-  void fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
-                       std::size_t segment);
-  const Sample* sampleAt(double t) const;
   void drainSmoother();
   static bool takeFrom(LoadsRecord& record, std::vector<LoadsRecord>& drained, std::size_t& next);
   void sampleSmoothed(double t, const BasePose* base);
@@ -472,6 +364,8 @@ class Pipeline {
   Settings settings_;
   Estimator estimator_;
   FrameResolver frame_resolver_;
+  Timeline timeline_;
+  RecordBuilder builder_;
   std::unique_ptr<ExternalEffort> external_;  // external_effort/enabled
   std::vector<double> external_variance_;     // the model efforts' variances, per joint
   JointStateMap joints_;
@@ -484,29 +378,10 @@ class Pipeline {
   PipelineCounters counters_;
   std::vector<WrenchInput> wrenches_;
   std::vector<PlateInput> plates_;
-  double body_mass_ = 0.0;  // [kg] effort_per_kg divisor; 0: none
-  // The time axis: seconds since the first stamp seen after the start or a reset (a
-  // double holds epoch seconds only to 2.4e-7 s).
-  Stamp time_ref_ = 0;
-  bool have_ref_ = false;
-  bool axis_used_ = false;  // a time on the axis was handed out (relative) since its origin
-  Stamp last_stamp_ = 0;    // last joint state taken (0 after a reset)
-  Stamp last_clock_ = 0;
-  Stamp last_taken_clock_ = 0;  // the clock when the last joint state was taken
-  SampleClock clock_;           // the joint-state stream's
   bool joints_stamped_ = false;
-  // Joint states on another timeline, in a row: the last one's stamp and how many.
-  Stamp pending_stamp_ = 0;
-  int pending_ = 0;
-  int clock_back_ = 0;  // joint states taken since the clock went back that it confirms
-  // Ring of the latest joint samples, to give an estimate its stamp and measured efforts.
-  std::vector<Sample> ring_;
-  std::size_t ring_head_ = 0, ring_count_ = 0;
   std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
   std::string mimic_contradiction_;
   bool any_needed_ = false;  // the loads need at least one coordinate
-  bool jumped_ = false;
-  Stamp jump_from_ = 0, jump_to_ = 0;
   // Plausibility: per coordinate its joint's segment (limits), the joint states refused
   // in a row for moving too fast, and the velocities with the implausible ones as NaN.
   std::vector<int> coordinate_segment_;
@@ -516,7 +391,6 @@ class Pipeline {
   Group group_;
   bool group_record_ = false;  // record_ holds a closed instant's loads (takeDrained)
   bool stashed_ = false, stashed_smoothed_ = false;  // by stashGroupRecords, this call
-  double held_t_ = -1e300;  // estimator time of the last sample that held a joint
 };
 
 }  // namespace jle

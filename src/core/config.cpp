@@ -88,12 +88,23 @@ void validatePlate(const PlateInputConfig& p, std::size_t k) {
     fail(element("force_plates", k, "orientation"), "must be a rotation");
 }
 
+// A topic's settings pair with the input or plate of their `name` (empty: the one at their
+// index, for settings made in code), which must be the one at their index.
+void pairs(const std::string& key, const std::string& paired, const std::string& name,
+           const char* whose) {
+  if (!paired.empty() && paired != name)
+    fail(key,
+         "is '" + paired + "' in the topic's settings, but '" + name + "' in the " + whose + "'s");
+}
+
 void validateWrenchTopics(const Settings& s) {
   if (s.wrenches.size() != s.estimator.wrenches.size())
     fail("wrenches", "holds " + std::to_string(s.wrenches.size()) + " topics for " +
                          std::to_string(s.estimator.wrenches.size()) + " inputs");
   for (std::size_t k = 0; k < s.wrenches.size(); ++k) {
     required(element("wrenches", k, "topic"), s.wrenches[k].topic);
+    pairs(element("wrenches", k, "name"), s.wrenches[k].name, s.estimator.wrenches[k].name,
+          "input");
     positive(element("wrenches", k, "force_threshold"), s.wrenches[k].force_threshold);
     positive(element("wrenches", k, "moment_threshold"), s.wrenches[k].moment_threshold);
   }
@@ -110,6 +121,7 @@ void validatePlateTopics(const Settings& s) {
     if (!names.insert(name).second)
       fail(element("force_plates", k, "name"), "'" + name + "' names another plate too");
     required(element("force_plates", k, "topic"), s.force_plates[k].topic);
+    pairs(element("force_plates", k, "name"), s.force_plates[k].name, name, "plate");
   }
 }
 

@@ -1,18 +1,9 @@
 #include <joint_load_estimator/frame_resolver.hpp>
 #include <joint_load_estimator/frames.hpp>
 
-#include <cstdio>
+#include <string>
 
 namespace jle {
-namespace {
-
-std::string seconds(Stamp stamp) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9f", static_cast<double>(stamp) * 1e-9);
-  return text;
-}
-
-}  // namespace
 
 FrameResolver::FrameResolver(const Model<double>& model, const Settings& settings,
                              FrameSource* frames)
@@ -74,7 +65,7 @@ bool FrameResolver::basePose(Stamp stamp, Eigen::Isometry3d& X_world_base,
       frames_->lookup(settings_.world_frame, settings_.base_frame, stamp, X_world_base, error))
     return true;
   problem = "floating base: no pose of '" + settings_.base_frame + "' in '" +
-            settings_.world_frame + "' at " + seconds(stamp) + ": " + error;
+            settings_.world_frame + "' at " + secondsText(stamp) + ": " + error;
   return false;
 }
 

@@ -1,26 +1,18 @@
 #include <joint_load_estimator/frames.hpp>
-#include <joint_load_estimator/friction.hpp>
 #include <joint_load_estimator/pipeline.hpp>
 #include <joint_load_estimator/plausibility.hpp>
-#include <joint_load_estimator/sensor_bias.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
-#include <stdexcept>
 #include <utility>
 
 namespace jle {
 namespace {
 
-// Joint samples remembered (to publish a delayed estimate with its own stamp): more than
-// any Savitzky-Golay delay; a smoother grows the ring to its own (remember()).
-constexpr std::size_t kRing = 128;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr Stamp kReach = Stamp{1} << 52;  // [ns] of the time axis around its origin
 
 bool allFinite(const std::vector<double>& v, std::size_t& bad) {
   for (std::size_t i = 0; i < v.size(); ++i)
@@ -31,22 +23,9 @@ bool allFinite(const std::vector<double>& v, std::size_t& bad) {
   return true;
 }
 
-std::string seconds(Stamp stamp) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9f", static_cast<double>(stamp) * 1e-9);
-  return text;
-}
-
-// Stamp 0 on an input that has never had a stamp (a live driver that stamps nothing) is
-// the clock; on one that has, it is dropped: a bag's missing stamp is no reception time.
-bool zeroStamp(bool& stamped, Stamp& stamp, Stamp clock) {
-  if (stamp != 0) {
-    stamped = true;
-    return true;
-  }
-  if (stamped) return false;
-  stamp = clock;
-  return true;
+// A stamp out of order, in the words of the estimator's refusals.
+SampleStatus sampleStatus(StampVerdict order) {
+  return order == StampVerdict::kDuplicate ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder;
 }
 
 const char* const kZeroStamp = ": stamp 0 on a stream that has had stamps: dropped";
@@ -113,25 +92,6 @@ ModelOptions modelOptions(const Settings& settings) {
   return options;
 }
 
-std::vector<int> publishedSegments(const Model<double>& model,
-                                   const std::vector<std::string>& joints) {
-  if (joints.empty()) return model.moving_segments;
-  std::vector<int> segments;
-  for (const std::string& j : joints) {
-    int segment = -1;
-    for (int s = 1; s < model.nsegments(); ++s) {
-      const JointType type = model.joint_type[static_cast<std::size_t>(s)];
-      if (model.joint_name[static_cast<std::size_t>(s)] == j &&
-          (isMoving(type) || type == JointType::kFixed))
-        segment = s;
-    }
-    if (segment < 0)
-      throw SettingsError("parameter 'joints': '" + j + "' is not a joint of the model");
-    segments.push_back(segment);
-  }
-  return segments;
-}
-
 namespace {
 
 // The link of every force/torque sensor input (sensor_joint set, link empty) is its
@@ -155,47 +115,14 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
     : settings_(checkedSettings(model, settings)),
       estimator_(model, settings_.estimator),
       frame_resolver_(estimator_.model(), settings_, frames),
+      timeline_(settings_),
+      builder_(estimator_.model(), settings_, frame_resolver_, timeline_),
       joints_(estimator_.model(), publishedSegments(estimator_.model(), settings_.estimator.joints),
               settings_.plausibility.mimic_tolerance),
+      record_(builder_.sizedRecord()),
       wrenches_(settings_.estimator.wrenches.size()),
-      plates_(settings_.estimator.plates.size()),
-      clock_(settings_.stamps.regularize == StampRegularize::kAuto),
-      ring_(kRing) {
+      plates_(settings_.estimator.plates.size()) {
   const Model<double>& m = estimator_.model();
-  record_.segment = publishedSegments(m, settings_.estimator.joints);
-  const std::size_t n = record_.segment.size();
-  for (int s : record_.segment) {
-    record_.joint.push_back(m.joint_name[static_cast<std::size_t>(s)]);
-    record_.link.push_back(m.link_name[static_cast<std::size_t>(s)]);
-  }
-  record_.force.assign(n, Eigen::Vector3d::Zero());
-  record_.moment.assign(n, Eigen::Vector3d::Zero());
-  record_.effort.assign(n, 0.0);
-  record_.measured_effort.assign(n, kNaN);
-  record_.position.assign(n, 0.0);
-  record_.velocity.assign(n, 0.0);
-  record_.acceleration.assign(n, 0.0);
-  if (settings_.friction.enabled) record_.motor_effort.assign(n, 0.0);
-  const UncertaintyConfig& u = settings_.estimator.uncertainty;
-  if (u.enabled) {
-    record_.effort_stddev.assign(n, 0.0);
-    record_.covariance.assign((u.diagonal_only ? 6 : 36) * n, 0.0);
-  }
-  if (settings_.body_mass != 0.0) {
-    body_mass_ = settings_.body_mass > 0.0 ? settings_.body_mass : m.totalMass();
-    if (!(body_mass_ > 0.0))
-      throw SettingsError("parameter 'body_mass' is -1 but the URDF's total mass is " +
-                          std::to_string(body_mass_) + " kg");
-    record_.effort_per_kg.assign(n, 0.0);
-  }
-  record_.q.setZero(m.nq);
-  record_.qd.setZero(m.nq);
-  record_.qdd.setZero(m.nq);
-  record_.inputs.resize(wrenches_.size());
-  for (std::size_t k = 0; k < wrenches_.size(); ++k)
-    record_.inputs[k].frame = settings_.estimator.wrenches[k].link;
-  record_.plates.resize(plates_.size());
-  for (Sample& s : ring_) s.effort.assign(n, kNaN);
   coordinate_segment_ = coordinateSegments(m);
   for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
@@ -241,17 +168,6 @@ void Pipeline::fillExternal() {
   record_.contact_link = external_->contactLink();
 }
 
-void Pipeline::anchor(Stamp stamp) {
-  // The time axis resolves 1 ns within 2^52 ns (52 days) of its origin: a stamp farther
-  // away starts it again, but only while no time on it has been handed out since the
-  // start or the last reset. Under the estimator's samples a new origin would turn time
-  // back, and every later sample would be refused as out of order; on the axis kept,
-  // times beyond the reach stay in order and lose resolution slowly (2 ns to 104 days).
-  if (have_ref_ && (axis_used_ || std::abs(stamp - time_ref_) <= kReach)) return;
-  time_ref_ = stamp;
-  have_ref_ = true;
-}
-
 std::string Pipeline::smoothedBandwidthBound() const {
   if (!smoothed_) return "";
   const Estimator& e = smoothed_->estimator;
@@ -272,16 +188,7 @@ std::string Pipeline::smoothedBandwidthBound() const {
   return text;
 }
 
-double Pipeline::relative(Stamp stamp) {
-  anchor(stamp);
-  axis_used_ = true;
-  return static_cast<double>(stamp - time_ref_) * 1e-9;
-}
-
-Stamp Pipeline::absolute(double t) const {
-  const Sample* s = sampleAt(t);
-  return s ? s->stamp : time_ref_ + static_cast<Stamp>(std::llround(t * 1e9));
-}
+Stamp Pipeline::absolute(double t) const { return builder_.stampAt(t); }
 
 Outcome Pipeline::count(InputKind kind, Outcome outcome) {
   ++counters_.outcomes[static_cast<int>(kind)][static_cast<int>(outcome)];
@@ -293,20 +200,13 @@ Outcome Pipeline::fail(InputKind kind, Outcome outcome, const std::string& why) 
   return count(kind, outcome);
 }
 
-bool Pipeline::clockWentBack(Stamp stamp, Stamp clock) {
-  // The clock and the stamps come on different connections, so the clock may go back
-  // one message after the stamps did (or before): a clock going back is a jump only
-  // while the stamps do not go forward, else one jump would reset twice; going back
-  // first, it confirms the stamps' jump back when they follow.
-  const bool back = last_clock_ != 0 && clock < last_clock_;
-  last_clock_ = clock;
-  if (back) clock_back_ = settings_.stamps.jump_confirm;
-  return back && !(stamp > last_stamp_);
+Outcome Pipeline::stampOutcome(InputKind kind, StampVerdict verdict) {
+  if (verdict == StampVerdict::kRogue) return count(kind, Outcome::kRogueStamp);
+  if (verdict == StampVerdict::kJump) resetTimeline();
+  return Outcome::kUsed;
 }
 
-void Pipeline::resetTimeline(Stamp stamp) { resetTimeline(last_stamp_, stamp); }
-
-void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
+void Pipeline::resetTimeline() {
   // A looping bag (rosbag play -l), a restarted simulation, a driver's clock set: the
   // filters' memory belongs to another timeline, and so does the time axis. An instant
   // still waiting for a publisher is taken first, on its own timeline.
@@ -315,10 +215,7 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
     stashGroupRecords();
     stashed_ = stashed_smoothed_ = false;
   }
-  held_t_ = -1e300;
-  jumped_ = true;
-  jump_from_ = from;
-  jump_to_ = stamp;
+  builder_.clearHeld();
   drainSmoother();
   estimator_.reset();
   if (smoothed_) smoothed_->estimator.reset();
@@ -326,69 +223,10 @@ void Pipeline::resetTimeline(Stamp from, Stamp stamp) {
   if (smoothed_) smoothed_->settle.restarted = true;
   implausible_run_ = 0;
   if (external_) external_->reset();
-  clock_.reset();
-  ring_count_ = 0;
-  last_stamp_ = 0;
-  have_ref_ = axis_used_ = false;
-  pending_ = clock_back_ = 0;
+  builder_.forget();
+  timeline_.restart();
   ++counters_.resets;
-  if (jumpedForward()) ++counters_.forward_jumps;
-}
-
-Outcome Pipeline::checkJointStamp(Stamp stamp, Stamp clock) {
-  constexpr InputKind kind = InputKind::kJointState;
-  if (clockWentBack(stamp, clock)) resetTimeline(stamp);
-  if (last_stamp_ == 0) {
-    // The first joint state of the timeline, on an axis whose origin the wrenches or
-    // plates set (and used) more than its reach away: their clock is another one (a
-    // simulation's from 0 beside a wall clock). Kept, the axis would resolve these stamps
-    // to no better than its rounding there (240 ns at 54 years) and take samples a few ns
-    // apart for duplicates; the timeline restarts from the joint states, their readings
-    // before it left behind (one warning, a jump in the diagnostics).
-    if (axis_used_ && std::abs(stamp - time_ref_) > kReach) resetTimeline(time_ref_, stamp);
-    return Outcome::kUsed;
-  }
-  const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
-  const double threshold = settings_.time_jump_threshold;
-  // Forward, a gap of 10 periods is no jump either (a slow stream).
-  const double forward = std::max(threshold, 10e-9 * clock_.period());
-  // A gap that the clock saw as well (a driver or a bag paused) keeps the stream's lag
-  // behind the clock: no jump either.
-  const double lag = static_cast<double>((stamp - clock) - (last_stamp_ - last_taken_clock_));
-  if ((ahead >= -threshold && ahead <= forward) ||
-      (ahead > 0.0 && std::abs(lag) * 1e-9 <= threshold)) {
-    pending_ = 0;
-    return Outcome::kUsed;
-  }
-  // On another timeline: a jump once jump_confirm in a row agree (in order, each within
-  // `forward` of the one before), or at once back after the clock went back.
-  const bool follows = pending_ > 0 && stamp > pending_stamp_ &&
-                       static_cast<double>(stamp - pending_stamp_) * 1e-9 <= forward;
-  pending_ = follows ? pending_ + 1 : 1;
-  pending_stamp_ = stamp;
-  if (pending_ >= settings_.stamps.jump_confirm || (ahead < 0.0 && clock_back_ > 0)) {
-    resetTimeline(stamp);
-    return Outcome::kUsed;
-  }
-  return fail(kind, Outcome::kRogueStamp,
-              settings_.joint_states_topic + ": stamp " + seconds(stamp) + " is " +
-                  std::to_string(ahead) + " s from the stream's (" + seconds(last_stamp_) +
-                  "): dropped (a jump of time takes " +
-                  std::to_string(settings_.stamps.jump_confirm) + " in a row)");
-}
-
-Outcome Pipeline::checkInputStamp(InputKind kind, const std::string& input, double timeout,
-                                  Stamp stamp, Stamp clock) {
-  if (clockWentBack(stamp, clock)) resetTimeline(stamp);
-  if (last_stamp_ == 0) return Outcome::kUsed;  // no joint state on this timeline yet
-  // The joint states may lag a reading that is on time by a few periods (a sensor whose
-  // readings arrive before the joint states of their time): ten are allowed.
-  const double ahead = static_cast<double>(stamp - last_stamp_) * 1e-9;
-  if (ahead <= timeout + 1e-8 * clock_.period() && ahead >= -settings_.time_jump_threshold)
-    return Outcome::kUsed;
-  return fail(kind, Outcome::kRogueStamp,
-              input + ": stamp " + seconds(stamp) + " is " + std::to_string(ahead) +
-                  " s from the joint states' (" + seconds(last_stamp_) + "): dropped");
+  if (timeline_.jumpedForward()) ++counters_.forward_jumps;
 }
 
 bool Pipeline::checkJointState(const std::vector<std::string>& names,
@@ -479,7 +317,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
   nonfinite_velocity_.clear();
   mimic_contradiction_.clear();
   if (!checkJointState(names, position, velocity, effort)) return count(kind, Outcome::kInvalid);
-  jumped_ = false;
+  timeline_.clearJump();
   // Neither a sample nor a time: its stamp and clock are not the stream's.
   if (!movesNeeded()) {
     mapJointState(names, position, velocity, effort);
@@ -487,24 +325,26 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
                 settings_.joint_states_topic +
                     ": a message with none of the joints the loads need: not a sample");
   }
-  if (!zeroStamp(joints_stamped_, stamp, clock))
+  if (!Timeline::zeroStamp(joints_stamped_, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, settings_.joint_states_topic + kZeroStamp);
-  const Outcome timeline = checkJointStamp(stamp, clock);
+  const Outcome timeline = stampOutcome(
+      kind, timeline_.checkJointStamp(stamp, clock, settings_.joint_states_topic, problem_));
   if (timeline != Outcome::kUsed) return timeline;
   // The order before anything is stored: a message of an instant already taken, or older
   // than the one being assembled, is dropped whole.
   const bool joins = joinsGroup(stamp);
-  const Stamp newest = std::max(last_stamp_, group_.open && !joins ? group_.newest : Stamp{0});
-  if (newest != 0 && stamp <= newest)
-    return fail(
-        kind, Outcome::kOrder,
-        settings_.joint_states_topic + ": " +
-            toString(stamp == newest ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder) + " " +
-            seconds(stamp) + " (previous " + seconds(newest) + "): message dropped");
+  const Stamp assembling = group_.open && !joins ? group_.newest : Stamp{0};
+  const StampVerdict order = timeline_.order(stamp, assembling);
+  if (order != StampVerdict::kOnTime)
+    return fail(kind, Outcome::kOrder,
+                settings_.joint_states_topic + ": " + toString(sampleStatus(order)) + " " +
+                    secondsText(stamp) + " (previous " +
+                    secondsText(std::max(timeline_.lastStamp(), assembling)) +
+                    "): message dropped");
   if (!plausibleJointState(stamp, names, position)) return count(kind, Outcome::kImplausible);
   if (group_.open && !joins) closeGroup();  // a later instant: the open one is complete as is
   mapJointState(names, position, plausibleVelocities(names, velocity), effort);
-  anchor(stamp);
+  timeline_.anchor(stamp);
   group_.oldest = group_.open ? std::min(group_.oldest, stamp) : stamp;
   group_.newest = group_.open ? std::max(group_.newest, stamp) : stamp;
   group_.has_effort = (group_.open && group_.has_effort) || !effort.empty();
@@ -617,13 +457,13 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   constexpr InputKind kind = InputKind::kJointState;
   const auto order = [&](SampleStatus status) {
     return fail(kind, Outcome::kOrder,
-                settings_.joint_states_topic + ": " + toString(status) + " " + seconds(stamp) +
-                    " (previous " + seconds(last_stamp_) + "): message dropped");
+                settings_.joint_states_topic + ": " + toString(status) + " " + secondsText(stamp) +
+                    " (previous " + secondsText(timeline_.lastStamp()) + "): message dropped");
   };
   // The order of the stamps, not of the instants (which the sample clock makes increase).
-  if (last_stamp_ != 0 && stamp <= last_stamp_)
-    return order(stamp == last_stamp_ ? SampleStatus::kDuplicate : SampleStatus::kOutOfOrder);
-  const double t = relative(clock_.add(stamp));
+  const StampVerdict in_order = timeline_.order(stamp);
+  if (in_order != StampVerdict::kOnTime) return order(sampleStatus(in_order));
+  const double t = timeline_.sampleTime(stamp);
   const SampleStatus status =
       estimator_.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
   noteStart(settle_, status, t);
@@ -635,9 +475,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
                   settings_.joint_states_topic + ": non-finite stamp or base pose: dropped");
     default: break;
   }
-  last_stamp_ = stamp;
-  last_taken_clock_ = last_clock_;
-  if (clock_back_ > 0) --clock_back_;
+  timeline_.taken(stamp);
   remember(t, stamp, has_effort);
   countHeld(t);
   if (smoothed_) sampleSmoothed(t, base);
@@ -646,10 +484,10 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged)
     return count(kind, Outcome::kUnchanged);
   fillRecord(estimator_, record_);
-  if (!finiteLoads(record_)) {
+  if (!RecordBuilder::finiteLoads(record_)) {
     restartFilters(false);  // what made them not finite is in the filters' state
     return fail(kind, Outcome::kNonFinite,
-                settings_.joint_states_topic + ": the loads at " + seconds(stamp) +
+                settings_.joint_states_topic + ": the loads at " + secondsText(stamp) +
                     " are not finite: not published, the filters restart");
   }
   return count(kind, Outcome::kPublished);
@@ -665,7 +503,8 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
   smoothed_published_ = status == SampleStatus::kPublished &&
                         !(e.lastWasReused() && !settings_.estimator.savings.republish_unchanged);
   if (smoothed_published_) fillRecord(e, stream.record);
-  if (smoothed_published_ && !finiteLoads(stream.record)) {  // counted by the immediate stream
+  if (smoothed_published_ &&
+      !RecordBuilder::finiteLoads(stream.record)) {  // counted by the immediate stream
     e.reset();
     stream.settle.restarted = true;
     smoothed_published_ = false;
@@ -727,7 +566,7 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
     if (status != SampleStatus::kPublished) continue;
     if (estimator.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
     fillRecord(estimator, record);
-    if (!finiteLoads(record)) continue;  // never published
+    if (!RecordBuilder::finiteLoads(record)) continue;  // never published
     return true;
   }
   return false;
@@ -774,89 +613,16 @@ Outcome Pipeline::staleProblem() {
 
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
   // The estimates still to come are of the newest sample and the delaySamples() before
-  // it (a smoother's pending samples, its carry over a gap included), in either stream:
-  // grown to twice that when they do not fit (rarely after the warm-up: a faster rate, a
-  // gap).
+  // it (a smoother's pending samples, its carry over a gap included), in either stream.
   const int delay =
       std::max(estimator_.delaySamples(), smoothed_ ? smoothed_->estimator.delaySamples() : 0);
-  const std::size_t needed = static_cast<std::size_t>(delay) + 1;
-  if (needed > ring_.size()) growRing(2 * needed);
-  Sample& s = ring_[ring_head_];
-  s.t = t;
-  s.stamp = stamp;
-  s.has_effort = has_effort;
-  if (has_effort) s.effort = joints_.effort();  // same size: no allocation
-  ring_head_ = (ring_head_ + 1) % ring_.size();
-  if (ring_count_ < ring_.size()) ++ring_count_;
-}
-
-void Pipeline::growRing(std::size_t size) {
-  // Every slot's effort at its size now: none allocated when first used.
-  std::vector<Sample> grown(size);
-  for (Sample& slot : grown) slot.effort.assign(ring_.front().effort.size(), kNaN);
-  for (std::size_t i = 0; i < ring_count_; ++i)  // oldest first
-    grown[i] = std::move(ring_[(ring_head_ + ring_.size() - ring_count_ + i) % ring_.size()]);
-  ring_head_ = ring_count_;
-  ring_.swap(grown);
-}
-
-const Pipeline::Sample* Pipeline::sampleAt(double t) const {
-  // The estimate's time is one of the samples' own times (the filter's delay is a whole
-  // number of samples); half a nanosecond separates it from any other.
-  for (std::size_t i = 0; i < ring_count_; ++i) {
-    const Sample& s = ring_[(ring_head_ + ring_.size() - 1 - i) % ring_.size()];
-    if (std::abs(s.t - t) < 0.5e-9) return &s;
-  }
-  return nullptr;
+  builder_.remember(t, stamp, has_effort ? &joints_.effort() : nullptr, delay);
 }
 
 void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
-  const Data<double>& data = estimator.data();
-  const Sample* s = sampleAt(estimator.stamp());
-  rec.stamp = s ? s->stamp : absolute(estimator.stamp());
-  const bool measured = s && s->has_effort;
-  const UncertaintyConfig& u = settings_.estimator.uncertainty;
-  const std::size_t per_joint = u.diagonal_only ? 6 : 36;
-  for (std::size_t i = 0; i < rec.segment.size(); ++i) {
-    const int segment = rec.segment[i];
-    const std::size_t j = static_cast<std::size_t>(segment);
-    rec.force[i] = data.force[j];
-    rec.moment[i] = data.moment[j];
-    rec.effort[i] = data.effort[j];
-    rec.measured_effort[i] = measured ? s->effort[i] : kNaN;
-    if (!rec.effort_per_kg.empty()) rec.effort_per_kg[i] = data.effort[j] / body_mass_;
-    fillCoordinates(estimator, rec, i, j);
-    if (!u.enabled) continue;
-    const Eigen::Matrix<double, 6, 6>& C = estimator.covariance(segment);
-    double* cov = &rec.covariance[per_joint * i];
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c < 6; ++c)
-        if (!u.diagonal_only)
-          cov[6 * r + c] = C(r, c);
-        else if (r == c)
-          cov[r] = C(r, r);
-    rec.effort_stddev[i] = std::sqrt(estimator.effortVariance(segment));
-  }
-  fillSideOutputs(estimator, rec);
-  rec.status =
-      statusOf(estimator, &estimator == &estimator_ ? settle_.from : smoothed_->settle.from, rec);
+  const Settle& settle = &estimator == &estimator_ ? settle_ : smoothed_->settle;
+  builder_.fill(estimator, settle.from, rec);
   if (external_ && &rec == &record_) fillExternal();
-}
-
-std::uint8_t Pipeline::statusOf(const Estimator& estimator, double settle_from,
-                                const LoadsRecord& rec) const {
-  const PlausibilityConfig& p = settings_.plausibility;
-  std::uint8_t status = kTrusted;
-  if (estimator.stamp() < settle_from + p.settle_time) status |= kSettling;
-  if (std::abs(estimator.stamp() - held_t_) <= p.settle_time) status |= kHeldJoint;
-  for (const InputRecord& in : rec.inputs) status |= in.stale ? kStaleInput : 0;
-  for (std::size_t k = 0; k < rec.plates.size(); ++k)
-    if (rec.plates[k].stale && estimator.plateNeeded(static_cast<int>(k))) status |= kStaleInput;
-  const Model<double>& m = model();
-  for (std::size_t i = 0; i < rec.segment.size(); ++i)
-    if (implausibleEffort(m, p, static_cast<std::size_t>(rec.segment[i]), rec.effort[i]))
-      status |= kImplausibleLoad;
-  return status;
 }
 
 void Pipeline::countHeld(double t) {
@@ -866,7 +632,7 @@ void Pipeline::countHeld(double t) {
     held = estimator_.coordinateNeeded(k) && !joints_.fresh(k);
   if (held) {
     ++counters_.held_samples;
-    held_t_ = t;
+    builder_.heldAt(t);
   }
   joints_.clearFresh();
 }
@@ -883,13 +649,6 @@ void Pipeline::noteStart(Settle& settle, SampleStatus status, double t) {
   settle.warming = warming;
 }
 
-bool Pipeline::finiteLoads(const LoadsRecord& rec) {
-  for (std::size_t i = 0; i < rec.effort.size(); ++i)
-    if (!std::isfinite(rec.effort[i]) || !rec.force[i].allFinite() || !rec.moment[i].allFinite())
-      return false;
-  return rec.base_force.allFinite() && rec.base_moment.allFinite();
-}
-
 void Pipeline::restartFilters(bool drain) {
   // The wrench and plate readings are forgotten too (Estimator::reset): the next ones
   // refill them.
@@ -898,20 +657,7 @@ void Pipeline::restartFilters(bool drain) {
   if (smoothed_) smoothed_->estimator.reset();
   settle_.restarted = true;
   if (smoothed_) smoothed_->settle.restarted = true;
-  ring_count_ = 0;  // the stamps of the samples the filters held; the stamps' order stays
-}
-
-std::string describeStatus(std::uint8_t status) {
-  if (status == kTrusted) return "trusted";
-  std::string words;
-  const auto add = [&](std::uint8_t bit, const char* word) {
-    if (status & bit) words += (words.empty() ? "" : ", ") + std::string(word);
-  };
-  add(kSettling, "settling");
-  add(kStaleInput, "stale input");
-  add(kImplausibleLoad, "implausible load");
-  add(kHeldJoint, "held joint");
-  return words;
+  builder_.forget();  // the samples the filters held; the stamps' order stays
 }
 
 bool Pipeline::plausibleWrench(InputKind kind, const std::string& input,
@@ -935,7 +681,8 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   const PlausibilityConfig& p = settings_.plausibility;
   const Model<double>& m = model();
   const std::vector<int>& coordinate = joints_.coordinates();  // bound by checkJointState
-  const double dt = last_stamp_ != 0 ? 1e-9 * static_cast<double>(stamp - last_stamp_) : -1.0;
+  const Stamp last = timeline_.lastStamp();
+  const double dt = last != 0 ? 1e-9 * static_cast<double>(stamp - last) : -1.0;
   bool too_fast = false;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const int c = coordinate[i];
@@ -986,55 +733,6 @@ const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<std::
   return any ? velocity_checked_ : velocity;
 }
 
-void Pipeline::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) {
-  rec.q = estimator.q();  // same sizes: no allocation
-  rec.qd = estimator.qd();
-  rec.qdd = estimator.qdd();
-  rec.planar = estimator.lastWasPlanar();
-  for (std::size_t k = 0; k < rec.inputs.size(); ++k) {
-    const int input = static_cast<int>(k);
-    InputRecord& in = rec.inputs[k];
-    in.stale = estimator.stale(input);
-    in.used = estimator.sensorSegment(input) >= 0 && estimator.sensorUsed(input);
-    const std::string& frame = frame_resolver_.wrenchFrame(input);
-    if (!frame.empty() && in.frame != frame) in.frame = frame;  // rare: a new frame
-    const Eigen::Isometry3d& X = frame_resolver_.wrenchPose(input);
-    in.residual =
-        in.used ? residualInReading(estimator.sensorResidual(input), X.linear(), X.translation())
-                : Wrench<double>();
-    in.predicted =
-        in.used ? residualInReading(estimator.predictedWrench(input), X.linear(), X.translation())
-                : Wrench<double>();
-  }
-  for (std::size_t k = 0; k < rec.plates.size(); ++k) {
-    PlateRecord& p = rec.plates[k];
-    p.stale = estimator.plateStale(static_cast<int>(k));
-    p.reading = estimator.plateReading(static_cast<int>(k));
-    const std::string& frame = frame_resolver_.plateFrame(static_cast<int>(k));
-    if (p.frame != frame) p.frame = frame;  // rare: a new frame
-  }
-  if (model().floating_base) {
-    rec.base_force = estimator.data().force[0];
-    rec.base_moment = estimator.data().moment[0];
-  }
-}
-
-void Pipeline::fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
-                               std::size_t segment) {
-  const Model<double>& m = model();
-  const int c = m.coordinate[segment];
-  if (c < 0) return;  // a fixed joint kept as a segment: 0 from the constructor
-  // As forwardKinematics maps them (a mimic joint follows its leader).
-  const double k = m.multiplier[segment];
-  rec.position[i] = k * estimator.q()[c] + m.offset[segment];
-  rec.velocity[i] = k * estimator.qd()[c];
-  rec.acceleration[i] = k * estimator.qdd()[c];
-  if (!rec.motor_effort.empty())
-    rec.motor_effort[i] =
-        rec.effort[i] + frictionEffort(m.damping[segment], m.friction[segment], rec.velocity[i],
-                                       settings_.friction.velocity_scale);
-}
-
 bool Pipeline::retune(const DifferentiatorConfig& differentiator, int decimation) {
   // A new differentiator restarts the filters: a smoother's pending loads come first.
   EstimatorConfig next = estimator_.config();
@@ -1069,12 +767,13 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   if (frame.empty())
     return fail(kind, Outcome::kFrame,
                 "wrench '" + topic + "': empty header.frame_id and no 'frame' configured: dropped");
-  jumped_ = false;
-  if (!zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
+  timeline_.clearJump();
+  if (!Timeline::zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, "wrench '" + topic + "'" + kZeroStamp);
   // The stamps first, as for a joint state: the clock is followed whatever the values.
-  const Outcome timeline = checkInputStamp(
-      kind, "wrench '" + topic + "'", settings_.estimator.wrenches[ix(k)].timeout, stamp, clock);
+  const Outcome timeline = stampOutcome(
+      kind, timeline_.checkInputStamp(stamp, clock, settings_.estimator.wrenches[ix(k)].timeout,
+                                      "wrench '" + topic + "'", problem_));
   if (timeline != Outcome::kUsed) return timeline;
   if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
     return count(kind, Outcome::kImplausible);
@@ -1086,12 +785,12 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   const Eigen::Isometry3d& X = frame_resolver_.wrenchPose(k);
   Eigen::Vector3d f_link, m_link;
   wrenchInLink(X.linear(), X.translation(), f, m, f_link, m_link);
-  const double t = relative(stamp);
+  const double t = timeline_.relative(stamp);
   if (smoothed_) smoothed_->estimator.addWrench(k, t, f_link, m_link);  // the same order
   if (!estimator_.addWrench(k, t, f_link, m_link))
-    return fail(
-        kind, Outcome::kOrder,
-        "wrench '" + topic + "': stamp " + seconds(stamp) + " not newer than the last: dropped");
+    return fail(kind, Outcome::kOrder,
+                "wrench '" + topic + "': stamp " + secondsText(stamp) +
+                    " not newer than the last: dropped");
   return count(kind, Outcome::kUsed);
 }
 
@@ -1123,20 +822,21 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
     return fail(
         kind, Outcome::kFrame,
         "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
-  jumped_ = false;
-  if (!zeroStamp(plates_[ix(k)].stamped, stamp, clock))
+  timeline_.clearJump();
+  if (!Timeline::zeroStamp(plates_[ix(k)].stamped, stamp, clock))
     return fail(kind, Outcome::kRogueStamp, "force plate '" + name + "'" + kZeroStamp);
-  const Outcome timeline = checkInputStamp(kind, "force plate '" + name + "'",
-                                           settings_.estimator.plates[ix(k)].timeout, stamp, clock);
+  const Outcome timeline = stampOutcome(
+      kind, timeline_.checkInputStamp(stamp, clock, settings_.estimator.plates[ix(k)].timeout,
+                                      "force plate '" + name + "'", problem_));
   if (timeline != Outcome::kUsed) return timeline;
   if (!plausibleWrench(kind, "force plate '" + name + "'", force, moment))
     return count(kind, Outcome::kImplausible);
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
-  const double t = relative(stamp);
+  const double t = timeline_.relative(stamp);
   if (smoothed_) smoothed_->estimator.addPlateSample(k, t, force, moment);  // the same order
   if (!estimator_.addPlateSample(k, t, force, moment))
     return fail(kind, Outcome::kOrder,
-                "force plate '" + name + "': stamp " + seconds(stamp) +
+                "force plate '" + name + "': stamp " + secondsText(stamp) +
                     " not newer than the last: dropped");
   return count(kind, Outcome::kUsed);
 }

@@ -286,11 +286,13 @@ void readWrench(Section& s, WrenchTopicSettings& w, WrenchInputConfig& input) {
   s.read("force_noise", input.force_noise);
   s.read("moment_noise", input.moment_noise);
   input.name = w.topic;  // an input is named by its topic in the estimator's messages
+  w.name = input.name;   // the pair's key (validate)
 }
 
 void readPlate(Section& s, PlateTopicSettings& p, PlateInputConfig& input) {
   ForcePlateConfig& plate = input.plate;
   s.read("name", plate.name);
+  p.name = plate.name;  // the pair's key (validate)
   s.read("topic", p.topic);
   s.read("frame", p.frame);
   s.read("link", plate.link);

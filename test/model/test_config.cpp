@@ -3,6 +3,7 @@
 // (no ROS): the reader's side is test_settings.cpp.
 #include <joint_load_estimator/config.hpp>
 #include <joint_load_estimator/estimator.hpp>
+#include <joint_load_estimator/settings_reader.hpp>
 #include <joint_load_estimator/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -295,6 +297,53 @@ TEST(Config, Wrenches) {
        // The topics pair with the inputs by index.
        {"wrenches", [](Settings& s) { s.wrenches.pop_back(); }}},
       false);
+}
+
+// The topic settings and the estimator's inputs pair by name: each topic's settings carry
+// the name of their input or plate (the reader sets them: a wrench input is named by its
+// topic); lists in different orders are refused, naming both. Settings made in code without
+// the names pair by index, as before.
+TEST(Config, TopicsPairWithTheirInputsByName) {
+  Settings s = withInputs();
+  EXPECT_EQ(refusal(s), "");  // names left empty: paired by index
+  s.wrenches[0].name = "/tool/wrench";
+  s.wrenches[1].name = "/ft/wrench";
+  EXPECT_EQ(refusal(s), "");
+  std::swap(s.wrenches[0], s.wrenches[1]);
+  EXPECT_EQ(refusal(s),
+            "parameter 'wrenches[0]/name' is '/ft/wrench' in the topic's settings, but "
+            "'/tool/wrench' in the input's");
+  std::swap(s.estimator.wrenches[0], s.estimator.wrenches[1]);
+  EXPECT_EQ(refusal(s), "");
+  // Two plates, their topics' settings named.
+  s.force_plates.push_back(s.force_plates[0]);
+  s.estimator.plates.push_back(s.estimator.plates[0]);
+  s.estimator.plates[1].plate.name = "right";
+  s.force_plates[1].topic = "/plate/right";
+  EXPECT_EQ(refusal(s), "");  // names left empty: paired by index
+  s.force_plates[0].name = "plate";
+  s.force_plates[1].name = "right";
+  EXPECT_EQ(refusal(s), "");
+  std::swap(s.force_plates[0], s.force_plates[1]);
+  EXPECT_EQ(refusal(s),
+            "parameter 'force_plates[0]/name' is 'right' in the topic's settings, but 'plate' in "
+            "the plate's");
+  // Read from YAML, each pair named alike.
+  const Settings read =
+      jle::parseSettings(jle::parseYaml("wrenches:\n"
+                                        "  - {topic: /a, link: tool0}\n"
+                                        "  - {topic: /b, link: tool0}\n"
+                                        "force_plates:\n"
+                                        "  - {name: left, topic: /l, link: left_foot}\n"
+                                        "  - {name: right, topic: /r, link: right_foot}\n"));
+  ASSERT_EQ(read.wrenches.size(), 2u);
+  ASSERT_EQ(read.force_plates.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(read.estimator.wrenches[k].name, read.wrenches[k].topic);
+    EXPECT_EQ(read.wrenches[k].name, read.estimator.wrenches[k].name);
+    EXPECT_EQ(read.force_plates[k].name, read.estimator.plates[k].plate.name);
+  }
+  EXPECT_EQ(read.force_plates[1].name, "right");
 }
 
 TEST(Config, ForcePlates) {
