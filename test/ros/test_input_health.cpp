@@ -91,6 +91,16 @@ TEST(MasterWatch, LostBackAndRestarted) {
   EXPECT_EQ(bare.update(true, ""), Event::kNone);
   EXPECT_EQ(bare.update(false, ""), Event::kLost);
   EXPECT_EQ(bare.update(true, ""), Event::kRestarted);
+  // A node started before roscore set /run_id learns it at a poll, and a restart then
+  // names both run_ids.
+  jle::MasterWatch early("");
+  EXPECT_EQ(early.update(true, ""), Event::kNone);
+  EXPECT_EQ(early.update(true, "run-1"), Event::kNone);
+  EXPECT_EQ(early.runId(), "run-1");
+  EXPECT_EQ(early.update(false, ""), Event::kLost);
+  EXPECT_EQ(early.update(true, "run-2"), Event::kRestarted);
+  EXPECT_EQ(early.previousRunId(), "run-1");
+  EXPECT_EQ(early.runId(), "run-2");
 }
 
 }  // namespace

@@ -31,6 +31,11 @@ class MasterWatch {
       unknown_polls_ = 0;
       return lost ? Event::kLost : Event::kNone;
     }
+    // The node started before roscore set /run_id: the first one read is its master's.
+    if (reachable_ && run_id_.empty() && !run_id.empty()) {
+      run_id_ = run_id;
+      return Event::kNone;
+    }
     const bool changed = !run_id.empty() && !run_id_.empty() && run_id != run_id_;
     if (reachable_ && !changed) return Event::kNone;
     // Back after a loss without a run_id yet (roscore sets /run_id a moment after its
