@@ -22,7 +22,7 @@
 
 #include "node_test_common.hpp"
 
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 namespace {
 
