@@ -4,12 +4,12 @@
 // are known (ground_truth.hpp). Writes one CSV row per configuration and joint plus an
 // overall row per configuration; bench/plot_accuracy.py turns it into docs/studies/accuracy.md
 // and the figures. tools/accuracy.sh runs both.
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <jle_testing/ground_truth.hpp>
 

@@ -5,9 +5,9 @@
 // stamps the stamp errs), after a settling time, and the CPU time per sample of the
 // differentiator alone, as a ratio to the old default's in the same run.
 //   bench_adaptive_filter [DATA_DIR]
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/ground_truth.hpp>
 

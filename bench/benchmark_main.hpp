@@ -3,7 +3,7 @@
 // Google Benchmark's own options and the benchmarks.
 #pragma once
 
-#include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
 
 #include <benchmark/benchmark.h>
 

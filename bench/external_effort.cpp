@@ -19,11 +19,11 @@
 // jittered stamps; at two poses inside the Panda's joint limits and at a near-singular one
 // beyond them, each row with the range of the tool Jacobian's condition number over the
 // window (sigma_max / sigma_min of its 6 x 7 [m/s; rad/s] rows, as the solve uses it).
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/external_effort.hpp>
-#include <joint_load_estimator/joint_space.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/external_effort.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/joint_space.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <jle_testing/contact_scene.hpp>
 #include <jle_testing/panda_contacts.hpp>

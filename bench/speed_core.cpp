@@ -1,12 +1,12 @@
 // Per-timestep cost of the core against Orocos KDL on the same states, same run.
 // Each benchmark cycles through the same 256 random states (fixed seed), so both
 // libraries see identical inputs. The ratios are printed by bench/speed (run_speed.sh).
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/random_models.hpp>
 

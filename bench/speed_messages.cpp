@@ -7,9 +7,9 @@
 // smoothed record serialised too (docs/how_it_works.md "Two streams": their ratio is the cost of
 // both).
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
 
 #include "benchmark_main.hpp"
 

@@ -9,9 +9,9 @@
 // that the two formulations differ only in where the backward pass works.
 #pragma once
 
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
 
 #include <jle_testing/random_models.hpp>
 

@@ -5,11 +5,11 @@
 // efforts and of qdd. Prints a Markdown table.
 //   zero_phase_study [--quick]
 #include <jle_testing/ground_truth.hpp>
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <cmath>
 #include <cstdio>

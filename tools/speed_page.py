@@ -258,7 +258,7 @@ def main():
             "`~wrench/<joint>` is computed only when subscribed. The planar reduction "
             "publishes the same 6-D wrenches within 1e-12 relative "
             "(`test/algorithms/test_planar.cpp`; conditions in "
-            "`include/joint_load_estimator/planar.hpp`); its effect on accuracy and run time "
+            "`include/joint_load_estimator/model/planar.hpp`); its effect on accuracy and run time "
             "in the accuracy study: [accuracy.md](accuracy.md), scene `planar_savings`.\n",
             LINKING]
     with open(args.output, "w", encoding="utf-8") as f:

@@ -4,8 +4,8 @@
 // joint_load_estimator.process_bag only, so that the core module loads without ROS.
 #include "records.hpp"
 
+#include <joint_load_estimator/filters/zero_phase.hpp>
 #include <joint_load_estimator/ros/bag_processing.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
 
 #include <pybind11/pybind11.h>
 

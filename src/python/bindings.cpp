@@ -6,14 +6,14 @@
 // module _bag, reads bags). docs/python.md.
 #include "records.hpp"
 
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/settings_reader.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
+#include <joint_load_estimator/settings/config.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>

@@ -2,7 +2,7 @@
 // kept as numpy columns: what the Python modules return for a batch or a bag. ROS-free.
 #pragma once
 
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

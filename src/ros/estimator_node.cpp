@@ -1,6 +1,6 @@
 #include <joint_load_estimator/ros/estimator_node.hpp>
 
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <tf2_eigen/tf2_eigen.h>
 

@@ -1,9 +1,9 @@
 // The joint_load_estimator node: parameters from ~ (config/default.yaml), model from
 // robot_description. A bad configuration exits non-zero with the culprit named.
 // --help and --version print and exit 0 before ros::init (no master, no parameters).
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/config.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
 #include <joint_load_estimator/ros/estimator_node.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <ros/ros.h>
 

@@ -4,7 +4,7 @@
 // (parseSettings, which checks it); the decimation and the thresholds apply in place,
 // a new differentiator restarts the filters (Pipeline::retune).
 #include <joint_load_estimator/ros/estimator_node.hpp>
-#include <joint_load_estimator/settings_reader.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include <mutex>
 #include <stdexcept>

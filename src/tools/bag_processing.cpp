@@ -2,13 +2,13 @@
 // Python bindings run it. Moved out of process_bag.cpp unchanged but for its sink.
 #include <joint_load_estimator/ros/bag_processing.hpp>
 
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/estimation/sensor_sign.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
-#include <joint_load_estimator/sensor_sign.hpp>
-#include <joint_load_estimator/settings_reader.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include "bag_errors.hpp"
 

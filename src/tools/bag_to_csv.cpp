@@ -2,8 +2,8 @@
 // from the node with rosbag record, or written by process_bag --output) as a CSV in the
 // columns of process_bag --csv and joint_loads. docs/data_in_out.md.
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/csv.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>

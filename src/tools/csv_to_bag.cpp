@@ -1,9 +1,9 @@
 // csv_to_bag: a trial in joint_loads' CSV columns (docs/joint_loads.md) as a bag of
 // sensor_msgs/JointState, geometry_msgs/WrenchStamped and /tf, so that it can be played
 // to the node or given to process_bag. docs/data_in_out.md.
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 #include "bag_writing.hpp"
 

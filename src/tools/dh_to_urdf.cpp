@@ -1,8 +1,8 @@
 // dh_to_urdf: a serial robot given as a Denavit-Hartenberg table (standard or modified)
 // with each link's mass, centre of mass and inertia, to a URDF that the package and KDL
 // read. The mapping is stated in kUsage and docs/dh_to_urdf.md.
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/csv.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
 
 #include <yaml-cpp/yaml.h>
 

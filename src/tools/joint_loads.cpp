@@ -1,18 +1,18 @@
 // joint_loads: the joint wrenches and efforts of a URDF robot along a CSV of joint
 // states (and applied wrenches), one output row per input row. docs/joint_loads.md.
-#include <joint_load_estimator/base_motion.hpp>
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/force_plate.hpp>
-#include <joint_load_estimator/friction.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/planar.hpp>
-#include <joint_load_estimator/plausibility.hpp>
-#include <joint_load_estimator/sto.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/base_motion.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/io/sto.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/force_plate.hpp>
+#include <joint_load_estimator/model/friction.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/planar.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/plausibility.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

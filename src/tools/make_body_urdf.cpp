@@ -2,8 +2,8 @@
 // knees, ankles, optionally subtalar joints, feet) scaled from body mass and height with
 // the classic anthropometric tables. Every table value, its source and every assumption
 // is documented here and in docs/body_model.md.
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <yaml-cpp/yaml.h>
 

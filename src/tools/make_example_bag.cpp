@@ -1,11 +1,11 @@
 // make_example_bag: a deterministic example bag of an arm with a wrist force/torque
 // sensor, for the demo and for process_bag's tests and benchmarks. The formulas are in
 // kUsage and docs/demo.md.
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include "bag_writing.hpp"
 

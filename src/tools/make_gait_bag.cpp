@@ -3,12 +3,12 @@
 // plate signals are computed from the model's own inverse dynamics, so that the
 // floating-base residual of the estimate is filter error only. The formulas are in
 // kUsage and docs/gait_demo.md.
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include "bag_writing.hpp"
 

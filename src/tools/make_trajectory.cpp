@@ -1,9 +1,9 @@
 // make_trajectory: a deterministic analytic joint-state CSV (and optionally an applied
 // wrench) for joint_loads. The formula is in kUsage and docs/joint_loads.md.
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <cmath>
 #include <cstdint>

@@ -5,14 +5,14 @@
 // this tool parses the options and writes the outputs. docs/demo.md.
 #include <joint_load_estimator/Contact.h>
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/io/sto.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 #include <joint_load_estimator/ros/bag_processing.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
 #include <joint_load_estimator/ros/external_outputs.hpp>
-#include <joint_load_estimator/sto.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
 
 #include <rosbag/bag.h>
 

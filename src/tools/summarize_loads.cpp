@@ -3,7 +3,7 @@
 // RMS difference from the measured effort when the joint states carried one). Used by
 // the headless demo (launch/demo.launch rviz:=false).
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 

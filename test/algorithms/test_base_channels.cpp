@@ -1,8 +1,8 @@
 // A floating base's channels (base_channels.hpp): the quaternion's sign kept continuous,
 // and the pose, twist and acceleration read back from a bank, against a base moving on a
 // parabola while turning at a constant rate about a fixed axis.
-#include <joint_load_estimator/base_channels.hpp>
-#include <joint_load_estimator/estimator.hpp>  // BasePose
+#include <joint_load_estimator/estimation/base_channels.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>  // BasePose
 
 #include <gtest/gtest.h>
 

@@ -10,11 +10,11 @@
 // 8e-16 of it (3.7 eps, the kept-fixed-joint arm; most cases stay under 2 eps), and the
 // bound 1e-12 leaves a margin of 1000 while still catching any wrong term, which would
 // be of the order of the scale itself.
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/papers_foot.hpp>
 #include <jle_testing/random_models.hpp>

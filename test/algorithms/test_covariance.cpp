@@ -2,11 +2,11 @@
 // Carlo: 10 000 noisy replays of one trajectory through the real Estimator, whose
 // empirical covariance the propagated one must match; and the filters' noise gains
 // against their closed forms.
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/ground_truth.hpp>
 #include <jle_testing/random_models.hpp>

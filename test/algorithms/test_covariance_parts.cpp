@@ -1,11 +1,11 @@
 // The covariance's model and workspace (covariance.hpp) on their own: the sweeps of a
 // mimic joint, the propagation at rest against closed forms, and the extrapolation of
 // uncertainty.period against a quadratic.
-#include <joint_load_estimator/covariance.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>  // UncertaintyConfig
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/covariance.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>  // UncertaintyConfig
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // The online estimator: exact where its differentiator is exact, wrench resampling,
 // signs, stale policies, bad stamps, decimation, a floating base from its pose alone.
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

@@ -7,13 +7,13 @@
 //    are this package's inverse dynamics with the wrench applied (addExternalWrench), the
 //    model efforts the same without it; the estimate must return the applied wrench;
 //  - the observer against the residual passed through the observer's own first-order lag.
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/external_effort.hpp>
-#include <joint_load_estimator/joint_space.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/external_effort.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/joint_space.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <jle_testing/contact_scene.hpp>
 #include <jle_testing/panda_contacts.hpp>

@@ -4,9 +4,9 @@
 // plate origin against the centre of pressure and the free moment, a plate origin below
 // the surface, a plate whose own z axis points down, the contact threshold, bad input;
 // and the reaction applied to the foot (applyPlateReaction) in double and in float.
-#include <joint_load_estimator/force_plate.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/force_plate.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

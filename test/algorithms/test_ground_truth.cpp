@@ -3,7 +3,7 @@
 // the same seed, and its scenes' loads match closed forms.
 #include <jle_testing/ground_truth.hpp>
 
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // The input buffer (input_buffer.hpp): linear resampling of known samples, the newest
 // held, staleness against the timeout and the stale policies, the ring's wrap, and the
 // filtered wrench read out of a bank, against numbers worked by hand.
-#include <joint_load_estimator/estimator.hpp>  // StalePolicy
-#include <joint_load_estimator/input_buffer.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>  // StalePolicy
+#include <joint_load_estimator/estimation/input_buffer.hpp>
 
 #include <gtest/gtest.h>
 

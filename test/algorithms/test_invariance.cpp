@@ -2,11 +2,11 @@
 // split in two, the choice of world frame, the scalar type) and what must change them
 // in a known way (the output frame); and the global Newton-Euler balance of a floating
 // humanoid, summed independently from the per-segment kinematics.
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/random_models.hpp>
 

@@ -11,11 +11,11 @@
 // S . f[seg], S the joint's unit twist in the segment frame: axis . moment (revolute),
 // axis . force (prismatic), our data.effort. KDL knows no mimic joints (kdl_parser gives
 // them their own coordinate), so the test sets each one from its leader itself.
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/random_models.hpp>
 

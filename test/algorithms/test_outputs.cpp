@@ -2,11 +2,11 @@
 // q-ddot the loads were computed from, against an independent filter bank fed the same
 // samples and against closed forms; and the optional friction term (friction.hpp) of the
 // motor effort, against its closed form on a 1-joint model, exactly absent when off.
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/friction.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/model/friction.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <gtest/gtest.h>
 

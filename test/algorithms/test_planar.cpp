@@ -9,11 +9,11 @@
 // force (or moment) of the sample over all segments (`scale`); the bound 1e-12 is the
 // one the saving promises, and any missing term (a lever arm along n, a sign) would be
 // of the order of the scale itself.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/planar.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/planar.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/papers_foot.hpp>
 #include <jle_testing/random_models.hpp>

@@ -1,11 +1,11 @@
 // The force plates' unit (plate_inputs.hpp): a static plate under a known foot, the
 // contact threshold at the estimate's stamp (filtered above it, raw below it), the stale
 // policies and the refused configurations, against numbers worked by hand.
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/estimator.hpp>  // PlateInputConfig
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/plate_inputs.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>  // PlateInputConfig
+#include <joint_load_estimator/estimation/plate_inputs.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
 // Force plates in the core: the decoding (force_plate.hpp) and the estimator's plate
 // path (threshold, contact at the estimate's stamp, no stance load smeared on a swinging
 // foot), against hand-worked numbers.
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/force_plate.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/force_plate.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

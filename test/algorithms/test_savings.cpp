@@ -1,7 +1,7 @@
 // Every saving of the estimator leaves the published loads unchanged: each test runs
 // the same samples with the saving on and off and compares the loads it applies to.
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <joint_load_estimator/frames.hpp>
-#include <joint_load_estimator/sensor_bias.hpp>
+#include <joint_load_estimator/estimation/sensor_bias.hpp>
+#include <joint_load_estimator/model/frames.hpp>
 #include <stdexcept>
 #include <vector>
 

@@ -8,12 +8,12 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <jle_testing/wrist_sensor_arm.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/sensor_sign.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/estimation/sensor_sign.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 namespace {
 

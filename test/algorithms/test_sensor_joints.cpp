@@ -1,11 +1,11 @@
 // The sensor joints' unit (sensor_joints.hpp): the prediction kept at the sensor's joint,
 // the measurement substituted for the joints proximal to it, the residual, and the
 // refused configurations, on an arm at rest against numbers worked by hand.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>  // WrenchInputConfig
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/sensor_joints.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>  // WrenchInputConfig
+#include <joint_load_estimator/estimation/sensor_joints.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 

@@ -9,11 +9,11 @@
 #include <jle_testing/far_com.hpp>
 #include <jle_testing/stability_bounds.hpp>
 
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/random_models.hpp>
 

@@ -1,7 +1,7 @@
 // sinCos (trig.hpp) against long double sinl/cosl (x87, 64-bit mantissa: an independent
 // reference 2000 times finer than double's ulp), and its fallback.
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/trig.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/trig.hpp>
 
 #include <gtest/gtest.h>
 

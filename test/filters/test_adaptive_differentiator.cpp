@@ -1,8 +1,8 @@
 // The adaptive differentiator (the node's default): exact where its model is, its noise
 // estimate against the noise put in, and its error against the fixed Kalman filters it
 // replaces on 1-DOF signals with jittered stamps, gaps, noise and acceleration steps.
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 #include <gtest/gtest.h>
 

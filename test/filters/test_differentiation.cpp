@@ -1,8 +1,8 @@
 // The differentiators against polynomials they must reproduce exactly (at any
 // spacing), and the Kalman filter against a known steady state.
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <gtest/gtest.h>
 

@@ -4,12 +4,12 @@
 // non-finite velocity costs that velocity, never the sample; positions-only streams are
 // unchanged by the setting.
 #include <jle_testing/message_stream.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <gtest/gtest.h>
 

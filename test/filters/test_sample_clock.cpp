@@ -3,10 +3,10 @@
 // irregular streams kept bit for bit; receive-time stamps of a periodic stream (jitter,
 // drops, gaps up to 10 periods, bursts) brought back to the instants; and, through the
 // Pipeline on a Panda at 1 kHz, the effort error with and without stamps/regularize.
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/sample_clock.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/filters/sample_clock.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <jle_testing/ground_truth.hpp>
 

@@ -4,8 +4,8 @@
 // equations of all the states at once), which is what the Rauch-Tung-Striebel recursion
 // computes in another way. And: every sample is estimated once, across gaps and at the
 // end of a stream.
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>

@@ -1,10 +1,10 @@
 // The adaptive smoother's bandwidth choice (spectral_cutoff.hpp) against independent
 // references: the FFT against the direct sum, the running-spectrum GCV against the
 // time-domain GCV of the offline zero-phase filter (zero_phase.cpp) on the same record.
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/spectral_cutoff.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/filters/spectral_cutoff.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 #include <gtest/gtest.h>
 

@@ -3,8 +3,8 @@
 // sine, with no phase; a constant and a ramp passed exactly through the padding, on
 // regular and irregular stamps; the automatic cutoffs on a noisy sine. The agreement with
 // an independently written scipy pipeline is test/scripts/zero_phase_reference.py.
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 #include <gtest/gtest.h>
 

@@ -4,10 +4,10 @@
 // are checked against the exact ones, the cutoffs against the best fixed cutoff (an
 // oracle scanned here with the truth), and joint_loads (the real CLI, on a CSV written
 // here) for its choice, its loads and its warnings.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/ground_truth.hpp>
 

@@ -25,7 +25,7 @@ common=(-std=c++17 -O1 -g $san -I"$repo/include" -I/usr/include/eigen3
 # Every target links the whole ROS-free core (compiled once, shared; without the fuzzer
 # runtime so that it holds no main): no list to keep up to date. The objects compile
 # JLE_JOBS at a time (default 2), each rebuilt when its source or a header is newer.
-core_sources=$(cd "$repo" && ls src/core/*.cpp)
+core_sources=$(cd "$repo" && ls src/{model,filters,estimation,pipeline,settings,io}/*.cpp)
 jobs=${JLE_JOBS:-2}
 objs=()
 build_failed=0

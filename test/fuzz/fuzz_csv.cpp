@@ -3,10 +3,10 @@
 // bindStateColumns, numbers, then the dynamics of every record). Any input must be read
 // or refused with a jle::CsvError; any other exception, a crash or a sanitizer report
 // is a bug. The file is a memfd (the reader takes a path: /proc/self/fd/N).
-#include <joint_load_estimator/csv.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/csv.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <sys/mman.h>
 #include <unistd.h>

@@ -11,8 +11,8 @@
 // and the published records. Built by build_and_run.sh.
 #include "fuzz_check.hpp"
 
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -3,9 +3,9 @@
 // other exception, a crash or a sanitizer report is a bug. Built by build_and_run.sh.
 #include "fuzz_check.hpp"
 
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <cstddef>
 #include <cstdint>

@@ -3,7 +3,7 @@
 // numbers, one a line, for test_link_client to compare with its own run.
 #include "link_scenario.hpp"
 
-#include <joint_load_estimator/command_line.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
 
 #include <cstdio>
 #include <exception>

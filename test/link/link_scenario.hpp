@@ -4,9 +4,9 @@
 // built with other flags (-march=native) against the installed-style core library.
 #pragma once
 
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <cmath>
 #include <string>

@@ -4,11 +4,11 @@
 // height, worked here; the joint axes turn the segments the anatomical way; the tool
 // refuses bad options with the documented exit status; and a body standing still on
 // two force plates is in equilibrium with the joint loads worked by hand.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/force_plate.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/planar.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/force_plate.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/planar.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/tool_test.hpp>
 

@@ -1,10 +1,10 @@
 // The configuration (config.hpp): its defaults, and validate() accepting the edges of
 // every range and refusing what lies beyond, per key family, naming the key. Core only
 // (no ROS): the reader's side is test_settings.cpp.
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/settings_reader.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/settings/config.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include <gtest/gtest.h>
 

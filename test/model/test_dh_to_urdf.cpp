@@ -8,9 +8,9 @@
 //     DH frame as the table gives them.
 // Random tables (revolute and prismatic rows, offsets, off-diagonal inertias) and two
 // PUMA 560 tables (test/data/dh/) go through the tool; the efforts agree to 1e-12.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/tool_test.hpp>
 

@@ -5,8 +5,8 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <joint_load_estimator/frames.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/frames.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 #include <random>
 #include <stdexcept>
 

@@ -1,8 +1,8 @@
 // The URDF reader against urdfdom (ROS's own parser, an independent implementation):
 // every link's pose at q = 0, mass and inertia must agree on the public models.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <gtest/gtest.h>
 #include <urdf/model.h>

@@ -3,9 +3,9 @@
 // uncertainty.period 0.018 s): the effort sigma against the one computed at every sample
 // (period 0) from the first sample on, through a gap and after a reset; and against a
 // Monte Carlo of noisy replays at start-up, while the filter settles, and after.
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <jle_testing/ground_truth.hpp>
 

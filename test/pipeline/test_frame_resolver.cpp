@@ -2,8 +2,8 @@
 // where it rides on the link (the UR5's tool0, its pose typed in from the URDF), from the
 // frame source otherwise, looked up as often as it must be and no more; a plate's pose
 // found once; the floating base's pose; each failure naming what is missing.
-#include <joint_load_estimator/frame_resolver.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/frame_resolver.hpp>
 
 #include <gtest/gtest.h>
 

@@ -5,10 +5,10 @@
 // clean run of the same messages without the bad one (the loads after it must be equal),
 // the URDF's limits, and the stamps at which the filters started.
 #include <jle_testing/message_stream.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <gtest/gtest.h>
 

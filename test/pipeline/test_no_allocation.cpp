@@ -1,11 +1,11 @@
 // No heap allocation per timestep: the global operator new of this test binary counts
 // its calls, and the per-sample paths (the core passes, the estimator with every
 // differentiator) must not add to the count once their buffers are built.
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <gtest/gtest.h>
 

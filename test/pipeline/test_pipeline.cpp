@@ -4,11 +4,11 @@
 // efforts paired with a delayed estimate; frames from the URDF and from a frame source;
 // a floating base; sensor biases; time jumps; and that every message is counted once.
 #include <jle_testing/message_stream.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <gtest/gtest.h>
 

@@ -3,11 +3,11 @@
 // measured efforts of its own sample, as the record of the same sample computed live (by a
 // causal filter, at once) does; and each status bit, set where the settings' numbers say
 // and not a step beyond.
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/frame_resolver.hpp>
-#include <joint_load_estimator/record_builder.hpp>
-#include <joint_load_estimator/timeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/frame_resolver.hpp>
+#include <joint_load_estimator/pipeline/record_builder.hpp>
+#include <joint_load_estimator/pipeline/timeline.hpp>
 
 #include <gtest/gtest.h>
 

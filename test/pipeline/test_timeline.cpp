@@ -4,8 +4,8 @@
 // forward takes stamps.jump_confirm stamps in a row; a lone rogue stamp is dropped and
 // changes nothing; stamps out of order, and wrench stamps too far from the joint states,
 // are told apart; and the axis gives every stamp back to the nanosecond.
-#include <joint_load_estimator/portable_random.hpp>
-#include <joint_load_estimator/timeline.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/pipeline/timeline.hpp>
 
 #include <gtest/gtest.h>
 

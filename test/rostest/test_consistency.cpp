@@ -23,7 +23,7 @@
 #include "node_test_common.hpp"
 
 #include <jle_testing/wrist_sensor_arm.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include "node_test_common.hpp"
 
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>

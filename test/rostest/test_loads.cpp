@@ -7,7 +7,7 @@
 // node's input queues never overflow and the order of events is the order of sending.
 #include "node_test_common.hpp"
 
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2_msgs/TFMessage.h>

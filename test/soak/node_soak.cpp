@@ -29,11 +29,11 @@
 //     states before it.
 // Prints a summary; exits 1 on a failed check, 2 on a usage error.
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/differentiation.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/settings_reader.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/filters/differentiation.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/WrenchStamped.h>

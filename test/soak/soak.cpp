@@ -14,9 +14,9 @@
 //    many times as it was injected;
 //  - every load published is finite, and trusted once the filters have settled.
 // Prints the figures; exits 1 on a failed check. Usage: soak [SAMPLES (default 1000000)]
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <chrono>
 #include <cmath>

@@ -1,7 +1,7 @@
 #include <jle_testing/ground_truth.hpp>
 
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -2,10 +2,10 @@
 // plumbing (column mapping, order, frames, number formatting), their refusal of bad
 // input with one located message and no output file, and make_trajectory's formula;
 // and the option values' parsers that every tool shares (command_line.hpp).
-#include <joint_load_estimator/command_line.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/io/command_line.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <jle_testing/tool_test.hpp>
 

@@ -6,7 +6,7 @@
 // conversion's. The bag's contents are read back here with rosbag and compared with the
 // CSV cell by cell.
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <rosbag/bag.h>

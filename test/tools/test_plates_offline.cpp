@@ -2,7 +2,7 @@
 // naming the key) and in process_bag (the plate pose from the config; effort_per_kg),
 // against the hand-worked numbers of test/rostest/test_plates.cpp.
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/settings_reader.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <rosbag/bag.h>

@@ -6,8 +6,8 @@
 // must refuse bad input with a message naming the culprit.
 #include <joint_load_estimator/Contact.h>
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/estimator.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/estimation/estimator.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <rosbag/bag.h>

@@ -4,8 +4,8 @@
 // and fed to jle::Pipeline through the node's own conversions; the loads go to a sink.
 #pragma once
 
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/zero_phase.hpp>
+#include <joint_load_estimator/filters/zero_phase.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <string>
 

@@ -7,8 +7,8 @@
 // in the sensor's frame and sign convention, moment about the frame's origin.
 #pragma once
 
-#include <joint_load_estimator/pipeline.hpp>
-#include <joint_load_estimator/sensor_bias.hpp>
+#include <joint_load_estimator/estimation/sensor_bias.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <string>
 #include <vector>

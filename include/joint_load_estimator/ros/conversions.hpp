@@ -3,7 +3,7 @@
 #pragma once
 
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/time.h>

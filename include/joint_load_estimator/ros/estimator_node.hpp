@@ -5,7 +5,9 @@
 #include <joint_load_estimator/CalibrateBias.h>
 #include <joint_load_estimator/EstimatorConfig.h>
 #include <joint_load_estimator/JointLoads.h>
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/estimation/sensor_bias.hpp>
+#include <joint_load_estimator/estimation/sensor_sign.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 #include <joint_load_estimator/ros/bias_file.hpp>
 #include <joint_load_estimator/ros/conversions.hpp>
 #include <joint_load_estimator/ros/external_outputs.hpp>
@@ -13,8 +15,6 @@
 #include <joint_load_estimator/ros/input_health.hpp>
 #include <joint_load_estimator/ros/master_watch.hpp>
 #include <joint_load_estimator/ros/settings.hpp>
-#include <joint_load_estimator/sensor_bias.hpp>
-#include <joint_load_estimator/sensor_sign.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>

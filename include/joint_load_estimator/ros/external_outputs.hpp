@@ -5,7 +5,7 @@
 #pragma once
 
 #include <joint_load_estimator/Contact.h>
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/WrenchStamped.h>

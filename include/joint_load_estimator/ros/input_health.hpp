@@ -4,7 +4,7 @@
 // last one came. ROS-free but for the wall clock the node hands in.
 #pragma once
 
-#include <joint_load_estimator/pipeline.hpp>
+#include <joint_load_estimator/pipeline/pipeline.hpp>
 
 #include <cstdint>
 #include <string>

@@ -2,8 +2,8 @@
 // server's values, an XmlRpc struct, as a parameter tree.
 #pragma once
 
-#include <joint_load_estimator/config.hpp>
-#include <joint_load_estimator/settings_reader.hpp>
+#include <joint_load_estimator/settings/config.hpp>
+#include <joint_load_estimator/settings/settings_reader.hpp>
 
 #include <xmlrpcpp/XmlRpcValue.h>
 

@@ -5,10 +5,10 @@
 // Header-only, ROS-free.
 #pragma once
 
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
 
 #include <Eigen/Core>
 

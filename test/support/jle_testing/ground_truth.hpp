@@ -8,10 +8,10 @@
 // the random numbers are jle::PortableRandom's (portable_random.hpp).
 #pragma once
 
-#include <joint_load_estimator/data.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/data.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
 
 #include <Eigen/Core>
 

@@ -3,8 +3,8 @@
 // UR5 chain they drive.
 #pragma once
 
-#include <joint_load_estimator/timeline.hpp>
-#include <joint_load_estimator/urdf_reader.hpp>
+#include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/pipeline/timeline.hpp>
 
 #include <string>
 #include <vector>

@@ -5,10 +5,10 @@
 // (joint_load_estimator_testing): shared by the unit tests and bench/ (stability, speed_core).
 #pragma once
 
-#include <joint_load_estimator/dynamics.hpp>
-#include <joint_load_estimator/kinematics.hpp>
-#include <joint_load_estimator/model.hpp>
-#include <joint_load_estimator/portable_random.hpp>
+#include <joint_load_estimator/io/portable_random.hpp>
+#include <joint_load_estimator/model/dynamics.hpp>
+#include <joint_load_estimator/model/kinematics.hpp>
+#include <joint_load_estimator/model/model.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
