@@ -27,4 +27,5 @@ fi
 "$ws/devel/lib/joint_load_estimator/accuracy" "${quick[@]}" --csv "$out/accuracy.csv"
 /usr/bin/python3 "$repo/bench/plot_accuracy.py" "$out/accuracy.csv" --md "$out/accuracy.md" \
   --png-prefix "$out/accuracy" --command "tools/accuracy.sh${quick:+ --quick}"
-echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png"
+/usr/bin/python3 "$repo/bench/causal_limit.py" "$out/causal_limit.md" "$out/accuracy.csv" >/dev/null
+echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png, causal_limit.md"
