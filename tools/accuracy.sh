@@ -28,7 +28,8 @@ fi
 "$ws/devel/lib/joint_load_estimator/accuracy" "${quick[@]}" --csv "$out/accuracy.csv"
 /usr/bin/python3 "$repo/bench/plot_accuracy.py" "$out/accuracy.csv" --md "$out/accuracy.md" \
   --png-prefix "$out/accuracy" --command "tools/accuracy.sh${quick:+ --quick}"
+/usr/bin/python3 "$repo/bench/causal_limit.py" "$out/causal_limit.md" "$out/accuracy.csv" >/dev/null
 if [ ${#quick[@]} -eq 0 ]; then
   /usr/bin/python3 "$repo/bench/differentiator_tables.py" "$out/accuracy.csv" "$out/differentiators.md"
 fi
-echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png"
+echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png, causal_limit.md"
