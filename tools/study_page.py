@@ -13,6 +13,7 @@ page is an error, so that a renamed section cannot silently stop being regenerat
 As a program (for the shell scripts):
     study_page.py load                 prints the 1, 5 and 15 min load averages
     study_page.py machine              prints e.g. "AMD EPYC, 2 cores, Linux x86_64"
+    study_page.py fill PAGE NAME       the block NAME of PAGE becomes the standard input
 """
 import os
 import platform
@@ -86,5 +87,7 @@ if __name__ == "__main__":
         print(load())
     elif what == "machine":
         print(machine())
+    elif what == "fill" and len(sys.argv) == 4:
+        fill(sys.argv[2], {sys.argv[3]: sys.stdin.read()})
     else:
-        sys.exit("usage: study_page.py load|machine")
+        sys.exit("usage: study_page.py load | machine | fill PAGE NAME")
