@@ -384,10 +384,19 @@ int Estimator::velocitiesUsed() const {
 bool Estimator::velocitiesBetter() const {
   // The causal filter takes them wherever measured (accuracy study, the immediate default
   // with this rule: panda 0.049 -> 0.063 N m, the positions chosen over the velocities).
-  if (!(config_.differentiator.lag > 0.0)) return true;
-  if (!(bank_.spectralCutoff() > 0.0) || !(velocity_bank_.spectralCutoff() > 0.0)) return true;
+  if (!(config_.differentiator.lag > 0.0) || !config_.differentiator.auto_bandwidth) return true;
+  double floor_q = bank_.noiseFloor(), floor_v = velocity_bank_.noiseFloor();
+  if (!(bank_.spectralCutoff() > 0.0) || !(velocity_bank_.spectralCutoff() > 0.0)) {
+    // Before the spectra's first choice (4 s), the probes' (0.5 s blocks); before theirs,
+    // the positions (accuracy study, smoothed default + velocities / offline: panda_sines
+    // 1.56 -> 1.32, talos 1.71 -> 1.41, with the velocities until the spectra's choice;
+    // panda_stamp_jitter and arm_coloured_* kept at 1.09, 0.56, 1.19).
+    if (!(bank_.probeCutoff() > 0.0) || !(velocity_bank_.probeCutoff() > 0.0)) return false;
+    floor_q = bank_.probeFloor();
+    floor_v = velocity_bank_.probeFloor();
+    if (!(floor_q > 0.0) || !(floor_v > 0.0)) return true;  // a probe found none: no evidence
+  }
   const double f = bank_.bandwidth();
-  const double floor_q = bank_.noiseFloor(), floor_v = velocity_bank_.noiseFloor();
   if (!(floor_q > 0.0)) return false;  // positions without noise: nothing is better
   const double w = 2.0 * M_PI * f;
   return floor_v < floor_q * w * w;

@@ -78,9 +78,11 @@ class Estimator {
   int velocitiesUsed() const;
   /// Whether the measured velocities are the better evidence of the rates: true but where
   /// a smoother (lag > 0) sets its bandwidth from the data (differentiator.auto_bandwidth,
-  /// the smoothed stream) and both spectra have chosen; there, where the velocities' noise
-  /// floor is below the positions' times (2 pi f)^2, f the positions' bandwidth (at f, the
-  /// velocities' share of noise is the smaller). Where it is false, the coordinates of
+  /// the smoothed stream); there, where the velocities' noise floor is below the
+  /// positions' times (2 pi f)^2, f the positions' bandwidth (at f, the velocities' share
+  /// of noise is the smaller), the floors of both spectra once both have chosen, before
+  /// that of both probes (0.5 s blocks; true where a probe finds no floor), and before
+  /// the probes' first choice false (the positions). Where it is false, the coordinates of
   /// velocityUsed() take q-dot and q-ddot from the positions too (accuracy study: the
   /// Panda scenes' velocities, 1e-3 rad/s, are worse evidence than their positions;
   /// the coloured-noise scenes' much better).
