@@ -3,7 +3,7 @@
 // of q, on Panda scenes of the ground truth: effort and q-ddot RMS errors against the
 // truth at the instants the samples were taken (JointReading.time: with receive-time
 // stamps the stamp errs), after a settling time, and the CPU time per sample of the
-// differentiator alone, as a ratio to the old default's in the same run.
+// differentiator alone, as a ratio to the default's in the same run.
 //   bench_adaptive_filter [DATA_DIR]
 #include <joint_load_estimator/estimation/estimator.hpp>
 #include <joint_load_estimator/io/command_line.hpp>
@@ -74,6 +74,13 @@ double costPerSample(const jle::SensorReadings& readings, const jle::Differentia
   return best;
 }
 
+// The adaptive differentiator with its defaults (the default type is the Kalman filter).
+jle::DifferentiatorConfig adaptive() {
+  jle::DifferentiatorConfig c;
+  c.type = jle::DifferentiatorType::kAdaptive;
+  return c;
+}
+
 jle::DifferentiatorConfig kalman(double q) {
   jle::DifferentiatorConfig c;
   c.type = jle::DifferentiatorType::kKalman;
@@ -121,8 +128,8 @@ const char* const kUsage =
     "usage: bench_adaptive_filter [DATA_DIR]\n"
     "The adaptive differentiator against a constant-jerk Kalman filter (q = 1e4) and the best\n"
     "fixed one of a grid of q on Panda scenes of the ground truth: effort and q-ddot RMS\n"
-    "errors and the CPU time per sample. DATA_DIR: the package's test/data (default: the\n"
-    "source tree's).\n";
+    "errors and the CPU time per sample, one markdown row per scene. DATA_DIR: the package's\n"
+    "test/data (default: the source tree's).\n";
 
 int main(int argc, char** argv) {
   if (jle::cli::answerHelpOrVersion(argc, argv, "bench_adaptive_filter", kUsage)) return 0;
@@ -133,7 +140,7 @@ int main(int argc, char** argv) {
     const jle::GroundTruth truth(model, jle::randomMotion(model, spec.motion, spec.duration, 11),
                                  {});
     const jle::SensorReadings readings = truth.sample(spec.sensor, spec.duration, 12);
-    const Errors adaptive = score(truth, readings, jle::DifferentiatorConfig());
+    const Errors adaptive_errors = score(truth, readings, adaptive());
     const Errors old_default = score(truth, readings, kalman(1e4));
     Errors best{1e300, 1e300};
     double best_q = 0.0;
@@ -141,13 +148,10 @@ int main(int argc, char** argv) {
       const Errors e = score(truth, readings, kalman(q));
       if (e.effort < best.effort) best = e, best_q = q;
     }
-    const double ratio =
-        costPerSample(readings, jle::DifferentiatorConfig()) / costPerSample(readings, kalman(1e4));
-    std::printf(
-        "%s\n  effort RMS [N m]: adaptive %.4g, old default %.4g, best fixed (q=%.0e) %.4g\n"
-        "  qdd RMS [rad/s^2]: adaptive %.4g, old default %.4g, best fixed %.4g\n"
-        "  differentiator CPU per sample: %.2f x the old default's\n",
-        spec.name.c_str(), adaptive.effort, old_default.effort, best_q, best.effort, adaptive.qdd,
-        old_default.qdd, best.qdd, ratio);
+    const double ratio = costPerSample(readings, adaptive()) / costPerSample(readings, kalman(1e4));
+    // One markdown row (docs/studies/differentiators.md, tools/adaptive_filter.sh).
+    std::printf("| %s | %.3g / %.3g / %.3g (q=%.0e) | %.3g / %.3g / %.3g | %.1f× |\n",
+                spec.name.c_str(), adaptive_errors.effort, old_default.effort, best.effort, best_q,
+                adaptive_errors.qdd, old_default.qdd, best.qdd, ratio);
   }
 }

@@ -9,13 +9,30 @@
 #            (`nodelet standalone`; roscpp's TCP transport, tcpNoDelay);
 # the nodelet path also with the estimator's inline_callbacks true ("inline"), and with
 # the bench's receiver inline too (~inline_receiver).
-# Usage: bench/node_latency.sh [seconds per rate] [repeats]
+# Usage: bench/node_latency.sh [seconds per rate] [repeats]   (the package must be built)
+#        bench/node_latency.sh --page [seconds per rate] [repeats]   (default 3 s, 3 repeats:
+#          about 5 min) builds the node, the nodelets and the bench (tools/build.sh, JLE_WS
+#          as there), runs, and writes docs/studies/node_latency.md (bench/node_latency_page.py).
 # (JLE_BENCH_RATES="[1000, 5000, 10000]" the rates; JLE_BENCH_PORT the master's port.)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
-seconds=${1:-2.0}
-repeats=${2:-1}
+page=
+if [ "${1:-}" = "--page" ]; then
+  page=$repo/docs/studies/node_latency.md
+  shift
+  mkdir -p "$ws"
+  bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" joint_load_estimator_node joint_load_estimator_nodelet \
+    joint_load_estimator_bench_nodelet >"$ws/node_latency_build.log" 2>&1 ||
+    { tail -30 "$ws/node_latency_build.log"; echo "node_latency: build failed" >&2; exit 1; }
+  seconds=${1:-3}
+  repeats=${2:-3}
+else
+  seconds=${1:-2.0}
+  repeats=${2:-1}
+fi
+load_before=$(/usr/bin/python3 "$repo/tools/study_page.py" load)
+started=$SECONDS
 export PATH=/usr/bin:$PATH
 set +u; source "$ws/devel/setup.bash"; set -u
 export ROS_MASTER_URI=http://127.0.0.1:${JLE_BENCH_PORT:-11517}
@@ -61,6 +78,7 @@ stop_all() {
 # bench receiver's (~inline_receiver), $4 the run's number.
 configure() {
   echo "run $4, $1; $(uptime)"
+  echo "$4|$1|$(/usr/bin/python3 "$repo/tools/study_page.py" load)" >>"$log/loads.txt"
   printf 'joint_load_estimator: {inline_callbacks: %s}\nnode_latency_bench: {inline_receiver: %s, path: "%s", seconds: %s, rates: %s}\n' \
     "$2" "$3" "$1" "$seconds" "$rates" >"$log/params.yaml"
   rosparam load "$log/params.yaml"  # one process: each costs a second on a loaded machine
@@ -95,4 +113,9 @@ for r in $(seq "$repeats"); do
   tcp_path tcp false false "$r"
 done
 echo "logs: $log; after the run: $(uptime)"
+if [ -n "$page" ] && [ $status -eq 0 ]; then
+  /usr/bin/python3 "$repo/bench/node_latency_page.py" --log "$log" --seconds "$seconds" \
+    --repeats "$repeats" --wall $((SECONDS - started)) --rates "$rates" --load-before "$load_before" \
+    --load-after "$(/usr/bin/python3 "$repo/tools/study_page.py" load)" --output "$page"
+fi
 exit $status

@@ -20,6 +20,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+from study_page import cpu_name  # noqa: E402
+
 MAIN = "panda"
 DELAY_BUDGET_MS = 5.0  # the recommendation: least error with at most this delay
 FAMILY_NAMES = {
@@ -222,17 +225,6 @@ def plot(rows, x_key, x_label, path, recommended, log_x):
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
-
-
-def cpu_name():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
 
 
 def scored_scenes(scenes):

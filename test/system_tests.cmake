@@ -60,6 +60,7 @@ add_dependencies(test_node_agreement process_bag)
 jle_add_node_test(test_node_plates plates.test rostest/test_plates.cpp)
 # The node's sensor and base residuals and the bias calibration service.
 jle_add_node_test(test_node_consistency consistency.test rostest/test_consistency.cpp)
+target_link_libraries(test_node_consistency joint_load_estimator_testing)
 # The gait demo on the real node: the pelvis residual of the gait bag is filter error
 # only, and every joint gets its loads.
 jle_add_node_test(test_node_gait gait.test rostest/test_gait.cpp)

@@ -19,11 +19,13 @@ each FILE.md (docs/biomechanics.md, docs/gait_demo.md).
 import argparse
 import csv
 import os
-import platform
 import re
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study_page import cpu_name  # noqa: E402
 
 # The model's efforts (make_body_urdf, docs/body_model.md): positive = the sense named
 # first, as the moment on the distal segment.
@@ -114,17 +116,6 @@ def peaks(rows, joint, offset, stride):
             phase(lo["t"], offset, stride, "r"), diff)
 
 
-def machine():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.machine()
-
-
 def table(rows, offset, stride, strides, urdf):
     lines = [SIGN_CONVENTION, "",
              "| joint moment [N m/kg] | peak | at % of the cycle | normal walking, natural cadence "
@@ -141,7 +132,7 @@ def table(rows, offset, stride, strides, urdf):
               "derivatives) through `joint_loads --floating-base --plate ... --per-kg "
               "--contact-threshold 1`; 0 %% = right heel strike; the left side within %.1g "
               "N m/kg of the right at the same phase of its own cycle." % (strides, worst_side),
-              "", "Made by `/usr/bin/python3 tools/gait_peaks.py` (%s; %s)." % (urdf, machine())]
+              "", "Made by `/usr/bin/python3 tools/gait_peaks.py` (%s; %s)." % (urdf, cpu_name())]
     return "\n".join(lines) + "\n"
 
 

@@ -18,6 +18,21 @@ bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" bench_speed_core bench_speed_mess
   { tail -30 "$ws/speed_build.log"; exit 1; }
 bin=$ws/devel/lib/joint_load_estimator
 json=$ws/speed_core.json
+if [ "${1:-}" = "--page" ]; then
+  filter='^(coreDouble|coreDoubleWorld|fullStep|fullStepSmoother|kdlChain|kdlTree|filterBank|smootherBank|adaptiveSmootherBank|scaling)/|^estimatorStep/.*(_defaults|_none|_off|_on|_float|_auto)$'
+  args=(--benchmark_filter="$filter" --benchmark_min_time=0.2 --benchmark_repetitions=5
+    --benchmark_enable_random_interleaving=true)
+  before=$(/usr/bin/python3 "$repo/tools/study_page.py" load)
+  "$bin/bench_speed_core" "${args[@]}" --benchmark_out="$json" --benchmark_out_format=json \
+    >"$ws/speed_core.txt" 2> >(grep -v "KDL does not support" >&2)
+  "$bin/bench_speed_messages" --benchmark_min_time=0.2 --benchmark_repetitions=3 \
+    --benchmark_enable_random_interleaving=true --benchmark_out="$ws/speed_messages.json" \
+    --benchmark_out_format=json >"$ws/speed_messages.txt"
+  /usr/bin/python3 "$repo/tools/speed_page.py" "$json" "$ws/speed_messages.json" \
+    --load-before "$before" --load-after "$(/usr/bin/python3 "$repo/tools/study_page.py" load)" \
+    --command "bash tools/speed.sh --page" --output "$repo/docs/studies/speed.md"
+  exit 0
+fi
 "$bin/bench_speed_core" --benchmark_min_time=0.5 --benchmark_out="$json" \
   --benchmark_out_format=json "$@" 2> >(grep -v "KDL does not support" >&2)
 [ -n "${JLE_SPEED_CORE_ONLY:-}" ] || "$bin/bench_speed_messages" --benchmark_min_time=0.5

@@ -15,6 +15,10 @@ namespace {
 
 const char* typeName(DifferentiatorType type) { return nameOf(kDifferentiatorTypes, type); }
 
+bool sameDifferentiatorFields(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
+  return a.fields() == b.fields();
+}
+
 // The server's view of `settings`, with `status`, the answer to the last change.
 joint_load_estimator::EstimatorConfig toConfig(const Settings& settings,
                                                const std::string& status) {
@@ -88,6 +92,7 @@ void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
     const bool same = next.estimator.decimation == settings_.estimator.decimation &&
                       next.base_residual_threshold == settings_.base_residual_threshold &&
                       next.still_velocity == settings_.still_velocity;
+    const DifferentiatorConfig previous = settings_.estimator.differentiator;
     const bool kept = pipeline_->retune(next.estimator.differentiator, next.estimator.decimation);
     publishDrained(ros::Time::now());
     settings_.estimator.differentiator = next.estimator.differentiator;
@@ -100,6 +105,11 @@ void EstimatorNode::onReconfigure(joint_load_estimator::EstimatorConfig& config,
                             typeName(settings_.estimator.differentiator.type) +
                             "': the filters restart";
       ROS_WARN("reconfigure: %s", reconfigure_status_.c_str());
+    } else if (!sameDifferentiatorFields(previous, settings_.estimator.differentiator)) {
+      reconfigure_status_ = std::string("applied: the filters kept (differentiator '") +
+                            typeName(settings_.estimator.differentiator.type) +
+                            "' does not read the setting changed)";
+      ROS_INFO("reconfigure: %s", reconfigure_status_.c_str());
     } else if (!same) {
       reconfigure_status_ = "applied: decimation " +
                             std::to_string(settings_.estimator.decimation) +

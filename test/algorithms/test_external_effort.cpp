@@ -165,6 +165,17 @@ void simulate(const Scene& s, const std::string& link, const Vector3d& point_lin
   for (int seg : s.published) measured.push_back(data.effort[seg]);
 }
 
+// A Panda at rest in the random posture of `seed`: its efforts at the hand with `force`
+// and `moment` applied at the tool's origin (measured), and without (the model's).
+Scene pandaAtRest(unsigned seed, const Vector3d& force, const Vector3d& moment,
+                  std::vector<double>& model_effort, std::vector<double>& measured) {
+  Scene s = makeScene("panda.urdf", seed);
+  s.qd.setZero();
+  s.qdd.setZero();
+  simulate(s, "panda_hand_tcp", Vector3d::Zero(), force, moment, model_effort, measured);
+  return s;
+}
+
 jle::ExternalEffortConfig contactConfig(const std::string& link, const Vector3d& point,
                                         bool force_only) {
   jle::ExternalEffortConfig c;
@@ -238,12 +249,9 @@ TEST(ExactContact, TooFewJointsIsRefusedNamingTheLink) {
 // 40 time constants (K = 2 pi 10 Hz, 0.64 s) the lag's memory of its zero start is
 // e^-40 ~ 4e-18 of it; what is left is rounding of p differences (~1e-13 N m).
 TEST(Observer, AtRestConvergesToTheResidual) {
-  Scene s = makeScene("panda.urdf", 3);
-  s.qd.setZero();
-  s.qdd.setZero();
   std::vector<double> model_effort, measured;
   const Vector3d f(4, -6, 9), m(0.2, 0.3, -0.1);
-  simulate(s, "panda_hand_tcp", Vector3d::Zero(), f, m, model_effort, measured);
+  const Scene s = pandaAtRest(3, f, m, model_effort, measured);
   jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
   c.method = jle::ExternalMethod::kObserver;
   jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, false);
@@ -426,12 +434,8 @@ TEST(FreeMotion, ContactIsDetectedAtTheToolAndItsWrenchEstimated) {
 // ~4 %: 15 % is 3.5 of those). A reset starts the calibration again: no threshold until
 // settle_time + calibration_time later, then the same one.
 TEST(Calibration, RobustToJoltsAndRestartedByAReset) {
-  Scene s = makeScene("panda.urdf", 6);
-  s.qd.setZero();
-  s.qdd.setZero();
   std::vector<double> model_effort, measured;
-  simulate(s, "panda_hand_tcp", Vector3d::Zero(), Vector3d::Zero(), Vector3d::Zero(), model_effort,
-           measured);
+  const Scene s = pandaAtRest(6, Vector3d::Zero(), Vector3d::Zero(), model_effort, measured);
   jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
   c.noise_multiple = 6.0;
   jle::ExternalEffort ext(s.model, c, s.published, kGravity, 0.0, false);
@@ -508,11 +512,10 @@ ScenarioRun runScenario(jle::ExternalMethod method,
   const int n = static_cast<int>(jle_testing::PandaContacts::kDuration * 1000.0);
   for (int k = 0; k < n; ++k) {
     const double t = k * 1e-3;
-    Eigen::VectorXd q, qd, qdd;
-    scene.state(t, q, qd, qdd);
-    std::vector<double> effort = scene.efforts(t);
-    for (int i = 0; i < 7; ++i) position[i] = q[i] + 1e-4 * gauss(rng);
-    for (double& e : effort) e += 0.1 * gauss(rng);
+    Eigen::VectorXd q;
+    std::vector<double> effort;
+    scene.measured(t, rng, gauss, q, effort);
+    for (int i = 0; i < 7; ++i) position[i] = q[i];
     bool dropped = false;
     for (const auto& d : drops) dropped = dropped || (k >= d.first && k < d.second);
     const jle::Stamp stamp = t0 + static_cast<jle::Stamp>(k) * 1000000;
@@ -663,12 +666,8 @@ TEST(Covariance, ResidualWrenchMatchesMonteCarlo) {
 // samples are correlated over ~1 / a = 17 steps: ~1200 independent ones, 4 % scatter;
 // 12 % is 3 of those.
 TEST(Covariance, ObserverStddevMatchesMonteCarlo) {
-  Scene s = makeScene("panda.urdf", 5);
-  s.qd.setZero();
-  s.qdd.setZero();
   std::vector<double> model_effort, measured;
-  simulate(s, "panda_hand_tcp", Vector3d::Zero(), Vector3d::Zero(), Vector3d::Zero(), model_effort,
-           measured);
+  const Scene s = pandaAtRest(5, Vector3d::Zero(), Vector3d::Zero(), model_effort, measured);
   jle::ExternalEffortConfig c = contactConfig("panda_hand_tcp", Vector3d::Zero(), false);
   c.method = jle::ExternalMethod::kObserver;
   c.effort_noise = 0.1;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <jle_testing/wrist_sensor_arm.hpp>
 #include <joint_load_estimator/estimation/estimator.hpp>
 #include <joint_load_estimator/estimation/sensor_sign.hpp>
 #include <joint_load_estimator/model/dynamics.hpp>
@@ -19,11 +20,11 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-const std::string kUrdf = std::string(JLE_TEST_DATA) + "/urdf/wrist_sensor_arm.urdf";
-constexpr double kG = 9.80665;
-constexpr double kToolMass = 0.8;
-const Vector3d kToolCom(0.0, 0.02, 0.11);  // sensor frame [m]
-const Vector3d kTip(0.0, 0.0, 0.2);        // sensor frame [m]
+using jle_test::wrist_sensor_arm::j2EffortAtRest;
+using jle_test::wrist_sensor_arm::kG;
+using jle_test::wrist_sensor_arm::staticReading;
+const std::string kUrdf = jle_test::wrist_sensor_arm::urdf();
+const Vector3d kTip = jle_test::wrist_sensor_arm::tip();  // sensor frame [m]
 // Rounding: the readings pass through the 3-point filter, whose weights for
 // samples 1 ms apart sum to one only to ~1e-12 (measured 2e-12 relative on the
 // ~8 N reading), plus a few dozen operations on loads of order 10 N, 1 N m.
@@ -43,17 +44,6 @@ jle::EstimatorConfig sensorConfig() {
   ft.sensor_joint = "ft_joint";
   c.wrenches.push_back(ft);
   return c;
-}
-
-Eigen::Matrix3d Ry(double a) { return Eigen::AngleAxisd(a, Vector3d::UnitY()).toRotationMatrix(); }
-
-// The reading of a sensor at rest with the tool alone (sensor frame, about its
-// origin): the proximal side holds the tool's weight, m g upward, which is
-// (-cos q2, 0, -sin q2) in the sensor frame (turned by q1 about z, then q2 +
-// pi/2 about y from the world).
-void staticReading(double q2, Vector3d& f, Vector3d& m) {
-  f = kToolMass * kG * Vector3d(-std::cos(q2), 0.0, -std::sin(q2));
-  m = kToolCom.cross(f);
 }
 
 // Feeds constant q and a constant reading until the estimator publishes.
@@ -111,13 +101,7 @@ TEST(SensorJoint, UnmodelledContactIsTheResidualAndLoadsTheProximalJoints) {
   // Closed form of the effort of j2 at rest: minus the moment about its axis of
   // the weights of link2 and the tool and of the contact (frame of link1 turned
   // by q1, which leaves gravity and the axis y alone).
-  const Eigen::Matrix3d R2 = Ry(q[1]), Rs = R2 * Ry(M_PI / 2);
-  const Vector3d r_link2 = R2 * Vector3d(0.15, 0.0, 0.01);
-  const Vector3d r_tool = R2 * Vector3d(0.3, 0.0, 0.0) + Rs * kToolCom;
-  const Vector3d r_tip = R2 * Vector3d(0.3, 0.0, 0.0) + Rs * kTip;
-  const Vector3d weight(0.0, 0.0, -kG);
-  const double tau2 =
-      -(r_link2.cross(1.5 * weight) + r_tool.cross(kToolMass * weight) + r_tip.cross(Rs * c)).y();
+  const double tau2 = j2EffortAtRest(q[1], c);
 
   for (int variant = 0; variant < 3; ++variant) {
     SCOPED_TRACE(variant == 0 ? "all joints" : variant == 1 ? "pruned to j1" : "float");

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <vector>
 
@@ -224,6 +225,9 @@ TEST(AdaptiveDifferentiator, BeatsTheFixedFiltersOnJitterGapsAndNoise) {
       const double old_default = run(kalman(1e4), twoSines(), sensor).rms;
       const double narrow = run(kalman(10.0), twoSines(), sensor).rms;
       const double bound = rate >= 1000.0 ? 1.05 : 1.5;
+      // The row of docs/studies/differentiators.md (tools/adaptive_filter.sh).
+      std::printf("| %.0f Hz | %g | %.3g | %.3g | %.3g |\n", rate, noise, adaptive, old_default,
+                  narrow);
       EXPECT_LT(adaptive, 1.05 * old_default) << rate << " Hz, " << noise << " rad";
       EXPECT_LT(adaptive, bound * std::min(old_default, narrow))
           << rate << " Hz, " << noise << " rad: " << adaptive << " against " << old_default
@@ -242,6 +246,9 @@ TEST(AdaptiveDifferentiator, AccelerationStepsCostLessThanWithTheOldDefault) {
       sensor.noise = noise;
       const Score adaptive = run(adaptiveConfig(), accelerationSteps(), sensor);
       const Score old_default = run(kalman(1e4), accelerationSteps(), sensor);
+      // The row of docs/studies/differentiators.md (tools/adaptive_filter.sh).
+      std::printf("| %.0f Hz | %g | %.3g / %.0f%% | %.3g / %.0f%% |\n", rate, noise, adaptive.rms,
+                  100 * adaptive.overshoot, old_default.rms, 100 * old_default.overshoot);
       EXPECT_LT(adaptive.rms, 0.8 * old_default.rms)
           << rate << " Hz, " << noise << " rad; overshoot " << adaptive.overshoot << " against "
           << old_default.overshoot;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 #include <vector>
@@ -238,31 +239,57 @@ double accelError(const DifferentiatorConfig& c) {
   return std::sqrt(sum / count);
 }
 
-// Two configurations are the same filter when every field is equal (fields(), which the
-// compiler checks names every field: a field forgotten there would keep the old filter on
-// a retune); the process noise is compared as the filter runs it.
-TEST(Differentiator, ConfigurationsAreComparedWhole) {
+// Two configurations are the same filter when every field its type reads is equal
+// (asRun over fields(), which the compiler checks names every field: a field forgotten
+// there would keep the old filter on a retune); the process noise is compared as the
+// filter runs it. A field only another type reads (a Savitzky-Golay order while a Kalman
+// filter runs) changes nothing: the filters are kept.
+TEST(Differentiator, ConfigurationsAreComparedOnTheFieldsTheirTypeReads) {
   EXPECT_EQ(jle::detail::fieldCount<DifferentiatorConfig>(),
             std::tuple_size_v<decltype(DifferentiatorConfig().fields())>);
+  // Each field changed alone, in the order of fields().
+  const auto changes = [](const DifferentiatorConfig& base) {
+    std::vector<DifferentiatorConfig> changed(14, base);
+    changed[0].type = base.type == jle::DifferentiatorType::kAdaptive
+                          ? jle::DifferentiatorType::kKalman
+                          : jle::DifferentiatorType::kAdaptive;
+    changed[1].window = 11;
+    changed[2].order = 3;
+    changed[3].delay = 1;
+    changed[4].kalman_model = jle::KalmanModel::kConstantAcceleration;
+    changed[5].process_noise = 2e4;
+    changed[6].measurement_noise = 2e-4;
+    changed[7].lag = 0.1;
+    changed[8].auto_bandwidth = true;
+    changed[9].min_bandwidth = 1.0;
+    changed[10].max_bandwidth = 40.0;
+    changed[11].noise = 1e-3;
+    changed[12].memory = 2.0;
+    changed[13].max_gap = 0.25;
+    return changed;
+  };
+  const std::vector<std::size_t> fit_fields = {1, 2, 3};  // window, order, delay
+  struct Case {
+    jle::DifferentiatorType type;
+    std::vector<std::size_t> unread;  // fields of changes() the type does not read
+  };
+  const std::vector<Case> cases = {
+      {jle::DifferentiatorType::kKalman, fit_fields},
+      {jle::DifferentiatorType::kAdaptive, fit_fields},
+      {jle::DifferentiatorType::kSavitzkyGolay, {4, 5, 6, 7, 8, 9, 10, 11, 12}},
+      {jle::DifferentiatorType::kFiniteDifference, {1, 4, 5, 6, 7, 8, 9, 10, 11, 12}}};
+  for (const Case& c : cases) {
+    DifferentiatorConfig base;
+    base.type = c.type;
+    EXPECT_TRUE(jle::sameDifferentiator(base, base));
+    const std::vector<DifferentiatorConfig> changed = changes(base);
+    for (std::size_t k = 0; k < changed.size(); ++k) {
+      const bool unread = std::find(c.unread.begin(), c.unread.end(), k) != c.unread.end();
+      EXPECT_EQ(jle::sameDifferentiator(base, changed[k]), unread)
+          << "type " << static_cast<int>(c.type) << ", field " << k;
+    }
+  }
   const DifferentiatorConfig base;
-  EXPECT_TRUE(jle::sameDifferentiator(base, base));
-  std::vector<DifferentiatorConfig> changed(14, base);
-  changed[0].type = jle::DifferentiatorType::kAdaptive;
-  changed[1].window = 11;
-  changed[2].order = 3;
-  changed[3].delay = 1;
-  changed[4].kalman_model = jle::KalmanModel::kConstantAcceleration;
-  changed[5].process_noise = 2e4;
-  changed[6].measurement_noise = 2e-4;
-  changed[7].lag = 0.1;
-  changed[8].auto_bandwidth = true;
-  changed[9].min_bandwidth = 1.0;
-  changed[10].max_bandwidth = 40.0;
-  changed[11].noise = 1e-3;
-  changed[12].memory = 2.0;
-  changed[13].max_gap = 0.25;
-  for (std::size_t k = 0; k < changed.size(); ++k)
-    EXPECT_FALSE(jle::sameDifferentiator(base, changed[k])) << "field " << k;
   DifferentiatorConfig explicit_default = base;
   explicit_default.process_noise = jle::processNoise(base);
   EXPECT_TRUE(jle::sameDifferentiator(base, explicit_default));

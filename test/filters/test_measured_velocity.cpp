@@ -3,6 +3,7 @@
 // velocities the loads are closer to the truth than from the positions alone; a missing or
 // non-finite velocity costs that velocity, never the sample; positions-only streams are
 // unchanged by the setting.
+#include <jle_testing/message_stream.hpp>
 #include <joint_load_estimator/estimation/estimator.hpp>
 #include <joint_load_estimator/io/portable_random.hpp>
 #include <joint_load_estimator/model/dynamics.hpp>
@@ -20,12 +21,11 @@ using jle::InputKind;
 using jle::Outcome;
 using jle::Stamp;
 
-const std::string kData = JLE_TEST_DATA;
-constexpr Stamp kStart = 1700000000123456789;  // [ns]
-constexpr Stamp kMs = 1000000;
-const std::vector<double> kNone;
-
-jle::Model<double> ur5() { return jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf"); }
+using jle_test::kData;
+using jle_test::kMs;
+using jle_test::kNone;
+using jle_test::kStart;
+using jle_test::ur5;
 
 // Joint i moves as a_i sin(w_i t + p_i) (t [s] since kStart): an arm at 0.4-1.1 Hz.
 double amplitude(int i) { return 0.6 - 0.07 * i; }

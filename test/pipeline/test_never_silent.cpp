@@ -4,6 +4,7 @@
 // settling after the filters start, a stale input, an implausible load). References: a
 // clean run of the same messages without the bad one (the loads after it must be equal),
 // the URDF's limits, and the stamps at which the filters started.
+#include <jle_testing/message_stream.hpp>
 #include <joint_load_estimator/model/dynamics.hpp>
 #include <joint_load_estimator/model/kinematics.hpp>
 #include <joint_load_estimator/model/urdf_reader.hpp>
@@ -24,12 +25,11 @@ namespace {
 using jle::Outcome;
 using jle::Stamp;
 
-const std::string kData = JLE_TEST_DATA;
-constexpr Stamp kStart = 1700000000123456789;  // [ns]
-constexpr Stamp kMs = 1000000;
-const std::vector<double> kNone;
-
-jle::Model<double> ur5() { return jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf"); }
+using jle_test::kData;
+using jle_test::kMs;
+using jle_test::kNone;
+using jle_test::kStart;
+using jle_test::ur5;
 
 // Joint i: 0.5 sin(w_i t + i), 0.3-1.0 Hz, within the UR5's limits and speeds.
 double q(int i, double t) { return 0.5 * std::sin(2.0 * M_PI * (0.3 + 0.14 * i) * t + i); }

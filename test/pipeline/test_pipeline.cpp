@@ -3,6 +3,7 @@
 // with jittered stamps; the joints a published subset needs; stamps and measured
 // efforts paired with a delayed estimate; frames from the URDF and from a frame source;
 // a floating base; sensor biases; time jumps; and that every message is counted once.
+#include <jle_testing/message_stream.hpp>
 #include <joint_load_estimator/io/portable_random.hpp>
 #include <joint_load_estimator/model/dynamics.hpp>
 #include <joint_load_estimator/model/kinematics.hpp>
@@ -21,12 +22,11 @@ using jle::InputKind;
 using jle::Outcome;
 using jle::Stamp;
 
-const std::string kData = JLE_TEST_DATA;
-constexpr Stamp kStart = 1700000000123456789;  // [ns]
-constexpr Stamp kMs = 1000000;
-const std::vector<double> kNone;
-
-jle::Model<double> ur5() { return jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf"); }
+using jle_test::kData;
+using jle_test::kMs;
+using jle_test::kNone;
+using jle_test::kStart;
+using jle_test::ur5;
 
 // The arm's joints (0-2): q_i(t) = a_i + b_i t + c_i t^2 (t [s] since kStart), for which
 // the 3-point difference is exact; the wrist's (3-5) are held still, so that a sample

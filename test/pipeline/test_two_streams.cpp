@@ -5,6 +5,7 @@
 // and at the end of a stream. Its bandwidth from the data: near the offline zero-phase
 // smoother on a low-noise encoder, low under coloured noise, the highest on exact data.
 #include <jle_testing/ground_truth.hpp>
+#include <jle_testing/message_stream.hpp>
 #include <joint_load_estimator/filters/zero_phase.hpp>
 #include <joint_load_estimator/io/portable_random.hpp>
 #include <joint_load_estimator/model/dynamics.hpp>
@@ -22,12 +23,11 @@ namespace {
 using jle::Outcome;
 using jle::Stamp;
 
-const std::string kData = JLE_TEST_DATA;
-constexpr Stamp kStart = 1700000000123456789;  // [ns]
-constexpr Stamp kMs = 1000000;
-const std::vector<double> kNone;
-
-jle::Model<double> ur5() { return jle::modelFromUrdfFile(kData + "/urdf/chains/ur5_chain.urdf"); }
+using jle_test::kData;
+using jle_test::kMs;
+using jle_test::kNone;
+using jle_test::kStart;
+using jle_test::ur5;
 
 // Joint i: 0.5 sin(w_i t + i), 0.3-1.0 Hz.
 double q(int i, double t) { return 0.5 * std::sin(2.0 * M_PI * (0.3 + 0.14 * i) * t + i); }

@@ -224,6 +224,21 @@ TEST_F(AnyRobot, EffortsLaunchAndLiveTuning) {
   for (std::size_t i = 0; i < 100; ++i)
     EXPECT_EQ(stamps_.at(loads1_.msgs()[before + i]->header.stamp.toNSec()),
               smoothed + static_cast<long>(i));
+
+  // 6. A setting the running filter does not read (a Savitzky-Golay order while the
+  // Kalman filter runs) is applied and said so; the filters are kept: every sample sent
+  // has its loads at once, no warm-up (the causal filter warmed up first).
+  send(20);
+  c = reconfigure({{"differentiator_order", 3}}, {}, {});
+  EXPECT_EQ(intValue(c, "differentiator_order"), 3);
+  EXPECT_EQ(strValue(c, "status"),
+            "applied: the filters kept (differentiator 'kalman' does not read the setting "
+            "changed)");
+  before = loads1_.size();
+  const long kept = sent_;
+  send(20);
+  ASSERT_EQ(loads1_.size(), before + 20);
+  EXPECT_EQ(stamps_.at(loads1_.msgs()[before]->header.stamp.toNSec()), kept);
 }
 
 }  // namespace

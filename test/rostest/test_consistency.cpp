@@ -22,6 +22,7 @@
 
 #include "node_test_common.hpp"
 
+#include <jle_testing/wrist_sensor_arm.hpp>
 #include <joint_load_estimator/io/portable_random.hpp>
 
 namespace {
@@ -30,12 +31,12 @@ using namespace jle_test;
 using Eigen::Vector2d;
 using geometry_msgs::WrenchStamped;
 
-const std::string kUrdf = std::string(JLE_TEST_DATA) + "/urdf/wrist_sensor_arm.urdf";
-constexpr double kG = 9.80665;
-constexpr double kToolMass = 0.8;
-const Vector3d kToolCom(0.0, 0.02, 0.11);  // ft_sensor frame [m]
-const Vector3d kTip(0.0, 0.0, 0.2);        // ft_sensor frame [m]
-const Vector2d kStill(0.4, 0.3);           // the still posture [rad]
+using jle_test::wrist_sensor_arm::j2EffortAtRest;
+using jle_test::wrist_sensor_arm::kG;
+using jle_test::wrist_sensor_arm::staticReading;
+const std::string kUrdf = jle_test::wrist_sensor_arm::urdf();
+const Vector3d kTip = jle_test::wrist_sensor_arm::tip();  // ft_sensor frame [m]
+const Vector2d kStill(0.4, 0.3);                          // the still posture [rad]
 
 // Rounding of a still posture: the 3-point filter's weights sum to one to
 // ~1e-12 on readings of ~8 N (test_sensor_joint.cpp).
@@ -44,17 +45,6 @@ constexpr double kStillTol = 1e-9;
 // 1 ms apart lose ~1e-16 / 1e-6 of the acceleration, times masses and lever
 // arms ~1.
 constexpr double kMovingTol = 1e-7;
-
-Eigen::Matrix3d Ry(double a) { return Eigen::AngleAxisd(a, Vector3d::UnitY()).toRotationMatrix(); }
-
-// What the sensor reads at rest with the tool alone (ft_sensor frame, about its
-// origin): the proximal side holds the tool's weight, m g upward; the sensor
-// frame is turned by q1 about z and q2 + pi/2 about y from the world, so "up"
-// is (-cos q2, 0, -sin q2).
-void staticReading(double q2, Vector3d& f, Vector3d& m) {
-  f = kToolMass * kG * Vector3d(-std::cos(q2), 0.0, -std::sin(q2));
-  m = kToolCom.cross(f);
-}
 
 Vector3d force(const WrenchStamped& w) {
   return Vector3d(w.wrench.force.x, w.wrench.force.y, w.wrench.force.z);
@@ -68,6 +58,13 @@ struct Sample {
   VectorXd q;
   Vector3d f, m;
 };
+
+// The still posture and the reading of the tool's weight alone, at any stamp.
+Sample still(const ros::Time&) {
+  Sample s{kStill, {}, {}};
+  staticReading(kStill[1], s.f, s.m);
+  return s;
+}
 
 // One sensor node: its joint states, its sensor topic, its residual.
 class SensorNode {
@@ -175,11 +172,6 @@ bool waitForConsistencyStatus(const std::string& node, std::uint8_t level,
 TEST(Consistency, ReadingEqualToPredictionGivesZeroResidual) {
   SensorNode arm("arm");
   ASSERT_TRUE(arm.connect());
-  auto still = [](const ros::Time&) {
-    Sample s{kStill, {}, {}};
-    staticReading(kStill[1], s.f, s.m);
-    return s;
-  };
   double worst = 0.0;
   const int n_still =
       arm.run(ros::Time(10, 0), 30, still, [&](const ros::Time&, const WrenchStamped& r) {
@@ -230,9 +222,8 @@ TEST(Consistency, UnmodelledContact) {
   ASSERT_TRUE(arm.connect());
   const Vector3d c(3.0, -2.0,
                    5.0);  // [N] on the tool tip, ft_sensor axes (|c| = 6.2 N)
-  auto pushed = [&](const ros::Time&) {
-    Sample s{kStill, {}, {}};
-    staticReading(kStill[1], s.f, s.m);
+  auto pushed = [&](const ros::Time& t) {
+    Sample s = still(t);
     s.f -= c;
     s.m -= kTip.cross(c);
     return s;
@@ -248,16 +239,8 @@ TEST(Consistency, UnmodelledContact) {
   std::printf("unmodelled contact: largest residual error %.3g\n", worst);
   EXPECT_LT(worst, kStillTol);
 
-  // j2 at rest: minus the moment about its axis (y, unchanged by q1) of the
-  // weights of link2 (1.5 kg, com (0.15, 0, 0.01)) and of the tool, and of the
-  // push at the tip.
-  const Eigen::Matrix3d R2 = Ry(kStill[1]), Rs = R2 * Ry(M_PI / 2);
-  const Vector3d weight(0.0, 0.0, -kG);
-  const Vector3d r_link2 = R2 * Vector3d(0.15, 0.0, 0.01);
-  const Vector3d r_tool = R2 * Vector3d(0.3, 0.0, 0.0) + Rs * kToolCom;
-  const Vector3d r_tip = R2 * Vector3d(0.3, 0.0, 0.0) + Rs * kTip;
-  const double tau2 =
-      -(r_link2.cross(1.5 * weight) + r_tool.cross(kToolMass * weight) + r_tip.cross(Rs * c)).y();
+  // j2 at rest, in closed form (the weights of link2 and the tool, the push at the tip).
+  const double tau2 = j2EffortAtRest(kStill[1], c);
   const auto loads = arm.node.loads().find(origin + ros::Duration(0, 1000000 * 29));
   ASSERT_TRUE(loads);
   ASSERT_EQ(loads->name.size(), 2u);
@@ -277,11 +260,6 @@ TEST(Consistency, UnmodelledContact) {
 TEST(Consistency, AWrongSignIsNamed) {
   SensorNode flipped("flipped");
   ASSERT_TRUE(flipped.connect());
-  auto still = [](const ros::Time&) {
-    Sample s{kStill, {}, {}};
-    staticReading(kStill[1], s.f, s.m);
-    return s;
-  };
   const int n =
       flipped.run(ros::Time(15, 0), 40, still, [](const ros::Time&, const WrenchStamped&) {});
   EXPECT_GE(n, 30);
@@ -295,8 +273,16 @@ TEST(Consistency, AWrongSignIsNamed) {
 
 const Vector3d kBiasForce(0.7, -0.4, 1.2);      // [N]
 const Vector3d kBiasTorque(0.05, -0.03, 0.02);  // [N m]
-constexpr double kSigmaForce = 0.05;            // [N]
-constexpr double kSigmaTorque = 0.005;          // [N m]
+
+// The still reading with the sensor's bias and no noise, at any stamp.
+Sample stillWithBias(const ros::Time& t) {
+  Sample s = still(t);
+  s.f += kBiasForce;
+  s.m += kBiasTorque;
+  return s;
+}
+constexpr double kSigmaForce = 0.05;    // [N]
+constexpr double kSigmaTorque = 0.005;  // [N m]
 const std::string kCalibrate = "/calib/joint_load_estimator/calibrate_bias";
 long g_calibration_samples = 0;  // N of the calibration, for the reload test
 
@@ -346,9 +332,8 @@ TEST(Calibration, RecoversTheBiasWithinItsNoise) {
   SensorNode calib("calib");
   ASSERT_TRUE(calib.connect());
   jle::PortableRandom random(20240611);
-  auto biased = [&](const ros::Time&) {
-    Sample s{kStill, {}, {}};
-    staticReading(kStill[1], s.f, s.m);
+  auto biased = [&](const ros::Time& t) {
+    Sample s = still(t);
     for (int i = 0; i < 3; ++i) {
       s.f[i] += kBiasForce[i] + kSigmaForce * random.gaussian();
       s.m[i] += kBiasTorque[i] + kSigmaTorque * random.gaussian();
@@ -408,15 +393,8 @@ TEST(Calibration, RecoversTheBiasWithinItsNoise) {
   // estimate's error only (after the filter's 3-sample memory of readings from
   // before).
   const ros::Time origin(42, 0);
-  auto clean = [&](const ros::Time&) {
-    Sample s{kStill, {}, {}};
-    staticReading(kStill[1], s.f, s.m);
-    s.f += kBiasForce;
-    s.m += kBiasTorque;
-    return s;
-  };
   double worst_f = 0.0, worst_m = 0.0;
-  calib.run(origin, 20, clean, [&](const ros::Time&, const WrenchStamped& r) {
+  calib.run(origin, 20, stillWithBias, [&](const ros::Time&, const WrenchStamped& r) {
     worst_f = std::max(worst_f, force(r).cwiseAbs().maxCoeff());
     worst_m = std::max(worst_m, torque(r).cwiseAbs().maxCoeff());
   });
@@ -441,21 +419,14 @@ TEST(Calibration, ASecondNodeLoadsTheBiasFile) {
     const bool connected = reload.connect();
     EXPECT_TRUE(connected);
     if (connected) {
-      auto clean = [&](const ros::Time&) {
-        Sample s{kStill, {}, {}};
-        staticReading(kStill[1], s.f, s.m);
-        s.f += kBiasForce;
-        s.m += kBiasTorque;
-        return s;
-      };
       const double bf = 4.0 * kSigmaForce / std::sqrt(g_calibration_samples),
                    bt = 4.0 * kSigmaTorque / std::sqrt(g_calibration_samples);
       double worst_f = 0.0, worst_m = 0.0;
-      const int n =
-          reload.run(ros::Time(50, 0), 20, clean, [&](const ros::Time&, const WrenchStamped& r) {
-            worst_f = std::max(worst_f, force(r).cwiseAbs().maxCoeff());
-            worst_m = std::max(worst_m, torque(r).cwiseAbs().maxCoeff());
-          });
+      const int n = reload.run(ros::Time(50, 0), 20, stillWithBias,
+                               [&](const ros::Time&, const WrenchStamped& r) {
+                                 worst_f = std::max(worst_f, force(r).cwiseAbs().maxCoeff());
+                                 worst_m = std::max(worst_m, torque(r).cwiseAbs().maxCoeff());
+                               });
       EXPECT_GE(n, 10);
       std::printf(
           "node started with the bias file: largest residual force "

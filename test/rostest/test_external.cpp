@@ -169,11 +169,9 @@ TEST(External, Issue40SceneThroughTheNodeWithStartUpDrops) {
   const int n = static_cast<int>(jle_testing::PandaContacts::kDuration * 1000.0);
   for (int k = 0; k < n; ++k) {
     const double t = k * 1e-3;
-    Eigen::VectorXd q, qd, qdd;
-    scene.state(t, q, qd, qdd);
-    std::vector<double> effort = scene.efforts(t);
-    for (int i = 0; i < 7; ++i) q[i] += 1e-4 * gauss(rng);
-    for (double& e : effort) e += 0.1 * gauss(rng);
+    Eigen::VectorXd q;
+    std::vector<double> effort;
+    scene.measured(t, rng, gauss, q, effort);
     if ((k >= 3 && k < 9) || (k >= 20 && k < 41) || (k >= 60 && k < 63) || (k >= 85 && k < 97))
       continue;
     sensor_msgs::JointState js =

@@ -108,12 +108,35 @@ inline double processNoise(const DifferentiatorConfig& c) {
                                                               : kConstantJerk;
 }
 
-/// Whether two configurations make the same filter: every field equal (fields()), the
-/// process noise as the filter runs it.
-inline bool sameDifferentiator(DifferentiatorConfig a, DifferentiatorConfig b) {
-  a.process_noise = processNoise(a);  // 0 is the model's default: the same filter
-  b.process_noise = processNoise(b);
-  return a.fields() == b.fields();
+/// The configuration as its filter reads it: the fields only other types read set to
+/// their defaults (a Kalman or adaptive bank has no window, order or delay; a fit or a
+/// finite difference no Kalman model, noise, bandwidths or lag; a finite difference's
+/// window is order + 1), and the process noise as the filter runs it.
+inline DifferentiatorConfig asRun(DifferentiatorConfig c) {
+  const DifferentiatorConfig defaults;
+  if (c.type == DifferentiatorType::kKalman || c.type == DifferentiatorType::kAdaptive) {
+    c.window = defaults.window;
+    c.order = defaults.order;
+    c.delay = defaults.delay;
+    c.process_noise = processNoise(c);  // 0 is the model's default: the same filter
+    return c;
+  }
+  const int window = c.type == DifferentiatorType::kFiniteDifference ? defaults.window : c.window;
+  DifferentiatorConfig fit = defaults;
+  fit.type = c.type;
+  fit.window = window;
+  fit.order = c.order;
+  fit.delay = c.delay;
+  fit.max_gap = c.max_gap;
+  fit.process_noise = processNoise(fit);
+  return fit;
+}
+
+/// Whether two configurations make the same filter: every field the type reads equal
+/// (asRun), so that a change of another type's setting (a Savitzky-Golay order while a
+/// Kalman filter runs) keeps the filters.
+inline bool sameDifferentiator(const DifferentiatorConfig& a, const DifferentiatorConfig& b) {
+  return asRun(a).fields() == asRun(b).fields();
 }
 
 /// Checks a configuration once (the bank on construction, validate(EstimatorConfig) in

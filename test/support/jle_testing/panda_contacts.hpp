@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -70,6 +71,18 @@ class PandaContacts {
       qd[i] = a * w * std::cos(w * t + phase);
       qdd[i] = -a * w * w * std::sin(w * t + phase);
     }
+  }
+
+  /// What the robot measures at t [s]: the positions with encoder noise (1e-4 rad) and
+  /// the efforts with 0.1 N m of noise, drawn from `gauss` on `rng` in that order (the
+  /// core's test and the node's test draw the same noise).
+  void measured(double t, std::mt19937& rng, std::normal_distribution<double>& gauss,
+                Eigen::VectorXd& q, std::vector<double>& effort) const {
+    Eigen::VectorXd qd, qdd;
+    state(t, q, qd, qdd);
+    effort = efforts(t);
+    for (int i = 0; i < 7; ++i) q[i] += 1e-4 * gauss(rng);
+    for (double& e : effort) e += 0.1 * gauss(rng);
   }
 
   /// The joint efforts at t with the active contact's wrench (KDL's RNE) [N m].
