@@ -350,9 +350,11 @@ struct StampSettings {
 /// 1.32 times the offline result (now 1.27, 1.27, 1.26); 7 Hz from the start cost ur5 1.53
 /// (1.23) and random_tree 1.33 (1.13), whose motion is faster. Measured on the
 /// accuracy study's scenes: docs/studies/accuracy.md, "The defaults against the best of the
-/// study"; docs/how_it_works.md, "Two streams". The same filter with lag 0.25 s (the study's `KS-CJ
-/// auto lag=250ms`, its floor 5.6 Hz) is worse on the whole (geometric mean over the best 1.18
-/// against 1.16; panda 1.60x against 1.28x the best, leg_gait_70hz 1.71x against 1.45x).
+/// study"; docs/how_it_works.md, "Two streams". The same filter at the study's other lags
+/// (0.1, 0.25 s) are its rows `KS-CJ auto lag=...`. A zero-phase Butterworth at a fixed delay
+/// (its backward pass over blocks from the newest sample) was prototyped against it: at 6 Hz it
+/// needs about 0.45 s of delay to come within 1.1x of the offline result, where this smoother
+/// (whose response with a long lag is the same |H|^2) needs about 0.25 s.
 inline DifferentiatorConfig defaultSmoother() {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;
