@@ -280,11 +280,11 @@ void addSmoothers(bool quick, std::vector<Differentiator>& out) {
     out.push_back({label, "adaptive_smooth", c, c.measurement_noise, false, {}, false});
   }
   if (quick) return;
-  // The smoothed stream's default filter (its bandwidth from the data) at every lag of
-  // 0.2 s or more that issue 37 allows (at most 0.25 s) but its own.
+  // The smoothed stream's default filter (its bandwidth from the data) at the study's lags
+  // from 0.1 s to the 0.25 s that issue 37 allows, but its own.
   for (double lag : lags) {
     jle::DifferentiatorConfig c = jle::defaultSmoother();
-    if (lag < 0.2 || lag == c.lag) continue;
+    if (lag < 0.1 || lag == c.lag) continue;
     c.lag = lag;
     char label[64];
     std::snprintf(label, sizeof label, "KS-CJ auto lag=%.0fms", 1e3 * lag);

@@ -7,6 +7,7 @@
 #include <joint_load_estimator/model/dynamics.hpp>
 #include <joint_load_estimator/model/kinematics.hpp>
 #include <joint_load_estimator/model/urdf_reader.hpp>
+#include <joint_load_estimator/settings/config.hpp>
 
 #include <jle_testing/random_models.hpp>
 
@@ -366,6 +367,28 @@ void fullStepSmoother(benchmark::State& state, const std::string& file) {
   runEstimator(state, file, config, false);
 }
 
+// Both streams of the node's defaults (jle::Settings{}: the immediate estimator and the
+// smoothed one, smoothedEstimatorConfig) fed the same samples, against fullStep (the
+// immediate stream alone): their ratio is the cost of both (issue 37: under 3x).
+void fullStepBothStreams(benchmark::State& state, const std::string& file) {
+  const jle::Model<double> model = jle::modelFromUrdfFile(kData + file);
+  const jle::Settings settings;
+  jle::Estimator immediate(model, settings.estimator);
+  jle::Estimator smoothed(model, jle::smoothedEstimatorConfig(settings));
+  const int n = 4096;
+  std::vector<Eigen::VectorXd> q(n, Eigen::VectorXd(model.nq));
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i < model.nq; ++i) q[k][i] = 0.5 * std::sin(2e-3 * k + i);
+  int k = 0;
+  double t = 0.0;
+  for (auto _ : state) {
+    t += 1e-3;
+    benchmark::DoNotOptimize(immediate.addJointSample(t, q[k].data()));
+    benchmark::DoNotOptimize(smoothed.addJointSample(t, q[k].data()));
+    k = (k + 1) % n;
+  }
+}
+
 }  // namespace
 
 // Savings: each switched off (or on) against the defaults, where it applies and where
@@ -437,11 +460,12 @@ BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_auto, "/urdf/chains/p
 BENCHMARK_CAPTURE(estimatorStep, panda_chain_moving_planar_off, "/urdf/chains/panda_chain.urdf", "",
                   false, "planar_off");
 
-#define JLE_PASSES(name, file)                    \
-  BENCHMARK_CAPTURE(coreDouble, name, file);      \
-  BENCHMARK_CAPTURE(coreDoubleWorld, name, file); \
-  BENCHMARK_CAPTURE(fullStep, name, file);        \
-  BENCHMARK_CAPTURE(fullStepSmoother, name, file)
+#define JLE_PASSES(name, file)                     \
+  BENCHMARK_CAPTURE(coreDouble, name, file);       \
+  BENCHMARK_CAPTURE(coreDoubleWorld, name, file);  \
+  BENCHMARK_CAPTURE(fullStep, name, file);         \
+  BENCHMARK_CAPTURE(fullStepSmoother, name, file); \
+  BENCHMARK_CAPTURE(fullStepBothStreams, name, file)
 JLE_PASSES(panda_chain, "/urdf/chains/panda_chain.urdf");
 BENCHMARK_CAPTURE(kdlChain, panda_chain, "/urdf/chains/panda_chain.urdf", "panda_link0",
                   "panda_hand_tcp");

@@ -39,6 +39,27 @@ InputBuffer::Vector6 InputBuffer::interpolate(double t) const {
   return values_[ring(count_ - 1)];  // older than all we hold
 }
 
+InputBuffer::Vector6 InputBuffer::centredAt(double t, double half) const {
+  // Sums over the samples within half of t, newest first, in u = time - t.
+  double n = 0.0, su = 0.0, suu = 0.0;
+  Vector6 sx = Vector6::Zero(), sux = Vector6::Zero();
+  bool before = false, after = false;
+  for (int k = 0; k < count_; ++k) {
+    const double u = times_[ring(k)] - t;
+    if (u > half) continue;
+    if (u < -half) break;
+    (u > 0.0 ? after : before) = true;
+    n += 1.0;
+    su += u;
+    suu += u * u;
+    sx += values_[ring(k)];
+    sux += u * values_[ring(k)];
+  }
+  const double det = n * suu - su * su;
+  if (!before || !after || !(det > 0.0)) return interpolate(t);
+  return (suu * sx - su * sux) / det;  // the line's intercept at u = 0
+}
+
 bool InputBuffer::staleAt(double t) const { return count_ == 0 || t - times_[ring(0)] > timeout_; }
 
 bool InputBuffer::zeroAt(double t) const {
@@ -51,7 +72,7 @@ InputBuffer::Vector6 InputBuffer::valueAt(double t) const {
   return interpolate(t);
 }
 
-void InputBuffer::resample(double t, bool needed, double* out) {
+void InputBuffer::resample(double t, bool needed, double* out, double half) {
   if (!needed) {  // pruned away: never stale, never read
     stale_ = false;
     zeroed_ = false;
@@ -59,7 +80,9 @@ void InputBuffer::resample(double t, bool needed, double* out) {
   }
   stale_ = staleAt(t);
   zeroed_ = zeroAt(t);
-  const Vector6 value = valueAt(t);
+  const Vector6 value = zeroed_      ? Vector6::Zero()
+                        : half > 0.0 ? centredAt(t, half)
+                                     : interpolate(t);
   for (int j = 0; j < 6; ++j) out[j] = value[j];
 }
 

@@ -270,6 +270,13 @@ void DifferentiatorBank::setBandwidth(double f, double dt) {
   auto_bandwidth_ = bandwidthOf(config_.process_noise, h);
 }
 
+void DifferentiatorBank::startAtLagFloor(double dt) {
+  if (!(spacing_ > 0.0) || bandwidthOf(config_.process_noise, spacing_) >= kLagFloor / config_.lag)
+    return;
+  setBandwidth(0.0, dt);  // the floor
+  auto_bandwidth_ = 0.0;  // not the data's choice: the probe goes on
+}
+
 void DifferentiatorBank::addSpectra(double t, const double* x, double dt) {
   spectra_used_ = true;
   if (spectral_.add(t, x, state_.data() + 1, n_)) chooseNoise(dt);
@@ -560,6 +567,7 @@ bool DifferentiatorBank::smoothStep(double t, double dt) {
       Eigen::Map<const Eigen::VectorXd>(state_.data(), static_cast<Eigen::Index>(n_) * channels_);
   ring_times_[slot] = t;
   noteInterval(dt);
+  if (autoBandwidth() && auto_bandwidth_ == 0.0) startAtLagFloor(dt);
   return emitDue();
 }
 

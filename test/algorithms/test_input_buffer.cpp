@@ -155,3 +155,28 @@ TEST(InputBuffer, FilteredWrenchReadsItsSixChannels) {
 }
 
 }  // namespace
+
+// centredAt (a delayed estimate's read: the smoothed stream's): the least-squares line
+// through the samples within half of t, at t. A line passes exactly wherever the samples
+// lie; noise symmetric about it cancels; with samples on one side only, interpolate().
+TEST(InputBuffer, CentredAtFitsTheLineThroughTheSamplesAroundT) {
+  jle::InputBuffer b(0.5, jle::StalePolicy::kHold);
+  // A line 3 + 2 t in every component, at irregular stamps, with +-0.5 added to the
+  // samples at 1.00 and 1.04 s and -0.5 to those at 0.98 and 1.02 s (pairs symmetric
+  // about t = 1.01: the noise's fit is zero there).
+  const double stamps[] = {0.90, 0.98, 1.00, 1.02, 1.04, 1.20};
+  const double noise[] = {0.0, -0.5, 0.5, -0.5, 0.5, 0.0};
+  for (int k = 0; k < 6; ++k)
+    ASSERT_TRUE(b.add(stamps[k], Vector6::Constant(3.0 + 2.0 * stamps[k] + noise[k])));
+  // Within 0.035 of 1.01: the four noisy samples, at u = -0.03, -0.01, 0.01, 0.03 from t
+  // (sum 0): the fit's value at u = 0 is the line's, 5.02, plus the noise's mean, 0.
+  EXPECT_NEAR(b.centredAt(1.01, 0.035)[0], 5.02, 1e-12);
+  // A window holding two clean samples only (0.90 and 1.20 about 1.05): the line itself.
+  jle::InputBuffer clean(0.5, jle::StalePolicy::kHold);
+  for (double t : {0.90, 1.20, 1.50}) ASSERT_TRUE(clean.add(t, Vector6::Constant(3.0 + 2.0 * t)));
+  EXPECT_NEAR(clean.centredAt(1.05, 0.2)[3], 5.1, 1e-12);
+  // Samples on one side only (none after 1.5 s): interpolate(), the newest held.
+  EXPECT_EQ(clean.centredAt(1.6, 0.2), clean.interpolate(1.6));
+  // None within half: interpolate().
+  EXPECT_EQ(clean.centredAt(1.0, 0.01), clean.interpolate(1.0));
+}

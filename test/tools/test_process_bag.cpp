@@ -219,7 +219,7 @@ jle::Estimator referenceEstimator(const jle::Model<double>& model, bool smoothed
   if (smoothed) {
     config.differentiator.type = jle::DifferentiatorType::kKalman;
     config.differentiator.kalman_model = jle::KalmanModel::kConstantJerk;
-    config.differentiator.process_noise = 1e3;
+    config.differentiator.process_noise = 400.0;  // defaultSmoother()
     config.differentiator.measurement_noise = 1e-4;
     config.differentiator.lag = 0.2;
   } else {

@@ -78,9 +78,11 @@ class Estimator {
   int velocitiesUsed() const;
   /// Whether the measured velocities are the better evidence of the rates: true but where
   /// a smoother (lag > 0) sets its bandwidth from the data (differentiator.auto_bandwidth,
-  /// the smoothed stream) and both spectra have chosen; there, where the velocities' noise
-  /// floor is below the positions' times (2 pi f)^2, f the positions' bandwidth (at f, the
-  /// velocities' share of noise is the smaller). Where it is false, the coordinates of
+  /// the smoothed stream); there, where the velocities' noise floor is below the
+  /// positions' times (2 pi f)^2, f the positions' bandwidth (at f, the velocities' share
+  /// of noise is the smaller), the floors of both spectra once both have chosen, before
+  /// that of both probes (0.5 s blocks; true where a probe finds no floor), and before
+  /// the probes' first choice false (the positions). Where it is false, the coordinates of
   /// velocityUsed() take q-dot and q-ddot from the positions too (accuracy study: the
   /// Panda scenes' velocities, 1e-3 rad/s, are worse evidence than their positions;
   /// the coloured-noise scenes' much better).
@@ -170,12 +172,19 @@ class Estimator {
   /// distal side exerts on its surroundings beyond what the model and the other inputs
   /// explain (e.g. a tool pushing on a surface), or a sensor bias. Zero when unused.
   Wrench<double> sensorResidual(int k) const;
-  /// Samples taken and not yet estimated (a smoother's; flush()).
-  int pendingSamples() const { return bank_.pending(); }
+  /// Samples taken and not yet estimated (a smoother's; flush()), the held one included.
+  int pendingSamples() const { return bank_.pending() + (holding_ ? 1 : 0); }
   /// Delay of the estimate behind the newest sample, in samples (a smoother's: its
   /// pending samples, an upper bound of the delay of any estimate still to come:
   /// DifferentiatorBank::delaySamples()).
-  int delaySamples() const { return bank_.delaySamples(); }
+  int delaySamples() const { return bank_.delaySamples() + (holding_ ? 1 : 0); }
+  /// Whether each joint sample waits for the next one before it enters the filters: a
+  /// smoother (lag > 0) with wrench or plate inputs, which are then read around the
+  /// sample's stamp from the samples on both sides of it (InputBuffer::centredAt), as
+  /// the offline zero-phase path reads them, instead of the newest one held (a delay of
+  /// up to an F/T period) or one noisy point between slower F/T samples. The smoothed
+  /// stream's delay grows by one joint-state interval.
+  bool holdsSamples() const { return hold_inputs_; }
   /// Segments whose loads are computed (all, or what the wanted joints need).
   const std::vector<int>& dynamicsSegments() const { return dynamics_segments_; }
   /// Whether wrench input k acts on a segment whose loads are computed.
@@ -226,7 +235,13 @@ class Estimator {
   void setUpPlanar();
   // A joint sample: its checks (false: refused, and why), the bank's channels, the estimate.
   bool accept(double t, const double* q, const BasePose* base, SampleStatus& refused);
-  void fillChannels(double t, const double* q, const BasePose* base);
+  void fillChannels(double t, const double* q, const BasePose* base, double half);
+  // The sample into the filters (its inputs read within half [s] of t; 0: the newest),
+  // and its estimate if one is due.
+  SampleStatus feed(double t, const double* q, const BasePose* base, const double* qd, double half);
+  // holdsSamples(): the sample waits (held_), and the held one is fed.
+  void hold(double t, const double* q, const BasePose* base, const double* qd);
+  SampleStatus feedHeld(double next_t);
   void chooseVelocities(const double* qd);
   void fillVelocityChannels(double t, const double* qd);
   SampleStatus publish();
@@ -279,6 +294,17 @@ class Estimator {
   Eigen::Quaterniond last_orientation_ = Eigen::Quaterniond::Identity();
   double last_t_ = 0.0;
   bool have_last_ = false;
+  // holdsSamples(): the joint sample waiting for the next one, and the one fed before it
+  // (before < t; -inf: none since a start).
+  struct HeldSample {
+    double t = 0.0, before = 0.0;
+    std::vector<double> q, qd;
+    bool has_qd = false, has_base = false;
+    BasePose base;
+  };
+  HeldSample held_;
+  bool holding_ = false;
+  bool hold_inputs_ = false;
   long sample_count_ = 0;
   double stamp_ = 0.0;
   CovarianceModel covariance_model_;

@@ -39,6 +39,11 @@ class InputBuffer {
   /// The value at time t [s]: linear between the two samples around t, the newest past
   /// the newest, the oldest before the oldest, zero while there is no sample. No policy.
   Vector6 interpolate(double t) const;
+  /// The value at time t [s] from the samples within half [s] of it: the line fitted to
+  /// them (least squares) at t, where they lie on both sides of t (at least one at or
+  /// before t, one after); else interpolate(t). A joint sample between slower F/T samples
+  /// gets what lies around it, not one noisy point each (aliasing the sensor's noise).
+  Vector6 centredAt(double t, double half) const;
   /// Whether a joint sample at time t [s] finds the input stale: no sample, or the newest
   /// older than the timeout.
   bool staleAt(double t) const;
@@ -50,7 +55,9 @@ class InputBuffer {
   /// At the joint sample t [s]: valueAt(t) into out[0..6) and stale() updated. An input
   /// that no computed segment needs (needed false) is not read: out is left as it is and
   /// the input is not stale.
-  void resample(double t, bool needed, double* out);
+  /// half > 0: centredAt(t, half) instead of interpolate(t) (a delayed estimate, which has
+  /// the samples after t).
+  void resample(double t, bool needed, double* out, double half = 0.0);
   /// Whether the input was stale at the last resample() (true after a reset).
   bool stale() const { return stale_; }
   /// At the last resample(): the input read as zero (zeroAt).

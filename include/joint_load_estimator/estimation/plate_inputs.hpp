@@ -44,9 +44,10 @@ class PlateInputs {
   /// Which plates act on a computed segment: dynamics[s] != 0 for the computed segments s.
   void setNeeded(const Model<double>& model, const std::vector<char>& dynamics);
 
-  /// At the joint sample t [s]: every needed plate's value into its six channels.
-  void resample(double t, double* channels) {
-    for (Plate& p : plates_) p.samples.resample(t, p.needed, channels + p.channel);
+  /// At the joint sample t [s]: every needed plate's value into its six channels (half > 0:
+  /// InputBuffer::centredAt).
+  void resample(double t, double* channels, double half = 0.0) {
+    for (Plate& p : plates_) p.samples.resample(t, p.needed, channels + p.channel, half);
   }
   /// Whether a plate with the kStop policy is stale.
   bool stopped() const {

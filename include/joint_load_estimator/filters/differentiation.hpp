@@ -102,6 +102,10 @@ class DifferentiatorBank {
   /// its noise floor [unit^2] (SpectralCutoff::floorLevel: 0 where none was found).
   double spectralCutoff() const { return autoBandwidth() ? spectral_.cutoff() : 0.0; }
   double noiseFloor() const { return autoBandwidth() ? spectral_.floorLevel() : 0.0; }
+  /// auto_bandwidth: the probe's (0.5 s blocks) last choice [Hz] and noise floor, until the
+  /// spectrum's first choice (0 before the probe's first).
+  double probeCutoff() const { return autoBandwidth() ? probe_.cutoff() : 0.0; }
+  double probeFloor() const { return autoBandwidth() ? probe_.floorLevel() : 0.0; }
   /// auto_bandwidth: the process noise is only ever raised above process_noise's, never
   /// lowered (true), or set from the data both ways (false, the default). The measured
   /// velocities' filter raises only: a rate's spectrum falls more slowly than a
@@ -177,6 +181,11 @@ class DifferentiatorBank {
   // highest cutoff) is taken from two blocks on only; a spectrum that falls throughout
   // (no noise to remove: leg_running_200hz) at once.
   void chooseNoise(double dt);
+
+  // auto_bandwidth, a smoother before the data's first choice: process_noise's bandwidth
+  // at the recent interval raised to kLagFloor / lag where it is below (process_noise is
+  // a density: its bandwidth falls with the rate, 400 is 8 Hz at 1 kHz and 6 Hz at 100 Hz).
+  void startAtLagFloor(double dt);
 
   // auto_bandwidth: the process noise of bandwidth f [Hz], at least kLagFloor / lag.
   void setBandwidth(double f, double dt);

@@ -344,17 +344,22 @@ struct StampSettings {
 /// its bandwidth set from the data (auto_bandwidth): where the positions' spectrum meets
 /// its noise floor, at least 7 Hz (kLagFloor / lag), and where it shows no floor (data
 /// without noise: the running leg) up to max_bandwidth (1 kHz: 0.45 of the rate);
-/// process noise 1e3 (9 Hz at 1 kHz) until the first choice (4 s; data without noise:
-/// 0.5 s). Measured on the
+/// process noise 400 (8 Hz at 1 kHz; at least the lag's floor at any rate) until the first
+/// choice (4 s; data without noise: 0.5 s): a fifth to half of a recording is before it,
+/// and 1e3 (9 Hz at 1 kHz, 6.7 Hz at 100 Hz) cost talos 1.41, panda_4khz 1.39, panda_sines
+/// 1.32 times the offline result (now 1.27, 1.27, 1.26); 7 Hz from the start cost ur5 1.53
+/// (1.23) and random_tree 1.33 (1.13), whose motion is faster. Measured on the
 /// accuracy study's scenes: docs/studies/accuracy.md, "The defaults against the best of the
-/// study"; docs/how_it_works.md, "Two streams". The same filter with lag 0.25 s (the study's `KS-CJ
-/// auto lag=250ms`, its floor 5.6 Hz) is worse on the whole (geometric mean over the best 1.18
-/// against 1.16; panda 1.60x against 1.28x the best, leg_gait_70hz 1.71x against 1.45x).
+/// study"; docs/how_it_works.md, "Two streams". The same filter at the study's other lags
+/// (0.1, 0.25 s) are its rows `KS-CJ auto lag=...`. A zero-phase Butterworth at a fixed delay
+/// (its backward pass over blocks from the newest sample) was prototyped against it: at 6 Hz it
+/// needs about 0.45 s of delay to come within 1.1x of the offline result, where this smoother
+/// (whose response with a long lag is the same |H|^2) needs about 0.25 s.
 inline DifferentiatorConfig defaultSmoother() {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;
   c.kalman_model = KalmanModel::kConstantJerk;
-  c.process_noise = 1e3;
+  c.process_noise = 400.0;
   c.lag = 0.2;
   c.auto_bandwidth = true;
   c.max_bandwidth = 1e3;

@@ -67,11 +67,11 @@ struct DifferentiatorConfig {
   /// of the rate, averaged to 500 Hz); as the process noise r^2 h (2 pi f)^(2n) (r
   /// measurement_noise, h the recent interval: the smoother's gain is 1/2 at f, as the
   /// zero-phase Butterworth of order n's at its cutoff), process_noise until the first
-  /// choice. Without a lag (the causal filter) alike, but the bandwidth only ever raised
-  /// above process_noise's, never lowered (its lag would grow with it), no lag floor, and
-  /// for positions only where the spectrum shows no floor (DifferentiatorBank::raiseOnly:
-  /// a rate's filter takes the crossing too).
-  /// false: process_noise throughout.
+  /// choice (a smoother: raised to kLagFloor / lag where its bandwidth is below). Without a lag
+  /// (the causal filter) alike, but the bandwidth only ever raised above process_noise's, never
+  /// lowered (its lag would grow with it), no lag floor, and for positions only where the spectrum
+  /// shows no floor (DifferentiatorBank::raiseOnly: a rate's filter takes the crossing too). false:
+  /// process_noise throughout.
   bool auto_bandwidth = false;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
   /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
