@@ -4,9 +4,13 @@
 # then the driver (test/soak/node_soak.cpp) feeding it 1e6 joint states with bad
 # messages mixed in and checking its loads, diagnostics and memory. Exit status: the
 # verdict (0 ok, 1 a failed check or the node died, 2 usage).
-# Usage: node_soak.sh [--samples N] [other node_soak options]; needs the `tests` build
-# (JLE_WS as for tools/build.sh).
+# Usage: node_soak.sh [--page] [--samples N] [other node_soak options]; needs the `tests`
+# build (JLE_WS as for tools/build.sh). --page: a passing run also writes its figures into
+# docs/studies/node_soak.md (test/soak/node_soak_page.py).
 set -euo pipefail
+page=0
+if [ "${1:-}" = "--page" ]; then page=1; shift; fi
+load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
 bin=$ws/devel/lib/joint_load_estimator
@@ -48,7 +52,8 @@ rosparam load "$config" /joint_load_estimator
 node_pid=$!
 echo "node_soak.sh: master $ROS_MASTER_URI, node pid $node_pid"
 status=0
-"$bin/node_soak" --pid "$node_pid" --config "$config" "$@" || status=$?
+"$bin/node_soak" --pid "$node_pid" --config "$config" "$@" >"$ROS_HOME/soak.txt" || status=$?
+cat "$ROS_HOME/soak.txt"
 if kill -0 "$node_pid" 2>/dev/null; then
   kill -INT "$node_pid"
   node_status=0
@@ -65,6 +70,10 @@ fi
 if [ "$status" -ne 0 ]; then
   echo "node log (last 20 lines):"
   tail -20 "$ROS_HOME/node.log"
+fi
+if [ "$status" -eq 0 ] && [ "$page" -eq 1 ]; then
+  /usr/bin/python3 "$repo/test/soak/node_soak_page.py" "$ROS_HOME/soak.txt" "$load_before" \
+    "$(cut -d' ' -f1-3 /proc/loadavg)" "bash test/soak/node_soak.sh --page${*:+ $*}" || status=1
 fi
 echo "node_soak.sh: exit status $status"
 exit "$status"
