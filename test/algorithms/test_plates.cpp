@@ -457,7 +457,7 @@ void report(const char* what, const ImpactErrors& zero, const ImpactErrors& now,
             const ImpactErrors& before) {
   std::printf(
       "%s: ankle moment error over the stance [N m]: threshold 0: RMS %.3g max %.3g; "
-      "threshold 20 N: RMS %.3g max %.3g; earlier rule (ignored below 20 N): RMS %.3g "
+      "threshold 20 N: RMS %.3g max %.3g; the plate ignored below 20 N: RMS %.3g "
       "max %.3g\n",
       what, zero.stance_rms, zero.max, now.stance_rms, now.max, before.stance_rms, before.max);
 }
