@@ -2,7 +2,9 @@
 # The accuracy study in one command: builds bench/accuracy, runs every scene through
 # jle::Pipeline and the offline zero-phase smoother, and writes docs/studies/accuracy.csv, docs/studies/accuracy.md,
 # docs/studies/accuracy_error_vs_time.png and docs/studies/accuracy_error_vs_delay.png, then the
-# Kalman smoother's tables of docs/studies/differentiators.md (bench/differentiator_tables.py).
+# Kalman smoother's tables of docs/studies/differentiators.md (bench/differentiator_tables.py),
+# the tables of docs/studies/accuracy_overview.md (bench/accuracy_overview.py) and
+# docs/studies/causal_limit.md (bench/causal_limit.py).
 #   tools/accuracy.sh           the full study (about 2 min of CPU after the build)
 #   tools/accuracy.sh --quick   a tiny input, into $JLE_WS/accuracy_quick instead of docs/
 #                               (for CI: it fails if the study or the report no longer run,
@@ -31,5 +33,6 @@ fi
 /usr/bin/python3 "$repo/bench/causal_limit.py" "$out/causal_limit.md" "$out/accuracy.csv" >/dev/null
 if [ ${#quick[@]} -eq 0 ]; then
   /usr/bin/python3 "$repo/bench/differentiator_tables.py" "$out/accuracy.csv" "$out/differentiators.md"
+  /usr/bin/python3 "$repo/bench/accuracy_overview.py" "$out/accuracy.csv" "$out/accuracy_overview.md"
 fi
-echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png, causal_limit.md"
+echo "accuracy: wrote $out/accuracy.csv, accuracy.md, accuracy_error_vs_time.png, accuracy_error_vs_delay.png, causal_limit.md, accuracy_overview.md"
