@@ -480,7 +480,7 @@ def main():
               f"{fmt(least['rms_effort'])} N m with {ms(least['delay_ms'])} ms of delay.")
         if shipped_rows:
             r = shipped_rows[0]
-            w(f" The previous default, {shipped}: {fmt(r['rms_effort'])} N m, delay "
+            w(f" For comparison, the textbook causal fit {shipped}: {fmt(r['rms_effort'])} N m, delay "
               f"{ms(r['delay_ms'])} ms, {us(r['time_per_sample_us'])} us.")
         w(" Per scene: *Other scenes* below.\n\n")
     else:
@@ -619,7 +619,7 @@ def main():
     if rec:
         header.append(f"{rec['config']}: rank, error / delay")
     if shipped:
-        header.append(f"{shipped} (shipped): rank, error / delay")
+        header.append(f"{shipped}: rank, error / delay")
     w(table(header, body))
     w(f"\nRanks among {len(overall(rows, MAIN, precision='double'))} differentiators by RMS "
       "effort error. All rows of every scene, per joint too, are in accuracy.csv.\n")
