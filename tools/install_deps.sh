@@ -17,6 +17,7 @@ packages=(
   python3-matplotlib        # tools/examples/plot_loads.py, bench/plot_*.py
   pybind11-dev python3-pybind11 python3-numpy   # the Python bindings (docs/python.md)
   python3-pytest            # test/python (the bindings' tests)
+  catkin-tools              # test/scripts/fresh_workspace.sh: `catkin build` as a user runs it
   rviz python3-visualization-msgs  # estimator.launch rviz:=true (joint_labels: MarkerArray)
   xvfb imagemagick          # test/python/test_rviz.py: rviz on a virtual display, screenshots
   python3-scipy             # test/scripts/zero_phase_reference.py (the independent reference)

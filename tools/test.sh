@@ -34,11 +34,14 @@ if ! catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests -j1 >"$ws/run_te
   exit 1
 fi
 stage fresh_workspace
-# The package as a user builds it: a new catkin workspace, plain catkin_make, every
-# program rosrun finds answering --help, the node run from it (README, step 1).
-bash "$repo/test/scripts/fresh_workspace.sh" >"$ws/fresh_workspace.log" 2>&1 ||
-  { tail -30 "$ws/fresh_workspace.log"; echo "fresh workspace failed (log: $ws/fresh_workspace.log)"; bench_status=1; }
-tail -4 "$ws/fresh_workspace.log" || true
+# The package as a user builds it: a new catkin workspace, plain catkin_make, then
+# catkin_tools' catkin build, every program rosrun finds answering --help, the node run
+# from it (README, step 1).
+for builder in catkin_make catkin_build; do
+  JLE_BUILDER=$builder bash "$repo/test/scripts/fresh_workspace.sh" >"$ws/fresh_workspace_$builder.log" 2>&1 ||
+    { tail -30 "$ws/fresh_workspace_$builder.log"; echo "fresh workspace ($builder) failed (log: $ws/fresh_workspace_$builder.log)"; bench_status=1; }
+  tail -4 "$ws/fresh_workspace_$builder.log" || true
+done
 stage benchmarks
 # The benchmarks, once each on a tiny input, so that they cannot rot (no timing is
 # judged here).

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The package built as a user builds it (README, "Your own robot in five minutes", step
 # 1): a new catkin workspace with the repository's tracked files in src/, plain
-# catkin_make, then, from that workspace: every program rosrun finds answers --help
-# (exit 0, at once), and the node started with estimator.launch on a URDF publishes
-# ~joint_efforts for a bag of joint states. Exits non-zero naming what failed.
+# catkin_make (or, with JLE_BUILDER=catkin_build, catkin_tools' `catkin build`), then,
+# from that workspace: every program rosrun finds answers --help (exit 0, at once), and
+# the node started with estimator.launch on a URDF publishes ~joint_efforts for a bag of
+# joint states. Exits non-zero naming what failed.
 #   bash test/scripts/fresh_workspace.sh [WORKDIR]   (default: a new temporary directory,
 #                                                     removed at the end)
-# ROS_PORT: the roscore it starts (default 11397). Part of tools/test.sh.
+# ROS_PORT: the roscore it starts (default 11397). Part of tools/test.sh (both builders).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 work=${1:-}
@@ -30,12 +31,26 @@ else
 fi
 export PATH=/usr/bin:$PATH  # Debian's catkin needs the system python
 cd "$ws"
-log=$work/catkin_make.log
-echo "fresh_workspace: catkin_make in $ws"
-if ! catkin_make -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-    -j"${JLE_JOBS:-2}" >"$log" 2>&1; then
+builder=${JLE_BUILDER:-catkin_make}
+log=$work/$builder.log
+echo "fresh_workspace: $builder in $ws"
+case "$builder" in
+  catkin_make)
+    build() {
+      catkin_make -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+        -j"${JLE_JOBS:-2}"
+    } ;;
+  catkin_build)
+    build() {
+      catkin init &&
+        catkin config --cmake-args -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3 &&
+        catkin build --no-status --no-notify -j"${JLE_JOBS:-2}"
+    } ;;
+  *) echo "fresh_workspace: JLE_BUILDER is catkin_make or catkin_build" >&2; exit 2 ;;
+esac
+if ! build >"$log" 2>&1; then
   tail -40 "$log"
-  echo "fresh_workspace: catkin_make failed (log: $log)" >&2
+  echo "fresh_workspace: $builder failed (log: $log)" >&2
   exit 1
 fi
 set +u
@@ -44,7 +59,7 @@ source devel/setup.bash
 set -u
 status=0
 # Every program under rosrun's eyes answers --help at once, exit 0.
-programs=$(find devel/lib/joint_load_estimator -maxdepth 1 -type f -perm -u+x -printf '%f\n' | sort)
+programs=$(find -L devel/lib/joint_load_estimator -maxdepth 1 -type f -perm -u+x -printf '%f\n' | sort)
 for p in $programs; do
   if ! timeout 10 rosrun joint_load_estimator "$p" --help >"$work/help_$p.log" 2>&1; then
     echo "fresh_workspace: rosrun joint_load_estimator $p --help failed:" >&2
