@@ -30,6 +30,7 @@ using jle_test::kMs;
 using jle_test::kNone;
 using jle_test::kStart;
 using jle_test::ur5;
+using jle_test::withToolSensor;
 
 // Joint i: 0.5 sin(w_i t + i), 0.3-1.0 Hz, within the UR5's limits and speeds.
 double q(int i, double t) { return 0.5 * std::sin(2.0 * M_PI * (0.3 + 0.14 * i) * t + i); }
@@ -272,14 +273,7 @@ TEST(NeverSilent, ADeadWrenchInputIsDroppedAndFlagged) {
 // counted; an effort beyond effort_factor times its URDF limit flags the record.
 TEST(NeverSilent, AbsurdWrenchesAreRefusedAndImplausibleLoadsFlagged) {
   const jle::Model<double> model = ur5();
-  jle::Settings settings;
-  jle::WrenchInputConfig ft;
-  ft.name = "ft";
-  ft.link = "tool0";
-  settings.estimator.wrenches.push_back(ft);
-  jle::WrenchTopicSettings topic;
-  topic.topic = "ft";
-  settings.wrenches.push_back(topic);
+  const jle::Settings settings = withToolSensor();
   jle::Pipeline p(model, settings, nullptr);
   EXPECT_EQ(
       p.onWrench(0, kStart, kStart, "tool0", Eigen::Vector3d(0, 0, 1e300), Eigen::Vector3d::Zero()),

@@ -28,6 +28,7 @@ using jle_test::kMs;
 using jle_test::kNone;
 using jle_test::kStart;
 using jle_test::ur5;
+using jle_test::withToolSensor;
 
 // Joint i: 0.5 sin(w_i t + i), 0.3-1.0 Hz.
 double q(int i, double t) { return 0.5 * std::sin(2.0 * M_PI * (0.3 + 0.14 * i) * t + i); }
@@ -296,14 +297,7 @@ TEST(TwoStreams, TheSmoothedBandwidthIsTheHighestAtOnceOnExactData) {
 // Every joint state once, 0.2 s of stamps plus one interval behind.
 TEST(TwoStreams, TheSmoothedStreamReadsWrenchInputsAroundTheStamp) {
   const jle::Model<double> model = ur5();
-  jle::Settings settings;
-  jle::WrenchInputConfig ft;
-  ft.name = "ft";
-  ft.link = "tool0";
-  settings.estimator.wrenches.push_back(ft);
-  jle::WrenchTopicSettings topic;
-  topic.topic = "ft";
-  settings.wrenches.push_back(topic);
+  const jle::Settings settings = withToolSensor();
   jle::Pipeline late(model, settings, nullptr), at_stamps(model, settings, nullptr);
   const std::vector<double> still(static_cast<std::size_t>(model.nq), 0.3);
   const auto force = [](double t) { return Eigen::Vector3d(0.0, 0.0, -40.0 - 20.0 * t); };
