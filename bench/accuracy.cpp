@@ -875,8 +875,8 @@ struct Outputs {
   Eigen::MatrixXd qdd;         // nq x published
   double wall_us = 0.0;        // per joint sample, steady_clock over the whole run
   double cpu_us = 0.0;         // per joint sample, this thread's CPU time
-  bool planar = false;         // Estimator::planar(): the 3x3 path in use
-  long planar_published = 0;   // estimates computed by the 3x3 path (lastWasPlanar())
+  bool planar = false;         // Estimator::Layout::planar(): the 3x3 path in use
+  long planar_published = 0;   // estimates computed by the 3x3 path (LoadsRecord::planar)
 };
 
 double threadCpuSeconds() {
