@@ -304,54 +304,57 @@ struct Gait {
   Eigen::MatrixXd true_effort;     // samples x 3, at t
 };
 
+// The gait with its positions read at `rate` [Hz] (70: the study's).
+Gait gaitRecord(double rate) {
+  constexpr double duration = 10.0;
+  const jle::Model<double> model = jle::modelFromUrdfString(jle::planarLegUrdf());
+  const std::vector<jle::CoordinateMotion> motion =
+      jle::randomMotion(model, jle::MotionKind::kImpacts, duration, 41);
+  jle::WrenchMotion contact;
+  contact.link = "foot";
+  const std::vector<jle::AccelPulse>& pulses = motion.front().pulses;
+  for (std::size_t p = 1; p < pulses.size(); p += 2) {
+    jle::Stance s;
+    s.start = pulses[p].start;
+    s.rise = 0.008;
+    s.duration = 0.25;
+    s.peak << 150.0, 0.0, 1500.0, 0.0, 60.0, 0.0;
+    contact.stances.push_back(s);
+  }
+  jle::SensorModel sensor;
+  sensor.rate = rate;
+  sensor.coloured_noise = 2e-3;
+  sensor.coloured_corner = 15.0;
+  sensor.wrench_rate = 1000.0;
+  sensor.force_noise = 0.5;
+  sensor.moment_noise = 0.02;
+  Gait r;
+  r.truth =
+      std::make_unique<jle::GroundTruth>(model, motion, std::vector<jle::WrenchMotion>{contact});
+  const jle::SensorReadings readings = r.truth->sample(sensor, duration, 42);
+  const auto n = static_cast<Eigen::Index>(readings.joints.size());
+  r.q.resize(n, model.nq);
+  r.true_effort.resize(n, 3);
+  jle::Data<double> data(model);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const jle::JointReading& reading = readings.joints[static_cast<std::size_t>(k)];
+    r.t.push_back(reading.time);
+    r.q.row(k) = reading.q.transpose();
+    r.truth->loads(reading.time, data);
+    for (Eigen::Index j = 0; j < 3; ++j)
+      r.true_effort(k, j) = data.effort[model.moving_segments[static_cast<std::size_t>(j)]];
+  }
+  r.force.resize(static_cast<Eigen::Index>(readings.wrenches.size()), 6);
+  for (std::size_t k = 0; k < readings.wrenches.size(); ++k) {
+    const jle::WrenchReading& w = readings.wrenches[k];
+    r.t_force.push_back(w.stamp);
+    r.force.row(static_cast<Eigen::Index>(k)) << w.force.transpose(), w.moment.transpose();
+  }
+  return r;
+}
+
 const Gait& gait() {
-  static const Gait g = [] {
-    constexpr double duration = 10.0;
-    const jle::Model<double> model = jle::modelFromUrdfString(jle::planarLegUrdf());
-    const std::vector<jle::CoordinateMotion> motion =
-        jle::randomMotion(model, jle::MotionKind::kImpacts, duration, 41);
-    jle::WrenchMotion contact;
-    contact.link = "foot";
-    const std::vector<jle::AccelPulse>& pulses = motion.front().pulses;
-    for (std::size_t p = 1; p < pulses.size(); p += 2) {
-      jle::Stance s;
-      s.start = pulses[p].start;
-      s.rise = 0.008;
-      s.duration = 0.25;
-      s.peak << 150.0, 0.0, 1500.0, 0.0, 60.0, 0.0;
-      contact.stances.push_back(s);
-    }
-    jle::SensorModel sensor;
-    sensor.rate = 70.0;
-    sensor.coloured_noise = 2e-3;
-    sensor.coloured_corner = 15.0;
-    sensor.wrench_rate = 1000.0;
-    sensor.force_noise = 0.5;
-    sensor.moment_noise = 0.02;
-    Gait r;
-    r.truth =
-        std::make_unique<jle::GroundTruth>(model, motion, std::vector<jle::WrenchMotion>{contact});
-    const jle::SensorReadings readings = r.truth->sample(sensor, duration, 42);
-    const auto n = static_cast<Eigen::Index>(readings.joints.size());
-    r.q.resize(n, model.nq);
-    r.true_effort.resize(n, 3);
-    jle::Data<double> data(model);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      const jle::JointReading& reading = readings.joints[static_cast<std::size_t>(k)];
-      r.t.push_back(reading.time);
-      r.q.row(k) = reading.q.transpose();
-      r.truth->loads(reading.time, data);
-      for (Eigen::Index j = 0; j < 3; ++j)
-        r.true_effort(k, j) = data.effort[model.moving_segments[static_cast<std::size_t>(j)]];
-    }
-    r.force.resize(static_cast<Eigen::Index>(readings.wrenches.size()), 6);
-    for (std::size_t k = 0; k < readings.wrenches.size(); ++k) {
-      const jle::WrenchReading& w = readings.wrenches[k];
-      r.t_force.push_back(w.stamp);
-      r.force.row(static_cast<Eigen::Index>(k)) << w.force.transpose(), w.moment.transpose();
-    }
-    return r;
-  }();
+  static const Gait g = gaitRecord(70.0);
   return g;
 }
 
@@ -579,6 +582,78 @@ TEST_F(JointLoadsColoured, WarnsWhenTheChoiceSitsOnABound) {
   // A given cutoff: nothing to warn about.
   efforts(coloured(), "q.csv", {"--cutoff", "5"}, err);
   EXPECT_EQ(err.find("warning"), std::string::npos) << err;
+}
+
+// The gait as a joint_loads CSV, positions and contact force both at 1 kHz on the same rows
+// (a motion-capture export at the force plate's rate; the positions' noise still flat to
+// 15 Hz): the wrench columns' own spectrum raises the printed cutoff above the positions'
+// own, joint_loads says so, and its loads err less against the truth than at the
+// positions' own cutoff (--cutoff).
+TEST_F(JointLoadsColoured, TheGaitsContactForceRaisesThePrintedCutoff) {
+  const Gait g = gaitRecord(1000.0);
+  ASSERT_EQ(g.force.rows(), g.q.rows());
+  std::string text = "t";
+  for (const std::string& j : g.truth->model().coordinate_names) text += "," + j + ".q";
+  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"})
+    text += std::string(",wrench@foot.") + c;
+  text += "\n";
+  char cell[40];
+  for (Eigen::Index k = 0; k < g.q.rows(); ++k) {
+    ASSERT_NEAR(g.t_force[static_cast<std::size_t>(k)], g.t[static_cast<std::size_t>(k)], 1e-9);
+    std::snprintf(cell, sizeof cell, "%.17g", g.t[static_cast<std::size_t>(k)]);
+    text += cell;
+    for (Eigen::Index c = 0; c < g.q.cols(); ++c) {
+      std::snprintf(cell, sizeof cell, ",%.17g", g.q(k, c));
+      text += cell;
+    }
+    for (Eigen::Index c = 0; c < 6; ++c) {
+      std::snprintf(cell, sizeof cell, ",%.17g", g.force(k, c));
+      text += cell;
+    }
+    text += "\n";
+  }
+  write("gait.csv", text);
+  write("leg.urdf", jle::planarLegUrdf());
+  const auto loads = [&](const std::vector<std::string>& extra, std::string& err) {
+    std::vector<std::string> args{"--urdf", path("leg.urdf"), "--input", path("gait.csv")};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const jle_test::Result result = run(JLE_JOINT_LOADS, args);
+    err = result.err;
+    EXPECT_EQ(result.status, 0) << result.err;
+    const jle_test::Table table = jle_test::parseCsv(result.out);
+    const jle::Model<double>& model = g.truth->model();
+    double sum = 0.0;
+    long count = 0;
+    for (std::size_t k = 0; k < table.rows.size(); ++k) {
+      const double t = g.t[k];
+      if (t < kSettle || t > g.t.back() - kSettle) continue;
+      for (Eigen::Index j = 0; j < 3; ++j) {
+        const int s = model.moving_segments[static_cast<std::size_t>(j)];
+        const double e =
+            table.number(k, model.joint_name[static_cast<std::size_t>(s)] + ".effort") -
+            g.true_effort(static_cast<Eigen::Index>(k), j);
+        sum += e * e;
+        ++count;
+      }
+    }
+    return std::sqrt(sum / static_cast<double>(std::max(1L, count)));
+  };
+  std::string err, err_own;
+  const double raised = loads({}, err);
+  const jle::CutoffChoice own = jle::selectCutoff(g.t, g.q, jle::ZeroPhaseConfig{});
+  char given[32];
+  std::snprintf(given, sizeof given, "%.17g", own.cutoff);
+  const double at_own = loads({"--cutoff", given}, err_own);
+  EXPECT_NE(err.find("joint_loads: warning: zero-phase cutoff: "), std::string::npos) << err;
+  char from[48];
+  std::snprintf(from, sizeof from, "raised from the %.3g Hz of noise spectrum", own.cutoff);
+  EXPECT_NE(err.find(from), std::string::npos) << err;
+  EXPECT_GT(printedCutoff(err), 1.5 * own.cutoff) << err;
+  EXPECT_LT(raised, at_own) << err;
+  std::printf(
+      "joint_loads, gait with wrench@foot: %.3g Hz, %.3g N m; at the positions' own "
+      "%.3g Hz: %.3g N m\n",
+      printedCutoff(err), raised, own.cutoff, at_own);
 }
 
 }  // namespace
