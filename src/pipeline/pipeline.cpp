@@ -756,30 +756,42 @@ void Pipeline::setSensorBias(int k, const Eigen::Vector3d& force, const Eigen::V
   wrenches_[ix(k)].bias_torque = torque;
 }
 
+Outcome Pipeline::admitReading(InputKind kind, const std::string& what, bool has_frame,
+                               bool& stamped, Stamp& stamp, Stamp clock, double timeout,
+                               const Eigen::Vector3d& force, const Eigen::Vector3d& moment) {
+  if (!force.allFinite() || !moment.allFinite())
+    return fail(kind, Outcome::kInvalid, what + ": non-finite force or torque: dropped");
+  if (!has_frame)
+    return fail(kind, Outcome::kFrame,
+                what + ": empty header.frame_id and no 'frame' configured: dropped");
+  timeline_.clearJump();
+  if (!Timeline::zeroStamp(stamped, stamp, clock))
+    return fail(kind, Outcome::kRogueStamp, what + kZeroStamp);
+  // The stamps first, as for a joint state: the clock is followed whatever the values.
+  const Outcome timeline =
+      stampOutcome(kind, timeline_.checkInputStamp(stamp, clock, timeout, what, problem_));
+  if (timeline != Outcome::kUsed) return timeline;
+  if (!plausibleWrench(kind, what, force, moment)) return count(kind, Outcome::kImplausible);
+  return Outcome::kUsed;
+}
+
+Outcome Pipeline::notNewer(InputKind kind, const std::string& what, Stamp stamp) {
+  return fail(kind, Outcome::kOrder,
+              what + ": stamp " + secondsText(stamp) + " not newer than the last: dropped");
+}
+
 Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& frame_id,
                            const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
   constexpr InputKind kind = InputKind::kWrench;
   problem_.clear();
   smoothed_published_ = group_record_ = false;
-  const std::string& topic = settings_.wrenches.at(ix(k)).topic;
-  if (!force.allFinite() || !torque.allFinite())
-    return fail(kind, Outcome::kInvalid,
-                "wrench '" + topic + "': non-finite force or torque: dropped");
+  const std::string what = "wrench '" + settings_.wrenches.at(ix(k)).topic + "'";
   const std::string& configured = settings_.wrenches[ix(k)].frame;
   const std::string& frame = configured.empty() ? frame_id : configured;
-  if (frame.empty())
-    return fail(kind, Outcome::kFrame,
-                "wrench '" + topic + "': empty header.frame_id and no 'frame' configured: dropped");
-  timeline_.clearJump();
-  if (!Timeline::zeroStamp(wrenches_[ix(k)].stamped, stamp, clock))
-    return fail(kind, Outcome::kRogueStamp, "wrench '" + topic + "'" + kZeroStamp);
-  // The stamps first, as for a joint state: the clock is followed whatever the values.
-  const Outcome timeline = stampOutcome(
-      kind, timeline_.checkInputStamp(stamp, clock, settings_.estimator.wrenches[ix(k)].timeout,
-                                      "wrench '" + topic + "'", problem_));
-  if (timeline != Outcome::kUsed) return timeline;
-  if (!plausibleWrench(kind, "wrench '" + topic + "'", force, torque))
-    return count(kind, Outcome::kImplausible);
+  const Outcome admitted =
+      admitReading(kind, what, !frame.empty(), wrenches_[ix(k)].stamped, stamp, clock,
+                   settings_.estimator.wrenches[ix(k)].timeout, force, torque);
+  if (admitted != Outcome::kUsed) return admitted;
   if (!frame_resolver_.resolveWrench(k, frame, stamp, problem_))
     return count(kind, Outcome::kFrame);
   const WrenchInput& input = wrenches_[ix(k)];
@@ -790,10 +802,7 @@ Outcome Pipeline::onWrench(int k, Stamp stamp, Stamp clock, const std::string& f
   wrenchInLink(X.linear(), X.translation(), f, m, f_link, m_link);
   const double t = timeline_.relative(stamp);
   if (smoothed_) smoothed_->estimator.addWrench(k, t, f_link, m_link);  // the same order
-  if (!estimator_.addWrench(k, t, f_link, m_link))
-    return fail(kind, Outcome::kOrder,
-                "wrench '" + topic + "': stamp " + secondsText(stamp) +
-                    " not newer than the last: dropped");
+  if (!estimator_.addWrench(k, t, f_link, m_link)) return notNewer(kind, what, stamp);
   return count(kind, Outcome::kUsed);
 }
 
@@ -815,32 +824,17 @@ Outcome Pipeline::onPlate(int k, Stamp stamp, Stamp clock, const std::string& fr
   constexpr InputKind kind = InputKind::kPlate;
   problem_.clear();
   smoothed_published_ = group_record_ = false;
-  const std::string& name = settings_.estimator.plates.at(ix(k)).plate.name;
-  if (!force.allFinite() || !moment.allFinite())
-    return fail(kind, Outcome::kInvalid,
-                "force plate '" + name + "': non-finite force or torque: dropped");
+  const std::string what = "force plate '" + settings_.estimator.plates.at(ix(k)).plate.name + "'";
   const PlateTopicSettings& configured = settings_.force_plates[ix(k)];
   const std::string& frame = configured.frame.empty() ? frame_id : configured.frame;
-  if (frame.empty() && !configured.pose_configured)
-    return fail(
-        kind, Outcome::kFrame,
-        "force plate '" + name + "': empty header.frame_id and no 'frame' configured: dropped");
-  timeline_.clearJump();
-  if (!Timeline::zeroStamp(plates_[ix(k)].stamped, stamp, clock))
-    return fail(kind, Outcome::kRogueStamp, "force plate '" + name + "'" + kZeroStamp);
-  const Outcome timeline = stampOutcome(
-      kind, timeline_.checkInputStamp(stamp, clock, settings_.estimator.plates[ix(k)].timeout,
-                                      "force plate '" + name + "'", problem_));
-  if (timeline != Outcome::kUsed) return timeline;
-  if (!plausibleWrench(kind, "force plate '" + name + "'", force, moment))
-    return count(kind, Outcome::kImplausible);
+  const Outcome admitted =
+      admitReading(kind, what, !frame.empty() || configured.pose_configured, plates_[ix(k)].stamped,
+                   stamp, clock, settings_.estimator.plates[ix(k)].timeout, force, moment);
+  if (admitted != Outcome::kUsed) return admitted;
   if (!resolvePlatePose(k, frame)) return count(kind, Outcome::kFrame);
   const double t = timeline_.relative(stamp);
   if (smoothed_) smoothed_->estimator.addPlateSample(k, t, force, moment);  // the same order
-  if (!estimator_.addPlateSample(k, t, force, moment))
-    return fail(kind, Outcome::kOrder,
-                "force plate '" + name + "': stamp " + secondsText(stamp) +
-                    " not newer than the last: dropped");
+  if (!estimator_.addPlateSample(k, t, force, moment)) return notNewer(kind, what, stamp);
   return count(kind, Outcome::kUsed);
 }
 

@@ -351,6 +351,16 @@ class Pipeline {
                                                  const std::vector<double>& velocity);
   bool plausibleWrench(InputKind kind, const std::string& topic, const Eigen::Vector3d& force,
                        const Eigen::Vector3d& moment);
+  // What a wrench or plate reading (`what`: "wrench 'topic'", "force plate 'name'") passes
+  // before its frame is resolved: finite values, a frame (has_frame), a stamp that is not
+  // zero (`stamped` and `stamp` as Timeline::zeroStamp: a zero stamp on a stream that never had one
+  // becomes the clock), the time axis (timeout [s]) and plausible values. kUsed when it passes,
+  // else the outcome counted with problem_ set.
+  Outcome admitReading(InputKind kind, const std::string& what, bool has_frame, bool& stamped,
+                       Stamp& stamp, Stamp clock, double timeout, const Eigen::Vector3d& force,
+                       const Eigen::Vector3d& moment);
+  // An input's sample refused by the estimator as not newer than its last.
+  Outcome notNewer(InputKind kind, const std::string& what, Stamp stamp);
   // The filters start again from the next sample. drain: the smoother's pending samples
   // are published first (their state is good); else they are dropped (poisoned).
   void restartFilters(bool drain);
