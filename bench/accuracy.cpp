@@ -875,8 +875,8 @@ struct Outputs {
   Eigen::MatrixXd qdd;         // nq x published
   double wall_us = 0.0;        // per joint sample, steady_clock over the whole run
   double cpu_us = 0.0;         // per joint sample, this thread's CPU time
-  bool planar = false;         // Estimator::planar(): the 3x3 path in use
-  long planar_published = 0;   // estimates computed by the 3x3 path (lastWasPlanar())
+  bool planar = false;         // Estimator::Layout::planar(): the 3x3 path in use
+  long planar_published = 0;   // estimates computed by the 3x3 path (LoadsRecord::planar)
 };
 
 double threadCpuSeconds() {
@@ -1545,7 +1545,8 @@ Eigen::MatrixXd readingMatrix(const Scene& scene, bool rates) {
 }
 
 // Offline: the whole record's positions through smoothZeroPhase at their stamps (with
-// the measured velocities as evidence if `velocities` and the scene has them), every
+// the measured velocities as evidence if `velocities` and the scene has them, and the
+// wrench inputs as the channels filtered alike, which may raise the cutoff), every
 // wrench input through lowPassZeroPhase with the same cutoff at its own stamps, and the
 // same inverse dynamics as the online path (the core's forwardKinematics,
 // addExternalWrench, inverseDynamics). An estimate for every sample, no delay. `choice`:
@@ -1559,15 +1560,17 @@ RunResult zeroPhaseRun(const SceneRun& run, const jle::ZeroPhaseConfig& config, 
   const auto start = std::chrono::steady_clock::now();
   const Eigen::MatrixXd v =
       velocities && scene.spec.velocities ? readingMatrix(scene, true) : Eigen::MatrixXd();
+  std::vector<jle::FilteredAlike> alike(run.inputs.size());
+  for (std::size_t i = 0; i < run.inputs.size(); ++i) {
+    alike[i].x = wrenchReadings(scene.readings, static_cast<int>(i), alike[i].t);
+    alike[i].what = "wrench input " + run.inputs[i].name;
+  }
   const jle::ZeroPhaseResult zp =
-      jle::smoothZeroPhase(scene.stamps, readingMatrix(scene, false), config, v);
+      jle::smoothZeroPhase(scene.stamps, readingMatrix(scene, false), config, v, alike);
   std::vector<Eigen::MatrixXd> wrenches;
   std::vector<int> frames;
   choice = zp.choice;
   for (std::size_t i = 0; i < run.inputs.size(); ++i) {
-    std::vector<double> stamps;
-    const Eigen::MatrixXd raw = wrenchReadings(scene.readings, static_cast<int>(i), stamps);
-    jle::checkFilteredAlike(stamps, raw, config, "wrench input " + run.inputs[i].name, choice);
     wrenches.push_back(
         filteredWrench(scene.readings, static_cast<int>(i), zp.cutoff, config.order, scene.stamps));
     frames.push_back(model.frameIndex(run.inputs[i].link));

@@ -47,10 +47,10 @@ Errors score(const jle::GroundTruth& truth, const jle::SensorReadings& readings,
     truth.loads(r.time, exact);
     truth.coordinates(r.time, q, qd, qdd);
     for (int s : model.moving_segments) {
-      const double e = estimator.data().effort[s] - exact.effort[s];
+      const double e = estimator.last().data().effort[s] - exact.effort[s];
       effort2 += e * e;
     }
-    qdd2 += (estimator.qdd() - qdd).squaredNorm();
+    qdd2 += (estimator.last().qdd() - qdd).squaredNorm();
     ++n;
   }
   const double joints = static_cast<double>(model.moving_segments.size());

@@ -341,8 +341,9 @@ void runEstimator(benchmark::State& state, const std::string& file,
     benchmark::DoNotOptimize(estimator.addJointSample(t, q[k].data()));
     k = (k + 1) % n;
   }
-  state.counters["computed_segments"] = static_cast<double>(estimator.dynamicsSegments().size());
-  state.counters["planar"] = estimator.lastWasPlanar();
+  state.counters["computed_segments"] =
+      static_cast<double>(estimator.layout().dynamicsSegments().size());
+  state.counters["planar"] = estimator.last().planar();
 }
 
 void estimatorStep(benchmark::State& state, const std::string& file, const std::string& joints,

@@ -942,9 +942,9 @@ EventRun runEstimator(const jle::Model<double>& model, const DifferentiatorConfi
     out.status.push_back(st);
     if (st == jle::SampleStatus::kPublished) {
       out.index.push_back(static_cast<int>(k));
-      out.stamp.push_back(estimator.stamp());
-      out.qdd.push_back(estimator.qdd()[1]);
-      out.effort.push_back(estimator.data().effort[model.moving_segments[1]]);
+      out.stamp.push_back(estimator.last().stamp());
+      out.qdd.push_back(estimator.last().qdd()[1]);
+      out.effort.push_back(estimator.last().data().effort[model.moving_segments[1]]);
     }
   }
   return out;

@@ -621,14 +621,14 @@ std::string hz(double f) {
 void warnAbout(const CutoffSearch& search, CutoffRule other, CutoffChoice& choice) {
   bool found = true;
   const double f = ruleCutoff(search, other, found) / search.grid.h;
-  const double ratio = std::max(f / choice.cutoff, choice.cutoff / f);
+  const double own = choice.positions_cutoff;
+  const double ratio = std::max(f / own, own / f);
   if (!(ratio > kCutoffDisagreement)) return;
   char text[64];
   std::snprintf(text, sizeof text, "%.3g Hz, %.1fx ", f, ratio);
   choice.warnings.push_back(
       std::string("zero-phase cutoff: ") + toString(other) + " chooses " + text +
-      (f > choice.cutoff ? "above " : "below ") + "the " + hz(choice.cutoff) + " of " +
-      toString(choice.rule) +
+      (f > own ? "above " : "below ") + "the " + hz(own) + " of " + toString(choice.rule) +
       (other == CutoffRule::kVelocity
            ? ": the measured velocities contradict it"
            : ": the position noise may be coloured; check the loads or give --cutoff"));
@@ -647,8 +647,136 @@ bool velocitiesFollow(const CutoffSearch& search) {
   return difference < kFollow * rate_square;
 }
 
+// The search over the channels x at the stamps t (xg on the grid; v the measured
+// velocities at t or null). The lowest cutoff searched is a thousandth of the rate or one
+// period over the record, the highest config.max_cutoff or 0.4 of the rate; the scores
+// leave out two periods of the lowest at each end, at most a quarter of the record.
+CutoffSearch searchOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
+                      const Eigen::MatrixXd& xg, const Eigen::MatrixXd* v,
+                      const ZeroPhaseConfig& config) {
+  const double w_lo = std::max(1e-3, 1.0 / grid.m);
+  const double w_hi = std::max(w_lo, std::min(0.4, config.max_cutoff * grid.h));
+  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
+  CutoffSearch search{grid, t, x, xg, v, config.order, pad, w_lo, w_hi};
+  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
+                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
+  return search;
+}
+
+// Channels filtered alike (FilteredAlike) as the cutoff's search sees them: their grid,
+// where their own spectrum meets its noise floor (`top` [1/sample of their grid]: where
+// their content ends) and whether it found a floor.
+struct AlikeGroup {
+  std::string what;
+  Grid grid;
+  double top = 0.0;
+  bool found = false;
+  double topHz() const { return top / grid.h; }
+  // Whether their content reaches more than kCutoffDisagreement above f [Hz].
+  bool reachesAbove(double f) const { return found && topHz() > kCutoffDisagreement * f; }
+};
+
+AlikeGroup alikeGroup(const FilteredAlike& alike, const ZeroPhaseConfig& config) {
+  checkInput(alike.t, alike.x);
+  AlikeGroup g;
+  g.what = alike.what;
+  g.grid = gridOf(alike.t);
+  const Eigen::MatrixXd xg = g.grid.uniform ? alike.x : resample(g.grid, alike.t, alike.x);
+  g.top = spectrumCutoff(searchOf(g.grid, alike.t, alike.x, xg, nullptr, config), g.found);
+  return g;
+}
+
+// The positions' acceleration on the grid at cutoff w [1/sample].
+Eigen::MatrixXd gridAcceleration(const CutoffSearch& search, double w) {
+  Eigen::MatrixXd rate, accel;
+  differentiate(smoothPadded(search.xg, w, search.order, search.pad), search.pad, search.grid.h,
+                rate, accel);
+  return accel;
+}
+
+// The mean square, per channel, of the grid rows a 0.5 s or more from the ends (a tenth of
+// a shorter record: the project's convention for loads near a record's end).
+double scoredMeanSquare(const CutoffSearch& search, const Eigen::MatrixXd& a) {
+  const Eigen::Index n = a.rows();
+  const double h = search.grid.h;
+  const auto settle =
+      static_cast<Eigen::Index>(std::ceil(std::min(0.5, static_cast<double>(n) * h / 10.0) / h));
+  const Eigen::Index first = n > 2 * settle ? settle : 0, rows = n - 2 * first;
+  return a.middleRows(first, rows).squaredNorm() / static_cast<double>(rows * a.cols());
+}
+
+// The positions' own cutoff w_p [1/sample] raised for channels filtered alike whose own
+// spectrum meets its floor more than kCutoffDisagreement above it (a contact force's heel
+// strikes: content that w_p would smooth away from the loads): up to the highest such
+// group's top (at most w_hi), as long as the noise that the rise lets into the positions'
+// acceleration (its mean square change from w_p's: above w_p their spectrum is noise)
+// stays below kAlikeNoise times the acceleration's own mean square at w_p. At 1, the
+// acceleration keeps as much motion as noise: the balance that kSpectrum strikes per band
+// (motion's power equal to the noise's), struck over the whole acceleration. A scan at
+// ratio kAlikeStep, then bisection on log w between the last cutoff within and the first
+// beyond.
+constexpr double kAlikeNoise = 1.0;
+constexpr double kAlikeStep = 1.05;
+
+double alikeCutoff(const CutoffSearch& search, const std::vector<AlikeGroup>& groups, double w_p) {
+  const double h = search.grid.h;
+  double w_end = w_p;
+  for (const AlikeGroup& g : groups)
+    if (g.reachesAbove(w_p / h)) w_end = std::max(w_end, std::min(search.w_hi, g.topHz() * h));
+  if (!(w_end > kAlikeStep * w_p)) return w_p;
+  const Eigen::MatrixXd own = gridAcceleration(search, w_p);
+  const double bound = kAlikeNoise * scoredMeanSquare(search, own);
+  const auto within = [&](double w) {
+    return scoredMeanSquare(search, gridAcceleration(search, w) - own) <= bound;
+  };
+  double lo = w_p, hi = w_p;
+  while (hi < w_end && within(hi)) lo = hi, hi = std::min(w_end, kAlikeStep * hi);
+  if (within(hi)) return hi;  // w_end
+  for (int i = 0; i < 20; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (within(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+// A warning into choice where the group's own spectrum meets its noise floor more than
+// kCutoffDisagreement above the cutoff that filters it alike.
+void warnFilteredAlike(const AlikeGroup& g, const ZeroPhaseConfig& config, CutoffChoice& choice) {
+  if (!g.reachesAbove(choice.cutoff)) return;
+  const double f = g.topHz();
+  const bool bound = f >= 0.99 * std::min(config.max_cutoff, 0.4 / g.grid.h);
+  choice.warnings.push_back("zero-phase cutoff: " + g.what + ": its own spectrum meets its noise " +
+                            "floor at " + (bound ? "or above " : "") + hz(f) + ", " +
+                            std::to_string(static_cast<int>(f / choice.cutoff)) + "x the " +
+                            hz(choice.cutoff) + " that filters it alike: its fast " +
+                            "content (an impact, a heel strike) is smoothed away from the " +
+                            "loads; check them, or give --cutoff");
+}
+
+// The positions' own choice raised for the groups filtered alike (alikeCutoff), and what
+// a user must hear about them.
+void raiseForAlike(const CutoffSearch& search, const std::vector<AlikeGroup>& groups,
+                   CutoffChoice& choice) {
+  const double h = search.grid.h;
+  choice.positions_cutoff = choice.cutoff;
+  if (groups.empty()) return;
+  const double w_p = choice.cutoff * h, w = alikeCutoff(search, groups, w_p);
+  if (w > w_p) {
+    choice.cutoff = w / h;
+    std::string names;
+    for (const AlikeGroup& g : groups)
+      if (g.reachesAbove(choice.positions_cutoff)) names += (names.empty() ? "" : ", ") + g.what;
+    choice.warnings.push_back("zero-phase cutoff: " + hz(choice.cutoff) + ", raised from the " +
+                              hz(choice.positions_cutoff) + " of " + toString(choice.rule) +
+                              " for the content of " + names + " filtered alike: the " +
+                              "positions' rates carry more noise than at " +
+                              hz(choice.positions_cutoff));
+  }
+}
+
 // The automatic choice: the rule's cutoff, then the checks a user must hear about.
-CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& config) {
+CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& config,
+                             const std::vector<AlikeGroup>& groups) {
   CutoffChoice choice;
   const double h = search.grid.h;
   choice.lowest = search.w_lo / h;
@@ -670,6 +798,7 @@ CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& 
   if (!found)
     choice.warnings.push_back("zero-phase cutoff: the positions' spectrum falls steeply up to " +
                               hz(0.4 / h) + " (no noise floor found)");
+  raiseForAlike(search, groups, choice);
   if (choice.cutoff >= 0.99 * choice.highest || choice.cutoff <= 1.01 * choice.lowest)
     choice.warnings.push_back(std::string("zero-phase cutoff: ") + hz(choice.cutoff) + " (" +
                               toString(choice.rule) + ") is on the search's " +
@@ -680,35 +809,23 @@ CutoffChoice chooseAutomatic(const CutoffSearch& search, const ZeroPhaseConfig& 
   if (choice.rule == CutoffRule::kSpectrum) warnAbout(search, CutoffRule::kGcv, choice);
   if (follow && choice.rule != CutoffRule::kVelocity)
     warnAbout(search, CutoffRule::kVelocity, choice);
+  for (const AlikeGroup& g : groups) warnFilteredAlike(g, config, choice);
   return choice;
-}
-
-// The search over the channels x at the stamps t (xg on the grid; v the measured
-// velocities at t or null). The lowest cutoff searched is a thousandth of the rate or one
-// period over the record, the highest config.max_cutoff or 0.4 of the rate; the scores
-// leave out two periods of the lowest at each end, at most a quarter of the record.
-CutoffSearch searchOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
-                      const Eigen::MatrixXd& xg, const Eigen::MatrixXd* v,
-                      const ZeroPhaseConfig& config) {
-  const double w_lo = std::max(1e-3, 1.0 / grid.m);
-  const double w_hi = std::max(w_lo, std::min(0.4, config.max_cutoff * grid.h));
-  const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
-  CutoffSearch search{grid, t, x, xg, v, config.order, pad, w_lo, w_hi};
-  search.margin = grid.h * static_cast<double>(std::min<Eigen::Index>(
-                               static_cast<Eigen::Index>(std::ceil(2.0 / w_lo)), xg.rows() / 4));
-  return search;
 }
 
 // The cutoff of config.rule for the channels x at the stamps t (searchOf's arguments).
 CutoffChoice cutoffOf(const Grid& grid, const std::vector<double>& t, const Eigen::MatrixXd& x,
                       const Eigen::MatrixXd& xg, const Eigen::MatrixXd* v,
-                      const ZeroPhaseConfig& config) {
+                      const ZeroPhaseConfig& config, const std::vector<FilteredAlike>& alike) {
   if (config.rule == CutoffRule::kFixed) {
     CutoffChoice choice;
-    choice.cutoff = choice.lowest = choice.highest = config.cutoff;
+    choice.cutoff = choice.lowest = choice.highest = choice.positions_cutoff = config.cutoff;
     return choice;
   }
-  return chooseAutomatic(searchOf(grid, t, x, xg, v, config), config);
+  std::vector<AlikeGroup> groups;
+  for (const FilteredAlike& a : alike)
+    if (a.x.cols() > 0) groups.push_back(alikeGroup(a, config));
+  return chooseAutomatic(searchOf(grid, t, x, xg, v, config), config, groups);
 }
 
 // The measured velocities if they are usable evidence (the shape of x, at least half of
@@ -791,12 +908,13 @@ void validate(const ZeroPhaseConfig& config) {
 }
 
 CutoffChoice selectCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
-                          const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities) {
+                          const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities,
+                          const std::vector<FilteredAlike>& alike) {
   validate(config);
   checkInput(t, x);
   const Grid grid = gridOf(t);
   return cutoffOf(grid, t, x, grid.uniform ? x : resample(grid, t, x), evidenceOf(x, velocities),
-                  config);
+                  config, alike);
 }
 
 double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
@@ -805,13 +923,14 @@ double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
 }
 
 ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
-                                const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities) {
+                                const ZeroPhaseConfig& config, const Eigen::MatrixXd& velocities,
+                                const std::vector<FilteredAlike>& alike) {
   validate(config);
   checkInput(t, x);
   const Grid grid = gridOf(t);
   const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
   ZeroPhaseResult r;
-  r.choice = cutoffOf(grid, t, x, xg, evidenceOf(x, velocities), config);
+  r.choice = cutoffOf(grid, t, x, xg, evidenceOf(x, velocities), config, alike);
   r.cutoff = r.choice.cutoff;
   const int pad = paddingOf(config.padding, config.order, static_cast<int>(xg.rows()));
   const Eigen::MatrixXd padded =
@@ -827,21 +946,9 @@ double checkFilteredAlike(const std::vector<double>& t, const Eigen::MatrixXd& x
                           CutoffChoice& choice) {
   if (choice.rule == CutoffRule::kFixed || x.cols() == 0 || t.size() < 3) return 0.0;
   validate(config);
-  checkInput(t, x);
-  const Grid grid = gridOf(t);
-  const Eigen::MatrixXd xg = grid.uniform ? x : resample(grid, t, x);
-  bool found = false;
-  const double f = spectrumCutoff(searchOf(grid, t, x, xg, nullptr, config), found) / grid.h;
-  if (!found) return 0.0;
-  const bool bound = f >= 0.99 * std::min(config.max_cutoff, 0.4 / grid.h);
-  if (f > kCutoffDisagreement * choice.cutoff)
-    choice.warnings.push_back("zero-phase cutoff: " + what + ": its own spectrum meets its noise " +
-                              "floor at " + (bound ? "or above " : "") + hz(f) + ", " +
-                              std::to_string(static_cast<int>(f / choice.cutoff)) + "x the " +
-                              hz(choice.cutoff) + " that filters it alike: its fast " +
-                              "content (an impact, a heel strike) is smoothed away from the " +
-                              "loads; check them, or give --cutoff");
-  return f;
+  const AlikeGroup g = alikeGroup(FilteredAlike{t, x, what}, config);
+  warnFilteredAlike(g, config, choice);
+  return g.found ? g.topHz() : 0.0;
 }
 
 Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,

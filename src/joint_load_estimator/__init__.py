@@ -107,16 +107,20 @@ def inverse_dynamics(model, q, qd, qdd, wrenches=None, frame="child", gravity=No
     return Loads(_core._inverse_dynamics(model, q, qd, qdd, wrenches, frame, gravity, base))
 
 
-def smooth_zero_phase(t, x, cutoff=None, rule="auto", order=4, padding=0):
+def smooth_zero_phase(t, x, cutoff=None, rule="auto", order=4, padding=0, forces=None):
     """Zero-phase Butterworth smoothing and differentiation of a whole record
     (docs/studies/zero_phase.md; joint_loads' positions-only path).
 
     t: N stamps [s], increasing; x: N x channels. cutoff [Hz], or None to choose it by
     ``rule`` ('auto': the noise spectrum of the positions, 'spectrum', 'gcv' or
-    'residual'); order of each pass; padding (0: 3 (order + 1)).
+    'residual'); order of each pass; padding (0: 3 (order + 1)). forces: None, or
+    {name: (t, x)} of the force, wrench and plate channels to be filtered alike
+    (low_pass_zero_phase with the returned cutoff), each at its own stamps: a chosen
+    cutoff rises where their own spectrum shows content far above it (jle::FilteredAlike),
+    as joint_loads' does for its wrench and plate columns.
     Returns (value, rate, accel, cutoff): N x channels arrays and the cutoff used [Hz].
     """
-    r = _core._smooth_zero_phase(t, x, cutoff, rule, order, padding)
+    r = _core._smooth_zero_phase(t, x, cutoff, rule, order, padding, forces or {})
     return r["value"], r["rate"], r["accel"], r["cutoff"]
 
 

@@ -124,7 +124,8 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
       plates_(settings_.estimator.plates.size()) {
   const Model<double>& m = estimator_.model();
   coordinate_segment_ = coordinateSegments(m);
-  for (int i = 0; i < m.nq; ++i) any_needed_ = any_needed_ || estimator_.coordinateNeeded(i);
+  for (int i = 0; i < m.nq; ++i)
+    any_needed_ = any_needed_ || estimator_.layout().coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
     smoothed_ = std::make_unique<Stream>(model, smoothedEstimatorConfig(settings_));
     smoothed_->record = record_;  // sized; no external outputs
@@ -150,12 +151,13 @@ void Pipeline::fillExternal() {
   if (uncertainty)
     for (std::size_t i = 0; i < external_variance_.size(); ++i)
       external_variance_[i] = record_.effort_stddev[i] * record_.effort_stddev[i];
+  const Estimator::LastSample last = estimator_.last();
   BaseState<double> base;
   if (model().floating_base) {
-    base.R_world_base = estimator_.data().R_world[0];
-    base.p_world_base = estimator_.data().p_world[0];
+    base.R_world_base = last.data().R_world[0];
+    base.p_world_base = last.data().p_world[0];
   }
-  external_->update(estimator_.stamp(), estimator_.q(), estimator_.qd(), base, record_.effort,
+  external_->update(last.stamp(), last.q(), last.qd(), base, record_.effort,
                     record_.measured_effort, uncertainty ? &external_variance_ : nullptr);
   record_.external_effort = external_->external();
   if (uncertainty) record_.external_effort_stddev = external_->stddev();
@@ -171,10 +173,10 @@ void Pipeline::fillExternal() {
 std::string Pipeline::smoothedBandwidthBound() const {
   if (!smoothed_) return "";
   const Estimator& e = smoothed_->estimator;
-  const double chosen = e.spectralCutoff(), used = e.bandwidth();
+  const double chosen = e.filters().spectralCutoff(), used = e.filters().bandwidth();
   if (!(chosen > 0.0)) return "";
   char text[200];
-  if (!(e.noiseFloor() > 0.0)) {
+  if (!(e.filters().noiseFloor() > 0.0)) {
     std::snprintf(text, sizeof text,
                   "the positions' spectrum shows no noise floor: the highest bandwidth, %.3g Hz",
                   used);
@@ -269,7 +271,7 @@ bool Pipeline::checkJointState(const std::vector<std::string>& names,
 bool Pipeline::movesNeeded() const {
   if (!any_needed_) return true;  // a floating base alone: every message is a sample
   for (int k : joints_.coordinates())
-    if (k >= 0 && estimator_.coordinateNeeded(k)) return true;
+    if (k >= 0 && estimator_.layout().coordinateNeeded(k)) return true;
   return false;
 }
 
@@ -373,13 +375,13 @@ bool Pipeline::joinsGroup(Stamp stamp) const {
       1e-9 * static_cast<double>(std::max(group_.newest, stamp) - std::min(group_.oldest, stamp));
   if (span > settings_.stamps.merge_window) return false;
   for (int k : joints_.coordinates())
-    if (k >= 0 && estimator_.coordinateNeeded(k) && joints_.fresh(k)) return false;
+    if (k >= 0 && estimator_.layout().coordinateNeeded(k) && joints_.fresh(k)) return false;
   return true;
 }
 
 bool Pipeline::groupComplete() const {
   for (int k = 0; k < model().nq; ++k)
-    if (estimator_.coordinateNeeded(k) && !joints_.fresh(k)) return false;
+    if (estimator_.layout().coordinateNeeded(k) && !joints_.fresh(k)) return false;
   return true;
 }
 
@@ -481,7 +483,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   if (smoothed_) sampleSmoothed(t, base);
   if (status == SampleStatus::kStale) return staleProblem();
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
-  if (estimator_.lastWasReused() && !settings_.estimator.savings.republish_unchanged)
+  if (estimator_.last().reused() && !settings_.estimator.savings.republish_unchanged)
     return count(kind, Outcome::kUnchanged);
   fillRecord(estimator_, record_);
   if (!RecordBuilder::finiteLoads(record_)) {
@@ -501,7 +503,7 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
   const SampleStatus status = e.addJointSample(t, joints_.q().data(), base, joints_.qd().data());
   noteStart(stream.settle, status, t);
   smoothed_published_ = status == SampleStatus::kPublished &&
-                        !(e.lastWasReused() && !settings_.estimator.savings.republish_unchanged);
+                        !(e.last().reused() && !settings_.estimator.savings.republish_unchanged);
   if (smoothed_published_) fillRecord(e, stream.record);
   if (smoothed_published_ &&
       !RecordBuilder::finiteLoads(stream.record)) {  // counted by the immediate stream
@@ -513,9 +515,9 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
 
 void Pipeline::drainSmoother() {
   // Rare (a reset with a smoother): copies of the record are fine here.
-  if (estimator_.pendingSamples() > 0)
+  if (estimator_.filters().pendingSamples() > 0)
     while (nextRecord(estimator_, record_, true)) drained_.push_back(record_);
-  if (smoothed_ && smoothed_->estimator.pendingSamples() > 0)
+  if (smoothed_ && smoothed_->estimator.filters().pendingSamples() > 0)
     while (nextRecord(smoothed_->estimator, smoothed_->record, true))
       smoothed_->drained.push_back(smoothed_->record);
 }
@@ -564,7 +566,7 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
   SampleStatus status = SampleStatus::kPublished;
   while (end ? estimator.flush(status) : estimator.takeDue(status)) {
     if (status != SampleStatus::kPublished) continue;
-    if (estimator.lastWasReused() && !settings_.estimator.savings.republish_unchanged) continue;
+    if (estimator.last().reused() && !settings_.estimator.savings.republish_unchanged) continue;
     fillRecord(estimator, record);
     if (!RecordBuilder::finiteLoads(record)) continue;  // never published
     return true;
@@ -575,10 +577,10 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
 std::string Pipeline::staleInputs() const {
   std::string stale;
   for (std::size_t k = 0; k < wrenches_.size(); ++k)
-    if (estimator_.stale(static_cast<int>(k)))
+    if (estimator_.last().stale(static_cast<int>(k)))
       stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
   for (std::size_t k = 0; k < plates_.size(); ++k)
-    if (estimator_.plateStale(static_cast<int>(k)))
+    if (estimator_.last().plateStale(static_cast<int>(k)))
       stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
   return stale;
 }
@@ -589,10 +591,11 @@ std::string Pipeline::stoppingInputs() const {
   std::string stale;
   const EstimatorConfig& c = settings_.estimator;
   for (std::size_t k = 0; k < wrenches_.size(); ++k)
-    if (estimator_.stale(static_cast<int>(k)) && c.wrenches[k].stale_policy == StalePolicy::kStop)
+    if (estimator_.last().stale(static_cast<int>(k)) &&
+        c.wrenches[k].stale_policy == StalePolicy::kStop)
       stale += (stale.empty() ? "" : ", ") + settings_.wrenches[k].topic;
   for (std::size_t k = 0; k < plates_.size(); ++k)
-    if (estimator_.plateStale(static_cast<int>(k)) &&
+    if (estimator_.last().plateStale(static_cast<int>(k)) &&
         c.plates[k].stale_policy == StalePolicy::kStop)
       stale += (stale.empty() ? "" : ", ") + settings_.force_plates[k].topic;
   return stale;
@@ -601,7 +604,7 @@ std::string Pipeline::stoppingInputs() const {
 const std::string& Pipeline::missingJoint() const {
   static const std::string kNoJointMissing;
   for (int i = 0; i < model().nq; ++i)
-    if (!joints_.received(i) && estimator_.coordinateNeeded(i))
+    if (!joints_.received(i) && estimator_.layout().coordinateNeeded(i))
       return model().coordinate_names[static_cast<std::size_t>(i)];
   return kNoJointMissing;
 }
@@ -614,8 +617,8 @@ Outcome Pipeline::staleProblem() {
 void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
   // The estimates still to come are of the newest sample and the delaySamples() before
   // it (a smoother's pending samples, its carry over a gap included), in either stream.
-  const int delay =
-      std::max(estimator_.delaySamples(), smoothed_ ? smoothed_->estimator.delaySamples() : 0);
+  const int delay = std::max(estimator_.filters().delaySamples(),
+                             smoothed_ ? smoothed_->estimator.filters().delaySamples() : 0);
   builder_.remember(t, stamp, has_effort ? &joints_.effort() : nullptr, delay);
 }
 
@@ -629,7 +632,7 @@ void Pipeline::countHeld(double t) {
   // A needed coordinate no message since the last sample set: this sample holds it.
   bool held = false;
   for (int k = 0; k < model().nq && !held; ++k)
-    held = estimator_.coordinateNeeded(k) && !joints_.fresh(k);
+    held = estimator_.layout().coordinateNeeded(k) && !joints_.fresh(k);
   if (held) {
     ++counters_.held_samples;
     builder_.heldAt(t);

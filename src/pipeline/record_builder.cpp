@@ -138,9 +138,10 @@ Stamp RecordBuilder::stampAt(double t) const {
 }
 
 void RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRecord& rec) const {
-  const Data<double>& data = estimator.data();
-  const Sample* s = sampleAt(estimator.stamp());
-  rec.stamp = s ? s->stamp : timeline_.absolute(estimator.stamp());
+  const Estimator::LastSample last = estimator.last();
+  const Data<double>& data = last.data();
+  const Sample* s = sampleAt(last.stamp());
+  rec.stamp = s ? s->stamp : timeline_.absolute(last.stamp());
   const bool measured = s && s->has_effort;
   const UncertaintyConfig& u = settings_.estimator.uncertainty;
   const std::size_t per_joint = u.diagonal_only ? 6 : 36;
@@ -154,7 +155,7 @@ void RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRe
     if (!rec.effort_per_kg.empty()) rec.effort_per_kg[i] = data.effort[j] / body_mass_;
     fillCoordinates(estimator, rec, i, j);
     if (!u.enabled) continue;
-    const Eigen::Matrix<double, 6, 6>& C = estimator.covariance(segment);
+    const Eigen::Matrix<double, 6, 6>& C = last.covariance(segment);
     double* cov = &rec.covariance[per_joint * i];
     for (int r = 0; r < 6; ++r)
       for (int c = 0; c < 6; ++c)
@@ -162,7 +163,7 @@ void RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRe
           cov[6 * r + c] = C(r, c);
         else if (r == c)
           cov[r] = C(r, r);
-    rec.effort_stddev[i] = std::sqrt(estimator.effortVariance(segment));
+    rec.effort_stddev[i] = std::sqrt(last.effortVariance(segment));
   }
   fillSideOutputs(estimator, rec);
   rec.status = status(estimator, settle_from, rec);
@@ -170,13 +171,15 @@ void RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRe
 
 std::uint8_t RecordBuilder::status(const Estimator& estimator, double settle_from,
                                    const LoadsRecord& rec) const {
+  const Estimator::LastSample last = estimator.last();
   const PlausibilityConfig& p = settings_.plausibility;
   std::uint8_t status = kTrusted;
-  if (estimator.stamp() < settle_from + p.settle_time) status |= kSettling;
-  if (std::abs(estimator.stamp() - held_t_) <= p.settle_time) status |= kHeldJoint;
+  if (last.stamp() < settle_from + p.settle_time) status |= kSettling;
+  if (std::abs(last.stamp() - held_t_) <= p.settle_time) status |= kHeldJoint;
   for (const InputRecord& in : rec.inputs) status |= in.stale ? kStaleInput : 0;
   for (std::size_t k = 0; k < rec.plates.size(); ++k)
-    if (rec.plates[k].stale && estimator.plateNeeded(static_cast<int>(k))) status |= kStaleInput;
+    if (rec.plates[k].stale && estimator.layout().plateNeeded(static_cast<int>(k)))
+      status |= kStaleInput;
   for (std::size_t i = 0; i < rec.segment.size(); ++i)
     if (implausibleEffort(model_, p, static_cast<std::size_t>(rec.segment[i]), rec.effort[i]))
       status |= kImplausibleLoad;
@@ -191,48 +194,50 @@ bool RecordBuilder::finiteLoads(const LoadsRecord& rec) {
 }
 
 void RecordBuilder::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) const {
-  rec.q = estimator.q();  // same sizes: no allocation
-  rec.qd = estimator.qd();
-  rec.qdd = estimator.qdd();
-  rec.planar = estimator.lastWasPlanar();
+  const Estimator::LastSample last = estimator.last();
+  rec.q = last.q();  // same sizes: no allocation
+  rec.qd = last.qd();
+  rec.qdd = last.qdd();
+  rec.planar = last.planar();
   for (std::size_t k = 0; k < rec.inputs.size(); ++k) {
     const int input = static_cast<int>(k);
     InputRecord& in = rec.inputs[k];
-    in.stale = estimator.stale(input);
-    in.used = estimator.sensorSegment(input) >= 0 && estimator.sensorUsed(input);
+    in.stale = last.stale(input);
+    in.used = estimator.layout().sensorSegment(input) >= 0 && last.sensorUsed(input);
     const std::string& frame = frames_.wrenchFrame(input);
     if (!frame.empty() && in.frame != frame) in.frame = frame;  // rare: a new frame
     const Eigen::Isometry3d& X = frames_.wrenchPose(input);
-    in.residual =
-        in.used ? residualInReading(estimator.sensorResidual(input), X.linear(), X.translation())
-                : Wrench<double>();
-    in.predicted =
-        in.used ? residualInReading(estimator.predictedWrench(input), X.linear(), X.translation())
-                : Wrench<double>();
+    in.residual = in.used
+                      ? residualInReading(last.sensorResidual(input), X.linear(), X.translation())
+                      : Wrench<double>();
+    in.predicted = in.used
+                       ? residualInReading(last.predictedWrench(input), X.linear(), X.translation())
+                       : Wrench<double>();
   }
   for (std::size_t k = 0; k < rec.plates.size(); ++k) {
     PlateRecord& p = rec.plates[k];
-    p.stale = estimator.plateStale(static_cast<int>(k));
-    p.reading = estimator.plateReading(static_cast<int>(k));
+    p.stale = last.plateStale(static_cast<int>(k));
+    p.reading = last.plateReading(static_cast<int>(k));
     const std::string& frame = frames_.plateFrame(static_cast<int>(k));
     if (p.frame != frame) p.frame = frame;  // rare: a new frame
   }
   if (model_.floating_base) {
-    rec.base_force = estimator.data().force[0];
-    rec.base_moment = estimator.data().moment[0];
+    rec.base_force = last.data().force[0];
+    rec.base_moment = last.data().moment[0];
   }
 }
 
 void RecordBuilder::fillCoordinates(const Estimator& estimator, LoadsRecord& rec, std::size_t i,
                                     std::size_t segment) const {
+  const Estimator::LastSample last = estimator.last();
   const Model<double>& m = model_;
   const int c = m.coordinate[segment];
   if (c < 0) return;  // a fixed joint kept as a segment: 0 from the constructor
   // As forwardKinematics maps them (a mimic joint follows its leader).
   const double k = m.multiplier[segment];
-  rec.position[i] = k * estimator.q()[c] + m.offset[segment];
-  rec.velocity[i] = k * estimator.qd()[c];
-  rec.acceleration[i] = k * estimator.qdd()[c];
+  rec.position[i] = k * last.q()[c] + m.offset[segment];
+  rec.velocity[i] = k * last.qd()[c];
+  rec.acceleration[i] = k * last.qdd()[c];
   if (!rec.motor_effort.empty())
     rec.motor_effort[i] =
         rec.effort[i] + frictionEffort(m.damping[segment], m.friction[segment], rec.velocity[i],

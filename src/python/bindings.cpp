@@ -565,14 +565,20 @@ Array arrayOf(const Eigen::MatrixXd& m) {
 }
 
 py::dict smoothZeroPhase(const Array& t_in, const Array& x_in, const py::object& cutoff,
-                         const std::string& rule, int order, int padding) {
+                         const std::string& rule, int order, int padding, const py::dict& forces) {
   const std::vector<double> t = timesOf(t_in);
   const Eigen::MatrixXd x = matrixOf(x_in, t.size());
   const jle::ZeroPhaseConfig z = zeroPhaseConfig(cutoff, rule, order, padding);
+  std::vector<jle::FilteredAlike> alike;
+  for (const auto& [name, pair] : forces) {
+    const auto [tf, xf] = pair.cast<std::pair<Array, Array>>();
+    alike.push_back({timesOf(tf), Eigen::MatrixXd(), py::str(name)});
+    alike.back().x = matrixOf(xf, alike.back().t.size());
+  }
   jle::ZeroPhaseResult r;
   {
     py::gil_scoped_release release;
-    r = jle::smoothZeroPhase(t, x, z);
+    r = jle::smoothZeroPhase(t, x, z, Eigen::MatrixXd(), alike);
   }
   py::dict out;
   out["value"] = arrayOf(r.value);
@@ -762,7 +768,7 @@ PYBIND11_MODULE(_core, m) {
         py::arg("qdd"), py::arg("wrenches"), py::arg("frame"), py::arg("gravity"), py::arg("base"));
   defineEstimator(m);
   m.def("_smooth_zero_phase", &smoothZeroPhase, py::arg("t"), py::arg("x"), py::arg("cutoff"),
-        py::arg("rule"), py::arg("order"), py::arg("padding"));
+        py::arg("rule"), py::arg("order"), py::arg("padding"), py::arg("forces"));
   m.def("_low_pass_zero_phase", &lowPassZeroPhase, py::arg("t"), py::arg("x"), py::arg("cutoff"),
         py::arg("order"), py::arg("padding"));
   m.attr("default_gravity") = std::vector<double>{jle::EstimatorConfig().gravity_world[0],

@@ -91,9 +91,11 @@ class SmoothedBag {
   std::vector<double> times(const std::vector<jle::Stamp>& stamps, const std::string& topic) const;
   Eigen::MatrixXd positions() const;
   Eigen::MatrixXd velocities() const;
-  // The topic's wrenches filtered with choice's cutoff (and checked: checkFilteredAlike).
+  // The topic's wrenches, samples x (force, torque), at their times.
+  jle::FilteredAlike wrenches(const std::string& topic, const Series& s) const;
+  // The topic's wrenches filtered with `cutoff` [Hz].
   void filterForces(const std::string& topic, Series& s, const jle::ZeroPhaseConfig& config,
-                    jle::CutoffChoice& choice);
+                    double cutoff);
 
   std::string joint_topic_;
   std::vector<sensor_msgs::JointState> joints_;
@@ -153,16 +155,20 @@ Eigen::MatrixXd SmoothedBag::positions() const {
   return q;
 }
 
-void SmoothedBag::filterForces(const std::string& topic, Series& s,
-                               const jle::ZeroPhaseConfig& config, jle::CutoffChoice& choice) {
-  if (s.messages.size() < 3) return;  // too few to filter: the message path counts them
-  Eigen::MatrixXd f(s.messages.size(), 6);
+jle::FilteredAlike SmoothedBag::wrenches(const std::string& topic, const Series& s) const {
+  jle::FilteredAlike f{times(s.stamps, topic), Eigen::MatrixXd(s.messages.size(), 6), topic};
   for (std::size_t i = 0; i < s.messages.size(); ++i) {
     const geometry_msgs::Wrench& w = s.messages[i].wrench;
-    f.row(i) << w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z;
+    f.x.row(i) << w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z;
   }
-  jle::checkFilteredAlike(times(s.stamps, topic), f, config, topic, choice);
-  f = jle::lowPassZeroPhase(times(s.stamps, topic), f, choice.cutoff, config.order);
+  return f;
+}
+
+void SmoothedBag::filterForces(const std::string& topic, Series& s,
+                               const jle::ZeroPhaseConfig& config, double cutoff) {
+  if (s.messages.size() < 3) return;  // too few to filter: the message path counts them
+  const jle::FilteredAlike raw = wrenches(topic, s);
+  const Eigen::MatrixXd f = jle::lowPassZeroPhase(raw.t, raw.x, cutoff, config.order);
   for (std::size_t i = 0; i < s.messages.size(); ++i) {
     geometry_msgs::Wrench& w = s.messages[i].wrench;
     w.force.x = f(i, 0), w.force.y = f(i, 1), w.force.z = f(i, 2);
@@ -186,8 +192,11 @@ jle::CutoffChoice SmoothedBag::smooth(const jle::ZeroPhaseConfig& config) {
   const Eigen::MatrixXd q = positions();
   jle::ZeroPhaseResult r;
   try {
-    r = jle::smoothZeroPhase(times(joint_stamps_, joint_topic_), q, config, velocities());
-    for (auto& [topic, series] : forces_) filterForces(topic, series, config, r.choice);
+    std::vector<jle::FilteredAlike> alike;
+    for (const auto& [topic, series] : forces_)
+      if (series.messages.size() >= 3) alike.push_back(wrenches(topic, series));
+    r = jle::smoothZeroPhase(times(joint_stamps_, joint_topic_), q, config, velocities(), alike);
+    for (auto& [topic, series] : forces_) filterForces(topic, series, config, r.cutoff);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("--zero-phase: ") + e.what());
   }

@@ -875,16 +875,20 @@ void smoothBase(const Options& options, jle::StateColumns& columns, Record& r, d
 }
 
 // q and the forces smoothed alike (the JOINT.qd columns, if any, as the cutoff rule's
-// evidence), q's rate and acceleration appended to every row and `columns` pointed at
-// them. Returns how the cutoff was chosen.
+// evidence; the force columns as channels filtered alike, which may raise it), q's rate
+// and acceleration appended to every row and `columns` pointed at them. Returns how the
+// cutoff was chosen.
 jle::CutoffChoice smoothPositions(const Options& options, jle::StateColumns& columns, Record& r) {
   const jle::ZeroPhaseConfig& z = options.smoothing;
   const std::size_t width = r.cells.front().size(), nq = columns.q.size();
   const bool measured =
       std::all_of(columns.qd.begin(), columns.qd.end(), [](int c) { return c >= 0; });
   try {
+    const std::vector<int> forces = forceColumns(columns);
+    std::vector<jle::FilteredAlike> alike;
+    if (!forces.empty()) alike.push_back({r.t, gather(r, forces), "the wrench and plate columns"});
     const jle::ZeroPhaseResult k = jle::smoothZeroPhase(
-        r.t, gather(r, columns.q), z, measured ? gather(r, columns.qd) : Eigen::MatrixXd());
+        r.t, gather(r, columns.q), z, measured ? gather(r, columns.qd) : Eigen::MatrixXd(), alike);
     for (std::size_t j = 0; j < nq; ++j) {
       columns.qd[j] = static_cast<int>(width + j);
       columns.qdd[j] = static_cast<int>(width + nq + j);
@@ -893,15 +897,10 @@ jle::CutoffChoice smoothPositions(const Options& options, jle::StateColumns& col
     scatter(k.value, columns.q, r);
     scatter(k.rate, columns.qd, r);
     scatter(k.accel, columns.qdd, r);
-    jle::CutoffChoice choice = k.choice;
-    const std::vector<int> forces = forceColumns(columns);
-    if (!forces.empty()) {
-      const Eigen::MatrixXd raw = gather(r, forces);
-      jle::checkFilteredAlike(r.t, raw, z, "the wrench and plate columns", choice);
-      scatter(jle::lowPassZeroPhase(r.t, raw, k.cutoff, z.order, z.padding), forces, r);
-    }
+    if (!forces.empty())
+      scatter(jle::lowPassZeroPhase(r.t, alike.front().x, k.cutoff, z.order, z.padding), forces, r);
     if (columns.base_pose[0] >= 0) smoothBase(options, columns, r, k.cutoff);
-    return choice;
+    return k.choice;
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(options.input + ": smoothing the positions (--cutoff): " + e.what());
   }

@@ -1,4 +1,4 @@
-// The covariance of the published joint wrenches (Estimator::covariance) against Monte
+// The covariance of the published joint wrenches (Estimator::LastSample::covariance) against Monte
 // Carlo: 10 000 noisy replays of one trajectory through the real Estimator, whose
 // empirical covariance the propagated one must match; and the filters' noise gains
 // against their closed forms.
@@ -209,15 +209,16 @@ void runMonteCarlo(const Scene& scene, int replays) {
     jle::Estimator estimator(model, c);
     replay(estimator, nullptr, [&](int n) {
       for (std::size_t j = 0; j < np; ++j) {
-        propagated[n][j] = estimator.covariance(published[j]);
-        effort_variance[n][j] = estimator.effortVariance(published[j]);
-        clean[n][j] << estimator.data().force[published[j]], estimator.data().moment[published[j]];
+        propagated[n][j] = estimator.last().covariance(published[j]);
+        effort_variance[n][j] = estimator.last().effortVariance(published[j]);
+        clean[n][j] << estimator.last().data().force[published[j]],
+            estimator.last().data().moment[published[j]];
       }
     });
     c.uncertainty.linearize_state = false;
     jle::Estimator cheap(model, c);
     replay(cheap, nullptr, [&](int n) {
-      for (std::size_t j = 0; j < np; ++j) qdd_only[n][j] = cheap.covariance(published[j]);
+      for (std::size_t j = 0; j < np; ++j) qdd_only[n][j] = cheap.last().covariance(published[j]);
     });
   }
 
@@ -233,14 +234,14 @@ void runMonteCarlo(const Scene& scene, int replays) {
       for (std::size_t j = 0; j < np; ++j) {
         const int s = published[j];
         Vector6 d;
-        d << estimator.data().force[s], estimator.data().moment[s];
+        d << estimator.last().data().force[s], estimator.last().data().moment[s];
         d -= clean[n][j];
         sum[n][j] += d;
         sum2[n][j].noalias() += d * d.transpose();
         const double e =
-            estimator.data().effort[s] - (model.joint_type[s] == jle::JointType::kRevolute
-                                              ? model.axis[s].dot(clean[n][j].tail<3>())
-                                              : model.axis[s].dot(clean[n][j].head<3>()));
+            estimator.last().data().effort[s] - (model.joint_type[s] == jle::JointType::kRevolute
+                                                     ? model.axis[s].dot(clean[n][j].tail<3>())
+                                                     : model.axis[s].dot(clean[n][j].head<3>()));
         effort_sum2[n][j] += e * e;
       }
     });
@@ -392,7 +393,7 @@ void expectMatchesReference(const ReferenceScene& scene, bool linearize_state) {
     bank.update(t, &x);
   }
   const Eigen::Matrix3d Sigma = 1e-6 * bank.noiseGain();
-  const jle::Wrench<double> applied = estimator.appliedWrench(0);
+  const jle::Wrench<double> applied = estimator.last().appliedWrench(0);
   const int frame = model.frameIndex(scene.wrench_link);
   jle::Data<double> data(model);
   auto loads = [&](const Eigen::VectorXd& q_, const Eigen::VectorXd& qd_,
@@ -404,7 +405,8 @@ void expectMatchesReference(const ReferenceScene& scene, bool linearize_state) {
     y.resize(static_cast<std::size_t>(model.nsegments()));
     for (int i = 0; i < model.nsegments(); ++i) y[i] << data.force[i], data.moment[i];
   };
-  const Eigen::VectorXd q0 = estimator.q(), qd0 = estimator.qd(), qdd0 = estimator.qdd();
+  const Eigen::VectorXd q0 = estimator.last().q(), qd0 = estimator.last().qd(),
+                        qdd0 = estimator.last().qdd();
   const int n = model.nsegments();
   std::vector<Matrix6> reference(static_cast<std::size_t>(n), Matrix6::Zero());
   std::vector<Vector6> y0, yp, ym;
@@ -445,7 +447,7 @@ void expectMatchesReference(const ReferenceScene& scene, bool linearize_state) {
   const double tolerance = linearize_state ? 1e-8 : 1e-12;
   double worst = 0.0;
   for (int i : model.moving_segments) {
-    const Matrix6& P = estimator.covariance(i);
+    const Matrix6& P = estimator.last().covariance(i);
     const Matrix6& R = reference[i];
     for (int a = 0; a < 6; ++a)
       for (int b = 0; b < 6; ++b) {
@@ -620,7 +622,7 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
     config.uncertainty.diagonal_only = c == 2;
     sparse.emplace_back(model, config);
   }
-  const std::vector<int>& segments = every.dynamicsSegments();
+  const std::vector<int>& segments = every.layout().dynamicsSegments();
   std::vector<std::vector<Matrix6>> cov;  // per published sample, per computed segment
   published.clear();
   var.clear();
@@ -635,12 +637,12 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
     const jle::SampleStatus s = every.addJointSample(t, q.data());
     for (jle::Estimator& d : sparse) ASSERT_EQ(d.addJointSample(t, q.data()), s);
     if (s != jle::SampleStatus::kPublished) continue;
-    published.push_back(every.stamp());
+    published.push_back(every.last().stamp());
     std::vector<Matrix6> row;
-    for (int i : segments) row.push_back(every.covariance(i));
+    for (int i : segments) row.push_back(every.last().covariance(i));
     cov.push_back(row);
     std::vector<double> v;
-    for (int i : model.moving_segments) v.push_back(every.effortVariance(i));
+    for (int i : model.moving_segments) v.push_back(every.last().effortVariance(i));
     var.push_back(v);
     const std::size_t b = cov.size() - 1;
     for (std::size_t c = 0; c < 3; ++c) {
@@ -655,7 +657,7 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
         w = extrapolationWeights(2, tn, published[b]);
       }
       for (std::size_t m = 0; m < segments.size(); ++m) {
-        const Matrix6& P = d.covariance(segments[m]);
+        const Matrix6& P = d.last().covariance(segments[m]);
         if (computed && c < 2) {  // the same code on the same inputs
           EXPECT_EQ(P, cov[b][m]) << urdf << " sample " << b;
           continue;
@@ -690,7 +692,7 @@ void checkPeriod(const std::string& urdf, Stamps kind, std::vector<double>& publ
       for (std::size_t i = 0; i < names.size() && !computed; ++i) {
         const double v_e =
             std::max(0.0, w[0] * var[n[0]][i] + w[1] * var[n[1]][i] + w[2] * var[n[2]][i]);
-        EXPECT_NEAR(d.effortVariance(model.moving_segments[i]), v_e,
+        EXPECT_NEAR(d.last().effortVariance(model.moving_segments[i]), v_e,
                     1e-12 * (std::abs(w[0] * var[n[0]][i]) + std::abs(w[1] * var[n[1]][i]) +
                              std::abs(w[2] * var[n[2]][i])) +
                         1e-300)
@@ -817,7 +819,7 @@ TEST(CovarianceMonteCarlo, InertialParametersTalos) {
     estimator_diagonal.addJointSample(t, q.data());
   }
 
-  const jle::Wrench<double> applied = estimator.appliedWrench(0);
+  const jle::Wrench<double> applied = estimator.last().appliedWrench(0);
   const int frame = model.frameIndex("left_sole_link");
   const std::vector<int>& published = model.moving_segments;
   const std::size_t np = published.size();
@@ -833,15 +835,16 @@ TEST(CovarianceMonteCarlo, InertialParametersTalos) {
       for (int a = 0; a < 3; ++a) perturbed.com[i][a] = model.com[i][a] + 0.01 * random.gaussian();
       perturbed.inertia_com[i] = model.inertia_com[i] * (1.0 + 0.2 * random.gaussian());
     }
-    jle::forwardKinematics(perturbed, data, estimator.q(), estimator.qd(), estimator.qdd(),
-                           Eigen::Vector3d(0.0, 0.0, -9.80665));
+    jle::forwardKinematics(perturbed, data, estimator.last().q(), estimator.last().qd(),
+                           estimator.last().qdd(), Eigen::Vector3d(0.0, 0.0, -9.80665));
     jle::addExternalWrench(perturbed, data, frame, applied.force, applied.moment,
                            jle::WrenchFrame::kLocal);
     jle::inverseDynamics(perturbed, data);
     for (std::size_t j = 0; j < np; ++j) {
       const int s = published[j];
       Vector6 d;
-      d << data.force[s] - estimator.data().force[s], data.moment[s] - estimator.data().moment[s];
+      d << data.force[s] - estimator.last().data().force[s],
+          data.moment[s] - estimator.last().data().moment[s];
       sum[j] += d;
       sum2[j].noalias() += d * d.transpose();
     }
@@ -851,11 +854,11 @@ TEST(CovarianceMonteCarlo, InertialParametersTalos) {
     const int s = published[j];
     const Vector6 mean = sum[j] / replays;
     const Matrix6 empirical = sum2[j] / replays - mean * mean.transpose();
-    const Matrix6& P = estimator.covariance(s);
+    const Matrix6& P = estimator.last().covariance(s);
     // diagonal_only: the same variances (same sums in another order: 1e-12 relative).
     for (int c = 0; c < 6; ++c)
-      EXPECT_NEAR(estimator_diagonal.covariance(s)(c, c), P(c, c), 1e-12 * P(c, c) + 1e-300);
-    EXPECT_EQ(estimator_diagonal.covariance(s)(0, 1), 0.0);
+      EXPECT_NEAR(estimator_diagonal.last().covariance(s)(c, c), P(c, c), 1e-12 * P(c, c) + 1e-300);
+    EXPECT_EQ(estimator_diagonal.last().covariance(s)(0, 1), 0.0);
     const double top = P.diagonal().maxCoeff();
     for (int c = 0; c < 6; ++c) {
       if (P(c, c) <= 1e-9 * top) continue;  // zero in theory (see runMonteCarlo)
@@ -911,7 +914,7 @@ TEST(CovariancePeriod, NoiseGainGuardFollowsJitteryStamps) {
         ++published;
         bool same = true;
         for (int i : model.moving_segments) {
-          const double ve = exact.effortVariance(i), vg = guarded.effortVariance(i);
+          const double ve = exact.last().effortVariance(i), vg = guarded.last().effortVariance(i);
           same = same && ve == vg;
           if (ve > 0.0) worst = std::max(worst, std::abs(std::sqrt(vg / ve) - 1.0));
         }

@@ -67,7 +67,7 @@ TEST(Estimator, ExactWithExactDifferentiatorAndWrenchResampling) {
     const jle::SampleStatus status = estimator.addJointSample(t, q.data());
     if (status != jle::SampleStatus::kPublished) continue;
     ++published;
-    ASSERT_EQ(estimator.stamp(), t);
+    ASSERT_EQ(estimator.last().stamp(), t);
     jle::forwardKinematics(model, reference, q, traj.qd(model, t), traj.qdd(model, t),
                            config.gravity_world);
     jle::addExternalWrench(model, reference, model.frameIndex("tool0"), force(t), moment(t),
@@ -77,8 +77,8 @@ TEST(Estimator, ExactWithExactDifferentiatorAndWrenchResampling) {
       // Rounding of the 3-point formula at dt = 1 ms: ~1e-13 rad/s^2 on qdd, times
       // inertias O(1): 1e-9 relative to the load scale is a wide margin.
       const double scale = 1.0 + reference.force[s].norm() + reference.moment[s].norm();
-      EXPECT_LT((estimator.data().force[s] - reference.force[s]).norm(), 1e-9 * scale);
-      EXPECT_LT((estimator.data().moment[s] - reference.moment[s]).norm(), 1e-9 * scale);
+      EXPECT_LT((estimator.last().data().force[s] - reference.force[s]).norm(), 1e-9 * scale);
+      EXPECT_LT((estimator.last().data().moment[s] - reference.moment[s]).norm(), 1e-9 * scale);
     }
   }
   EXPECT_EQ(published, 198);
@@ -97,8 +97,8 @@ TEST(Estimator, SignFlipsAForcePlate) {
   estimator.addWrench(0, 0.0, Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(4, 5, 6));
   for (int k = 0; k < 3; ++k) estimator.addJointSample(1e-3 * k, q.data());
   // The held value passes through the filter's weights (summing to 1 up to rounding).
-  EXPECT_LT((estimator.appliedWrench(0).force - Eigen::Vector3d(-1, -2, -3)).norm(), 1e-13);
-  EXPECT_LT((estimator.appliedWrench(0).moment - Eigen::Vector3d(-4, -5, -6)).norm(), 1e-13);
+  EXPECT_LT((estimator.last().appliedWrench(0).force - Eigen::Vector3d(-1, -2, -3)).norm(), 1e-13);
+  EXPECT_LT((estimator.last().appliedWrench(0).moment - Eigen::Vector3d(-4, -5, -6)).norm(), 1e-13);
 }
 
 TEST(Estimator, StalePolicies) {
@@ -119,17 +119,17 @@ TEST(Estimator, StalePolicies) {
     jle::SampleStatus status = jle::SampleStatus::kWarmingUp;
     for (int k = 0; k <= 40; ++k) status = estimator.addJointSample(1e-3 * k, q.data());
     ASSERT_EQ(status, jle::SampleStatus::kPublished);  // 40 ms < 50 ms timeout
-    EXPECT_FALSE(estimator.stale(0));
+    EXPECT_FALSE(estimator.last().stale(0));
     for (int k = 41; k <= 100; ++k) status = estimator.addJointSample(1e-3 * k, q.data());
-    EXPECT_TRUE(estimator.stale(0));
+    EXPECT_TRUE(estimator.last().stale(0));
     switch (policy) {
       case jle::StalePolicy::kHold:
         EXPECT_EQ(status, jle::SampleStatus::kPublished);
-        EXPECT_LT((estimator.appliedWrench(0).force - f).norm(), 1e-13);
+        EXPECT_LT((estimator.last().appliedWrench(0).force - f).norm(), 1e-13);
         break;
       case jle::StalePolicy::kZero:
         EXPECT_EQ(status, jle::SampleStatus::kPublished);
-        EXPECT_EQ(estimator.appliedWrench(0).force, Eigen::Vector3d::Zero());
+        EXPECT_EQ(estimator.last().appliedWrench(0).force, Eigen::Vector3d::Zero());
         break;
       case jle::StalePolicy::kStop: EXPECT_EQ(status, jle::SampleStatus::kStale); break;
     }
@@ -210,7 +210,7 @@ TEST(Estimator, FloatingBaseTwistAndAccelerationFromItsPose) {
     pose.position = 0.5 * a0 * t * t;
     pose.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(w * t, axis));
     if (estimator.addJointSample(t, nullptr, &pose) != jle::SampleStatus::kPublished) continue;
-    const jle::Data<double>& d = estimator.data();
+    const jle::Data<double>& d = estimator.last().data();
     EXPECT_LT((jle::omegaWorld(d, 0) - w * axis).norm(), 1e-9);
     EXPECT_LT(jle::alphaWorld(d, 0).norm(), 1e-6);
     const Eigen::Vector3d expected_a = a0;

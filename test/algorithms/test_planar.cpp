@@ -258,8 +258,8 @@ EstimatorRun runEstimator(const jle::Model<double>& model, jle::EstimatorConfig 
     for (int i = 0; i < model.nq; ++i) q[i] = 0.5 * std::sin(3 * t + i) + 0.1 * i;
     wrenches(estimator, k, t);
     if (estimator.addJointSample(t, q.data()) != jle::SampleStatus::kPublished) continue;
-    out.loads.push_back(loadsOf(estimator.data(), estimator.dynamicsSegments()));
-    out.planar += estimator.lastWasPlanar();
+    out.loads.push_back(loadsOf(estimator.last().data(), estimator.layout().dynamicsSegments()));
+    out.planar += estimator.last().planar();
   }
   return out;
 }
@@ -292,7 +292,7 @@ TEST(Planar, EstimatorAutoMatchesOffOnATreeWithWrenchInputs) {
     }
   }
   jle::Estimator probe(model, on);
-  EXPECT_TRUE(probe.planar()) << probe.planarReason();
+  EXPECT_TRUE(probe.layout().planar()) << probe.layout().planarReason();
   auto feed = [&](jle::Estimator& e, int, double t) {
     int input = 0;
     for (int k : {2, 5, 9}) {
@@ -418,7 +418,7 @@ TEST(Planar, DetectionAcceptsPlanarModels) {
   EXPECT_TRUE(jle::detectPlanar(arm, Vec3(0, -kG, 0)).planar);
   jle::EstimatorConfig c;
   c.gravity_world = Vec3(0, -kG, 0);
-  EXPECT_TRUE(jle::Estimator(arm, c).planar());
+  EXPECT_TRUE(jle::Estimator(arm, c).layout().planar());
 }
 
 TEST(Planar, DetectionRefusesWhatIsNotPlanar) {
@@ -430,7 +430,7 @@ TEST(Planar, DetectionRefusesWhatIsNotPlanar) {
     jle::EstimatorConfig config;
     config.gravity_world = gravity;
     jle::Estimator e(model, config);
-    EXPECT_FALSE(e.planar());
+    EXPECT_FALSE(e.layout().planar());
   };
   // One axis tilted by 1e-9 rad: far beyond the tolerance (1e-13), far below anything
   // a user would see: detection must still refuse.
@@ -451,10 +451,10 @@ TEST(Planar, DetectionRefusesWhatIsNotPlanar) {
   jle::EstimatorConfig c;
   c.gravity_world = g;
   c.savings.planar = jle::PlanarMode::kOff;
-  EXPECT_FALSE(jle::Estimator(planar, c).planar());
+  EXPECT_FALSE(jle::Estimator(planar, c).layout().planar());
   c.savings.planar = jle::PlanarMode::kOn;
   c.precision = jle::Precision::kFloat;
-  EXPECT_FALSE(jle::Estimator(planar, c).planar());
+  EXPECT_FALSE(jle::Estimator(planar, c).layout().planar());
 }
 
 TEST(Planar, PruningLeavesOnlyTheJointsThatMatter) {
@@ -475,9 +475,9 @@ TEST(Planar, PruningLeavesOnlyTheJointsThatMatter) {
   const jle::Model<double> model = jle::modelFromUrdfString(urdf);
   jle::EstimatorConfig c;
   c.gravity_world = Vec3(0, -kG, 0);
-  EXPECT_FALSE(jle::Estimator(model, c).planar());
+  EXPECT_FALSE(jle::Estimator(model, c).layout().planar());
   c.joints = {"knee"};
-  EXPECT_TRUE(jle::Estimator(model, c).planar());
+  EXPECT_TRUE(jle::Estimator(model, c).layout().planar());
 }
 
 TEST(Planar, ForcedModeDropsWhatDetectionRefused) {
@@ -488,8 +488,8 @@ TEST(Planar, ForcedModeDropsWhatDetectionRefused) {
                        off = withPlanar(jle::PlanarMode::kOff);
   on.gravity_world = off.gravity_world = Vec3(0, -kG, 0);
   jle::Estimator probe(tilted, on);
-  EXPECT_TRUE(probe.planar());
-  EXPECT_NE(probe.planarReason().find("'j2'"), std::string::npos);
+  EXPECT_TRUE(probe.layout().planar());
+  EXPECT_NE(probe.layout().planarReason().find("'j2'"), std::string::npos);
   auto none = [](jle::Estimator&, int, double) {};
   const EstimatorRun a = runEstimator(tilted, on, none), b = runEstimator(tilted, off, none);
   ASSERT_EQ(a.loads.size(), b.loads.size());

@@ -158,10 +158,10 @@ void runStanceSwingStance(const jle::DifferentiatorConfig& differentiator, Stanc
       ASSERT_TRUE(
           estimator.addPlateSample(0, t, Vector3d(1.0, 0.0, -15.0), Vector3d(0.3, -0.2, 0.0)));
     if (estimator.addJointSample(t, &q) != jle::SampleStatus::kPublished) continue;
-    const int j = static_cast<int>(std::lround((estimator.stamp() - 3.0) * 1000.0));
-    const jle::PlateReading& r = estimator.plateReading(0);
-    const Vector3d& F = estimator.data().force[s];
-    const Vector3d& M = estimator.data().moment[s];
+    const int j = static_cast<int>(std::lround((estimator.last().stamp() - 3.0) * 1000.0));
+    const jle::PlateReading& r = estimator.last().plateReading(0);
+    const Vector3d& F = estimator.last().data().force[s];
+    const Vector3d& M = estimator.last().data().moment[s];
     if (!contact(j)) {
       // A swinging foot: exactly its weight and the 15 N reading from the first stamp
       // after lift-off, although the filters still remember the stance. Rounding only:
@@ -254,9 +254,9 @@ TEST(EstimatorPlates, StalePlateIsOutOfContact) {
     if (estimator.addJointSample(t, &q) != jle::SampleStatus::kPublished) continue;
     // Samples 2..9 fresh; 10..14 held within 5.5 ms; from 15 on stale: zero.
     const bool expect_contact = k < 15;
-    EXPECT_EQ(estimator.plateReading(0).contact, expect_contact) << k;
-    EXPECT_NEAR(estimator.data().force[s].z(), expect_contact ? -690.19335 : kG, 1e-9) << k;
-    EXPECT_EQ(estimator.plateStale(0), k >= 15) << k;
+    EXPECT_EQ(estimator.last().plateReading(0).contact, expect_contact) << k;
+    EXPECT_NEAR(estimator.last().data().force[s].z(), expect_contact ? -690.19335 : kG, 1e-9) << k;
+    EXPECT_EQ(estimator.last().plateStale(0), k >= 15) << k;
   }
 }
 
@@ -275,8 +275,8 @@ TEST(EstimatorPlates, FloatPrecision) {
     estimator.addPlateSample(0, 1e-3 * k, kF, kM);
     if (estimator.addJointSample(1e-3 * k, &q) != jle::SampleStatus::kPublished) continue;
     ++published;
-    EXPECT_NEAR((estimator.data().force[s] - kStanceForce).norm(), 0.0, 1e-6 * 700.0);
-    EXPECT_NEAR((estimator.data().moment[s] - kStanceMoment).norm(), 0.0, 1e-6 * 700.0);
+    EXPECT_NEAR((estimator.last().data().force[s] - kStanceForce).norm(), 0.0, 1e-6 * 700.0);
+    EXPECT_NEAR((estimator.last().data().moment[s] - kStanceMoment).norm(), 0.0, 1e-6 * 700.0);
   }
   EXPECT_EQ(published, 3);
 }
@@ -419,9 +419,9 @@ ImpactErrors runEstimator(const jle::DifferentiatorConfig& differentiator, doubl
     plateSample(scene, plate.plate, t, zero_below, force, moment);
     EXPECT_TRUE(estimator.addPlateSample(0, t, force, moment));
     if (estimator.addJointSample(t, &q) != jle::SampleStatus::kPublished) continue;
-    const double stamp = estimator.stamp();
+    const double stamp = estimator.last().stamp();
     if (plateSample(scene, plate.plate, stamp, 0.0, force, moment))
-      e.add(std::abs(estimator.data().effort[s] - scene.ankleMoment(stamp)));
+      e.add(std::abs(estimator.last().data().effort[s] - scene.ankleMoment(stamp)));
   }
   EXPECT_GT(e.n, 2400);
   return e.finish();

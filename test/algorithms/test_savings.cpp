@@ -33,7 +33,7 @@ std::vector<std::vector<double>> run(const jle::Model<double>& model, jle::Estim
     std::vector<double> loads;
     for (const std::string& j : joints) {
       const int s = model.segmentOfJoint(j);
-      const jle::Data<double>& d = estimator.data();
+      const jle::Data<double>& d = estimator.last().data();
       for (int c = 0; c < 3; ++c) loads.push_back(d.force[s][c]);
       for (int c = 0; c < 3; ++c) loads.push_back(d.moment[s][c]);
       loads.push_back(d.effort[s]);
@@ -79,8 +79,9 @@ TEST(Savings, PruningToTheAskedJointsIsBitExact) {
   pruned.joints = asked;
   jle::Estimator probe(talos, pruned);
   // The saving applies: two legs' and an arm's worth of segments, not 33.
-  EXPECT_LT(probe.dynamicsSegments().size(), 6u);
-  EXPECT_FALSE(probe.coordinateNeeded(talos.coordinate[talos.segmentOfJoint("leg_right_4_joint")]));
+  EXPECT_LT(probe.layout().dynamicsSegments().size(), 6u);
+  EXPECT_FALSE(
+      probe.layout().coordinateNeeded(talos.coordinate[talos.segmentOfJoint("leg_right_4_joint")]));
   expectIdentical(run(talos, pruned, asked, false), run(talos, full, asked, false));
 }
 
@@ -98,8 +99,8 @@ TEST(Savings, UnneededWrenchInputsAreSkipped) {
   pruned.savings.prune = true;
   pruned.joints = {"leg_left_4_joint"};
   jle::Estimator probe(talos, pruned);
-  EXPECT_TRUE(probe.inputNeeded(0));
-  EXPECT_FALSE(probe.inputNeeded(1));
+  EXPECT_TRUE(probe.layout().inputNeeded(0));
+  EXPECT_FALSE(probe.layout().inputNeeded(1));
   expectIdentical(run(talos, pruned, pruned.joints, false), run(talos, full, pruned.joints, false));
 }
 
@@ -136,7 +137,7 @@ TEST(Savings, UnchangedInputsReuseTheLastResult) {
   int reused = 0;
   for (int k = 0; k < 40; ++k)
     if (probe.addJointSample(1e-3 * k, q.data()) == jle::SampleStatus::kPublished)
-      reused += probe.lastWasReused();
+      reused += probe.last().reused();
   EXPECT_GT(reused, 20);
   expectIdentical(run(ur5, on, movingJoints(ur5), true), run(ur5, off, movingJoints(ur5), true));
   expectIdentical(run(ur5, on, movingJoints(ur5), false), run(ur5, off, movingJoints(ur5), false));

@@ -77,13 +77,13 @@ TEST(SensorJoint, ReadingEqualToPredictionGivesZeroResidual) {
   Vector3d f, m;
   staticReading(q[1], f, m);
   feedStill(e, q, f, m);
-  ASSERT_GE(e.sensorSegment(0), 0);
-  EXPECT_TRUE(e.sensorUsed(0));
+  ASSERT_GE(e.layout().sensorSegment(0), 0);
+  EXPECT_TRUE(e.last().sensorUsed(0));
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(e.predictedWrench(0).force[i], f[i], kExact);
-    EXPECT_NEAR(e.predictedWrench(0).moment[i], m[i], kExact);
-    EXPECT_NEAR(e.sensorResidual(0).force[i], 0.0, kExact);
-    EXPECT_NEAR(e.sensorResidual(0).moment[i], 0.0, kExact);
+    EXPECT_NEAR(e.last().predictedWrench(0).force[i], f[i], kExact);
+    EXPECT_NEAR(e.last().predictedWrench(0).moment[i], m[i], kExact);
+    EXPECT_NEAR(e.last().sensorResidual(0).force[i], 0.0, kExact);
+    EXPECT_NEAR(e.last().sensorResidual(0).moment[i], 0.0, kExact);
   }
 }
 
@@ -112,7 +112,7 @@ TEST(SensorJoint, UnmodelledContactIsTheResidualAndLoadsTheProximalJoints) {
     const double tol = variant == 2 ? 1e-5 : kExact;
     jle::Estimator e(model, config);
     feedStill(e, q, f_read, m_read);
-    const jle::Wrench<double> r = e.sensorResidual(0);
+    const jle::Wrench<double> r = e.last().sensorResidual(0);
     const Vector3d moment_expected = -kTip.cross(c);
     for (int i = 0; i < 3; ++i) {
       EXPECT_NEAR(r.force[i], -c[i], tol);
@@ -124,12 +124,12 @@ TEST(SensorJoint, UnmodelledContactIsTheResidualAndLoadsTheProximalJoints) {
       if (variant == 1 && std::string(joint) == "j2") continue;
       const int s = model.segmentOfJoint(joint);
       for (int i = 0; i < 3; ++i) {
-        EXPECT_NEAR(e.data().force[s][i], ref.force[s][i], tol) << joint;
-        EXPECT_NEAR(e.data().moment[s][i], ref.moment[s][i], tol) << joint;
+        EXPECT_NEAR(e.last().data().force[s][i], ref.force[s][i], tol) << joint;
+        EXPECT_NEAR(e.last().data().moment[s][i], ref.moment[s][i], tol) << joint;
       }
     }
     if (variant != 1) {
-      EXPECT_NEAR(e.data().effort[model.segmentOfJoint("j2")], tau2, tol);
+      EXPECT_NEAR(e.last().data().effort[model.segmentOfJoint("j2")], tau2, tol);
     }
   }
 }
@@ -153,9 +153,9 @@ TEST(SensorJoint, MovingWithContact) {
     referenceWithContact(model, ref, qk, qdk, qdd, c);
     e.addWrench(0, t, ref.force[s_ft], ref.moment[s_ft]);
     if (e.addJointSample(t, qk.data()) != jle::SampleStatus::kPublished) continue;
-    const double ts = e.stamp() - 2.0;
+    const double ts = e.last().stamp() - 2.0;
     referenceWithContact(model, ref, q0 + qd0 * ts + 0.5 * qdd * ts * ts, qd0 + qdd * ts, qdd, c);
-    const jle::Wrench<double> r = e.sensorResidual(0);
+    const jle::Wrench<double> r = e.last().sensorResidual(0);
     // Second differences of samples 1 ms apart: rounding of ~1e-16 / 1e-6 on
     // qdd.
     const double tol = 1e-8;
@@ -166,8 +166,8 @@ TEST(SensorJoint, MovingWithContact) {
     }
     for (int s : model.moving_segments)
       for (int i = 0; i < 3; ++i) {
-        EXPECT_NEAR(e.data().force[s][i], ref.force[s][i], tol);
-        EXPECT_NEAR(e.data().moment[s][i], ref.moment[s][i], tol);
+        EXPECT_NEAR(e.last().data().force[s][i], ref.force[s][i], tol);
+        EXPECT_NEAR(e.last().data().moment[s][i], ref.moment[s][i], tol);
       }
     ++checked;
   }

@@ -423,9 +423,9 @@ Published feed(const std::vector<double>& times, const DifferentiatorConfig& c,
     out.status.push_back(estimator.addJointSample(t, q.data()));
     if (out.status.back() != jle::SampleStatus::kPublished) continue;
     out.index.push_back(k);
-    out.stamp.push_back(estimator.stamp());
-    out.qdd.push_back(estimator.qdd()[2]);
-    out.effort.push_back(estimator.data().effort[model.moving_segments[1]]);
+    out.stamp.push_back(estimator.last().stamp());
+    out.qdd.push_back(estimator.last().qdd()[2]);
+    out.effort.push_back(estimator.last().data().effort[model.moving_segments[1]]);
   }
   return out;
 }

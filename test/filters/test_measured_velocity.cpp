@@ -145,11 +145,11 @@ TEST(MeasuredVelocity, TheCausalFilterTakesThemWhateverTheSpectraSay) {
     causal.addJointSample(t, p.data(), nullptr, v.data());
     smoothed.addJointSample(t, p.data(), nullptr, v.data());
   }
-  ASSERT_GT(causal.spectralCutoff(), 0.0);
-  ASSERT_GT(smoothed.spectralCutoff(), 0.0);
-  EXPECT_EQ(causal.velocitiesUsed(), model.nq);
-  EXPECT_TRUE(causal.velocitiesBetter());
-  EXPECT_FALSE(smoothed.velocitiesBetter());
+  ASSERT_GT(causal.filters().spectralCutoff(), 0.0);
+  ASSERT_GT(smoothed.filters().spectralCutoff(), 0.0);
+  EXPECT_EQ(causal.filters().velocitiesUsed(), model.nq);
+  EXPECT_TRUE(causal.filters().velocitiesBetter());
+  EXPECT_FALSE(smoothed.filters().velocitiesBetter());
 }
 
 TEST(MeasuredVelocity, PositionsOnlyStreamsAreUnchangedBySetting) {

@@ -37,15 +37,15 @@ inline std::vector<double> runScenario(const std::string& urdf_file) {
                           Eigen::Vector3d(0.1, 0.2 * std::cos(t), -0.3));
       for (int i = 0; i < model.nq; ++i) q[i] = 0.4 * std::sin(2.0 * t + 0.7 * i) + 0.1 * i;
       if (estimator.addJointSample(t, q.data()) != jle::SampleStatus::kPublished) continue;
-      out.push_back(estimator.stamp());
-      out.push_back(estimator.delaySamples());
-      const jle::Data<double>& d = estimator.data();
+      out.push_back(estimator.last().stamp());
+      out.push_back(estimator.filters().delaySamples());
+      const jle::Data<double>& d = estimator.last().data();
       for (int s = 0; s < model.nsegments(); ++s) {
         out.push_back(d.effort[s]);
         for (int c = 0; c < 3; ++c) out.push_back(d.force[s][c]);
         for (int c = 0; c < 3; ++c) out.push_back(d.moment[s][c]);
       }
-      const jle::Wrench<double> w = estimator.appliedWrench(0);
+      const jle::Wrench<double> w = estimator.last().appliedWrench(0);
       for (int c = 0; c < 3; ++c) out.push_back(w.force[c]);
     }
   }

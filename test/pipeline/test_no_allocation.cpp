@@ -141,7 +141,7 @@ TEST(NoAllocation, EstimatorWithCovariance) {
     }
     EXPECT_EQ(g_allocations - before, 0)
         << "linearize_state " << linearize << ", period " << config.uncertainty.period;
-    EXPECT_GT(estimator.covariance(model.moving_segments[0])(5, 5), 0.0);
+    EXPECT_GT(estimator.last().covariance(model.moving_segments[0])(5, 5), 0.0);
   }
 }
 
@@ -155,7 +155,7 @@ TEST(NoAllocation, EstimatorOnThePlanarPath) {
   w.name = w.link = "tool";
   c.wrenches.push_back(w);
   jle::Estimator estimator(arm, c);
-  ASSERT_TRUE(estimator.planar());
+  ASSERT_TRUE(estimator.layout().planar());
   std::vector<double> q(static_cast<std::size_t>(arm.nq), 0.0);
   long before = 0, planar = 0;
   for (int k = 0; k < 2000; ++k) {
@@ -166,7 +166,7 @@ TEST(NoAllocation, EstimatorOnThePlanarPath) {
     estimator.addWrench(0, t, Eigen::Vector3d(1, 0, k >= 1900 && k < 1910 ? 1.0 : 0.0),
                         Eigen::Vector3d(0, 0, 0.1));
     if (estimator.addJointSample(t, q.data()) == jle::SampleStatus::kPublished)
-      planar += estimator.lastWasPlanar();
+      planar += estimator.last().planar();
   }
   EXPECT_EQ(g_allocations - before, 0);
   EXPECT_GT(planar, 1700);

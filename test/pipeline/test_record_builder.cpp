@@ -44,8 +44,8 @@ struct Stream {
     const double t = timeline.sampleTime(stamp);
     jle::SampleStatus status = estimator.addJointSample(t, q.data());
     timeline.taken(stamp);
-    builder.remember(t, stamp, &effort, estimator.delaySamples());
-    max_delay = std::max(max_delay, estimator.delaySamples());
+    builder.remember(t, stamp, &effort, estimator.filters().delaySamples());
+    max_delay = std::max(max_delay, estimator.filters().delaySamples());
     if (status == jle::SampleStatus::kPublished) take(out);
     while (estimator.takeDue(status))
       if (status == jle::SampleStatus::kPublished) take(out);
@@ -130,7 +130,7 @@ TEST(RecordBuilder, DelayedRecordsCarryTheirOwnSample) {
   // The stamps were jittered about their instants: forgotten samples (a restart) get the
   // time axis' instant, not a stamp of their own.
   ASSERT_TRUE(delayed.timeline.sampleClock().regular());
-  const double t_last = delayed.estimator.stamp();
+  const double t_last = delayed.estimator.last().stamp();
   EXPECT_EQ(delayed.builder.stampAt(t_last), stampOf(kSamples - 1));
   delayed.builder.forget();
   EXPECT_EQ(delayed.builder.stampAt(t_last), delayed.timeline.absolute(t_last));
@@ -161,8 +161,8 @@ jle::Settings wristSettings() {
 TEST(RecordBuilder, EachStatusBitWhereTheSettingsPutIt) {
   Stream s(wristSettings());
   jle::Estimator& e = s.estimator;
-  ASSERT_TRUE(e.plateNeeded(0));
-  ASSERT_FALSE(e.plateNeeded(1));
+  ASSERT_TRUE(e.layout().plateNeeded(0));
+  ASSERT_FALSE(e.layout().plateNeeded(1));
   // Samples 10 ms apart, the wrench with each but the last: 10 ms old there.
   std::vector<jle::LoadsRecord> out;
   for (int k = 0; k < 10; ++k) {
@@ -173,7 +173,7 @@ TEST(RecordBuilder, EachStatusBitWhereTheSettingsPutIt) {
     s.feed(stamp, positions(k), efforts(k), out);
   }
   ASSERT_FALSE(out.empty());
-  const double t = e.stamp();  // 0.09 s
+  const double t = e.last().stamp();  // 0.09 s
   ASSERT_EQ(out.back().stamp, kStart + 90 * kMs);
   // Filled: the wrench fresh at the sample before, stale at the last; the plates never had
   // a sample: the needed one stale (the other one's staleness is not followed).

@@ -243,7 +243,8 @@ def test_zero_phase_is_joint_loads_positions_only(tmp_path):
     columns, stderr = joint_loads(tmp_path, ["--urdf", PANDA, "--cutoff", "auto",
                                              "--write-kinematics", kinematics],
                                   header, np.column_stack([t, q, wrench]))
-    value, rate, accel, cutoff = jle.smooth_zero_phase(t, q)  # auto, as joint_loads' default
+    # auto, as joint_loads' default, its wrench columns filtered alike
+    value, rate, accel, cutoff = jle.smooth_zero_phase(t, q, forces={"wrench": (t, wrench)})
     printed = float(re.search(r"cutoff (\S+) Hz", stderr).group(1))
     assert cutoff == pytest.approx(printed, rel=1e-15)
     smoothed = read_csv(kinematics)
@@ -263,6 +264,33 @@ def test_zero_phase_is_joint_loads_positions_only(tmp_path):
     assert residual[3] != cutoff and residual[3] > 0
     with pytest.raises(ValueError, match="cutoff"):
         jle.smooth_zero_phase(t, q, cutoff=-1.0)
+
+
+def test_zero_phase_rises_for_heel_strikes_as_joint_loads(tmp_path):
+    """A contact force's heel strikes (8 ms rise into a 0.25 s half sine of 1500 N, 0.5 N
+    of noise, 1 kHz) filtered alike raise the positions' own cutoff; joint_loads, given
+    them as wrench columns, prints the same cutoff and says it was raised."""
+    model = jle.Model(PANDA)
+    n = 6000
+    t = 0.001 * np.arange(n)
+    rng = np.random.default_rng(8)
+    q = 0.4 * np.sin(2 * np.pi * np.outer(t, rng.uniform(0.2, 1.0, model.nq))) + \
+        rng.normal(0, 1e-3, (n, model.nq))
+    wrench = rng.normal(0, 0.5, (n, 6))
+    for start in (0.7, 1.9, 3.1, 4.3):
+        s = t - start
+        on = (s >= 0) & (s <= 0.25)
+        wrench[on, 2] += 1500 * np.minimum(1, s[on] / 0.008) * np.sin(np.pi * s[on] / 0.25)
+    own = jle.smooth_zero_phase(t, q)[3]
+    raised = jle.smooth_zero_phase(t, q, forces={"contact": (t, wrench)})[3]
+    assert raised > 1.5 * own
+    header = ["t"] + [name + ".q" for name in model.coordinate_names] + \
+        ["wrench@panda_hand." + c for c in ("fx", "fy", "fz", "mx", "my", "mz")]
+    _, stderr = joint_loads(tmp_path, ["--urdf", PANDA, "--cutoff", "auto"], header,
+                            np.column_stack([t, q, wrench]))
+    assert float(re.search(r"cutoff (\S+) Hz", stderr).group(1)) == pytest.approx(raised,
+                                                                                  rel=1e-15)
+    assert "raised from the" in stderr, stderr
 
 
 # --- process_bag on the same bag -----------------------------------------------------

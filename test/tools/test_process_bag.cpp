@@ -255,16 +255,16 @@ struct Expected {
 void take(const jle::Estimator& estimator, const std::vector<int>& published,
           const ros::Time& origin, const std::map<double, std::vector<double>>& efforts,
           Expected& e) {
-  e.t.push_back((origin + ros::Duration(estimator.stamp())).toSec());
+  e.t.push_back((origin + ros::Duration(estimator.last().stamp())).toSec());
   std::vector<double> row;
   for (int s : published) {
-    const jle::Data<double>& d = estimator.data();
+    const jle::Data<double>& d = estimator.last().data();
     for (int c = 0; c < 3; ++c) row.push_back(d.force[static_cast<std::size_t>(s)][c]);
     for (int c = 0; c < 3; ++c) row.push_back(d.moment[static_cast<std::size_t>(s)][c]);
     row.push_back(d.effort[static_cast<std::size_t>(s)]);
   }
   e.values.push_back(row);
-  e.measured.push_back(efforts.at(estimator.stamp()));
+  e.measured.push_back(efforts.at(estimator.last().stamp()));
 }
 
 // Drives the estimator directly with the messages, in time order (and to the end of the

@@ -20,7 +20,7 @@ struct SensorBias {
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();
 };
 
-/// A sensor's residual (Estimator::sensorResidual: measured minus predicted joint
+/// A sensor's residual (Estimator::LastSample::sensorResidual: measured minus predicted joint
 /// wrench, in the sensor link's frame, moment about its origin) re-expressed in the
 /// reading's frame S, moment about S's origin, S's pose in the link being
 /// (R_link_sensor, p_link_sensor [m]). Its sign is the measured wrench's (the load on

@@ -61,12 +61,44 @@ struct ZeroPhaseConfig {
 /// The cutoff an automatic rule chose, the rule that chose it (kAuto resolved), the
 /// search's bounds [Hz], and what a user must hear: one line per warning (the choice on a
 /// bound; another rule, or the measured velocities, disagreeing by more than
-/// kCutoffDisagreement). Empty warnings for kFixed.
+/// kCutoffDisagreement with the positions' own cutoff; the cutoff raised for channels
+/// filtered alike, and those whose content reaches more than kCutoffDisagreement above
+/// it). Empty warnings for kFixed.
 struct CutoffChoice {
   double cutoff = 0.0;  ///< [Hz]
   CutoffRule rule = CutoffRule::kFixed;
   double lowest = 0.0, highest = 0.0;  ///< [Hz] the search's bounds
+  /// [Hz] the positions' own cutoff (what `rule` chose), before the channels filtered alike
+  /// raised it (FilteredAlike); equal to `cutoff` when they did not.
+  double positions_cutoff = 0.0;
   std::vector<std::string> warnings;
+};
+
+/// Force, wrench or plate channels that are filtered with the positions' cutoff: samples x
+/// channels ([N], [N m]) at their own stamps t [s] (strictly increasing, at least 3), and
+/// what they are, for the warnings ("wrench input foot").
+///
+/// Given to an automatic rule, they may raise its cutoff. Sampled fast, their own spectrum
+/// shows where their content ends (kSpectrum on them, up to max_cutoff): a contact force's
+/// heel strikes reach 50 Hz and more, a slow F/T wrench a few Hz. Where that lies more than
+/// kCutoffDisagreement above the positions' own cutoff f_p, the positions' choice would
+/// smooth the loads' largest term: the cutoff rises from f_p towards it, as long as the
+/// noise the rise lets into the positions' acceleration (its mean square change from f_p's:
+/// above f_p their spectrum is noise) stays below the acceleration's own mean square at f_p
+/// (as much noise as motion, the balance kSpectrum strikes per band, struck over the whole
+/// acceleration). Not scored in the loads: the weights of the two (the body's inertias and
+/// the contact's lever arms) are the model's, which the filter does not have. Measured
+/// (bench/accuracy.cpp, docs/studies/zero_phase.md) on leg_gait_70hz, a running leg's
+/// positions at 70 Hz with 2e-3 rad of noise flat to 15 Hz and its 1 kHz contact force: f_p
+/// 4.99 Hz (noise spectrum; the best fixed cutoff for the motion alone, without the force,
+/// is 4.59 Hz) erred 2.34 times the best fixed cutoff's 7.76 N m (10.8 Hz, the force filtered
+/// alike); raised to 8.61 Hz, 1.13 times. On every arm scene no wrench reaches that far and
+/// the choice is the positions' own. The choice raised says so in CutoffChoice::warnings, and
+/// so does a channel whose content still reaches more than kCutoffDisagreement above it.
+struct FilteredAlike {
+  std::vector<double> t;
+  Eigen::MatrixXd x;
+  std::string what;
 };
 
 /// The ratio between two rules' cutoffs beyond which CutoffChoice warns.
@@ -88,10 +120,14 @@ struct ZeroPhaseResult {
 /// std::invalid_argument naming what is wrong (sizes, stamps, config).
 /// `velocities`: empty, or measured rates of the same channels at the same stamps
 /// (samples x channels, [u/s]; non-finite entries left out): the evidence of kVelocity and
-/// kAuto, and a cross-check of the other automatic rules.
+/// kAuto, and a cross-check of the other automatic rules. `alike`: the force, wrench and
+/// plate channels that the caller filters with the returned cutoff (lowPassZeroPhase),
+/// which an automatic rule's cutoff rises for (FilteredAlike) and which are checked as
+/// checkFilteredAlike does; not filtered here.
 ZeroPhaseResult smoothZeroPhase(const std::vector<double>& t, const Eigen::MatrixXd& x,
                                 const ZeroPhaseConfig& config,
-                                const Eigen::MatrixXd& velocities = Eigen::MatrixXd());
+                                const Eigen::MatrixXd& velocities = Eigen::MatrixXd(),
+                                const std::vector<FilteredAlike>& alike = {});
 
 /// The same filter (cutoff [Hz] given, no derivatives) for force, wrench and plate
 /// columns: samples x channels in and out, at the stamps t [s]; `padding` as in
@@ -100,7 +136,8 @@ Eigen::MatrixXd lowPassZeroPhase(const std::vector<double>& t, const Eigen::Matr
                                  double cutoff, int order, int padding = 0);
 
 /// The force, wrench or plate channels x (samples x channels at the stamps t [s]) that an
-/// automatic `choice` of the positions' cutoff filters alike: where their own spectrum
+/// automatic `choice` of the positions' cutoff filters alike (what smoothZeroPhase checks
+/// for the channels given to it as `alike`): where their own spectrum
 /// meets its noise floor (CutoffRule::kSpectrum up to config.max_cutoff), returned [Hz];
 /// and a warning naming `what` into choice.warnings where that lies more than
 /// kCutoffDisagreement above choice.cutoff: content (an impact, a heel strike) that the
@@ -117,10 +154,11 @@ double chooseCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
                     const ZeroPhaseConfig& config,
                     const Eigen::MatrixXd& velocities = Eigen::MatrixXd());
 
-/// The same choice with its rule, bounds and warnings.
+/// The same choice with its rule, bounds and warnings; `alike` as in smoothZeroPhase.
 CutoffChoice selectCutoff(const std::vector<double>& t, const Eigen::MatrixXd& x,
                           const ZeroPhaseConfig& config,
-                          const Eigen::MatrixXd& velocities = Eigen::MatrixXd());
+                          const Eigen::MatrixXd& velocities = Eigen::MatrixXd(),
+                          const std::vector<FilteredAlike>& alike = {});
 
 /// Checks a configuration once; throws std::invalid_argument naming the member
 /// ("zero_phase cutoff must be finite and > 0 [Hz] ...").

@@ -219,7 +219,9 @@ class Pipeline {
   /// The smoothed stream's bandwidth [Hz] (its smoother's gain is 1/2 there): chosen from
   /// the joint positions' spectrum where smoothed.differentiator.auto_bandwidth (before
   /// the first choice, process_noise's); 0 without one.
-  double smoothedBandwidth() const { return smoothed_ ? smoothed_->estimator.bandwidth() : 0.0; }
+  double smoothedBandwidth() const {
+    return smoothed_ ? smoothed_->estimator.filters().bandwidth() : 0.0;
+  }
   /// What a user must hear when the smoothed stream's bandwidth sits on a bound of its
   /// search (issue 37: never a silent choice): the lag's floor above the data's choice, or
   /// the highest where the positions' spectrum shows no noise floor; empty otherwise (and
@@ -228,29 +230,29 @@ class Pipeline {
   /// Whether the smoothed stream takes q-dot and q-ddot from the measured velocities where
   /// the joint states carry them (Estimator::velocitiesBetter), or from the positions.
   bool smoothedVelocities() const {
-    return smoothed_ && smoothed_->estimator.velocitiesUsed() > 0 &&
-           smoothed_->estimator.velocitiesBetter();
+    return smoothed_ && smoothed_->estimator.filters().velocitiesUsed() > 0 &&
+           smoothed_->estimator.filters().velocitiesBetter();
   }
   const PipelineCounters& counters() const { return counters_; }
   const Settings& settings() const { return settings_; }
   /// What the computed loads need, fixed at construction: coordinate i, wrench input k,
   /// force plate k (an input on no computed segment is not needed: a front end need not
   /// subscribe to it).
-  bool coordinateNeeded(int i) const { return estimator_.coordinateNeeded(i); }
-  bool inputNeeded(int k) const { return estimator_.inputNeeded(k); }
-  bool plateNeeded(int k) const { return estimator_.plateNeeded(k); }
+  bool coordinateNeeded(int i) const { return estimator_.layout().coordinateNeeded(i); }
+  bool inputNeeded(int k) const { return estimator_.layout().inputNeeded(k); }
+  bool plateNeeded(int k) const { return estimator_.layout().plateNeeded(k); }
   /// How many coordinates take their q-dot from the measured velocities, and whether
   /// coordinate i does (decided at the first sample after a start, reset or retune).
-  int velocitiesUsed() const { return estimator_.velocitiesUsed(); }
-  bool velocityUsed(int i) const { return estimator_.velocityUsed(i); }
+  int velocitiesUsed() const { return estimator_.filters().velocitiesUsed(); }
+  bool velocityUsed(int i) const { return estimator_.filters().velocityUsed(i); }
   /// The immediate stream's delay behind the newest joint state in samples, and the
-  /// samples taken whose loads are still to come (a smoother's; Estimator::delaySamples,
+  /// samples taken whose loads are still to come (a smoother's; Estimator::Filters::delaySamples,
   /// pendingSamples).
-  int delaySamples() const { return estimator_.delaySamples(); }
-  int pendingSamples() const { return estimator_.pendingSamples(); }
+  int delaySamples() const { return estimator_.filters().delaySamples(); }
+  int pendingSamples() const { return estimator_.filters().pendingSamples(); }
   /// Whether the planar 3x3 path is in use (savings.planar), and why not if it is not.
-  bool planar() const { return estimator_.planar(); }
-  const std::string& planarReason() const { return estimator_.planarReason(); }
+  bool planar() const { return estimator_.layout().planar(); }
+  const std::string& planarReason() const { return estimator_.layout().planarReason(); }
   /// The topics of every wrench input and force plate that was stale at the last joint
   /// sample, whatever its policy, ", " between them; empty if none.
   std::string staleInputs() const;

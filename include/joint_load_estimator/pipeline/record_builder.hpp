@@ -147,7 +147,7 @@ class RecordBuilder {
   /// A joint sample was taken: at estimator time t [s], stamped `stamp`, with the measured
   /// efforts of the published joints (published-joint order) or null when its messages had
   /// none. `delay`: the most samples behind the newest that an estimate still to come can
-  /// be (Estimator::delaySamples over the streams): the samples remembered grow to twice
+  /// be (Estimator::Filters::delaySamples over the streams): the samples remembered grow to twice
   /// that when they do not fit (rare after the warm-up: a faster rate, a gap).
   void remember(double t, Stamp stamp, const std::vector<double>* effort, int delay);
   /// Forgets the samples remembered (the filters restarted: no estimate of theirs comes).

@@ -70,8 +70,8 @@ struct WrenchInputConfig {
 };
 
 /// The uncertainty of the inputs, propagated to the covariance of every computed joint
-/// wrench (Estimator::covariance; docs/studies/uncertainty.md). All standard deviations are
-/// 1 sigma; the errors are taken as independent, zero-mean and (for the sensors) white.
+/// wrench (Estimator::LastSample::covariance; docs/studies/uncertainty.md). All standard deviations
+/// are 1 sigma; the errors are taken as independent, zero-mean and (for the sensors) white.
 struct UncertaintyConfig {
   bool enabled = false;
   bool diagonal_only = false;  ///< only the 6 variances per joint (off-diagonal terms left 0)
