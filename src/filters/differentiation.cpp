@@ -26,6 +26,7 @@ DifferentiatorBank::DifferentiatorBank(const DifferentiatorConfig& config, int c
     state_.setZero(n_, channels_);
     P_.setZero(n_, n_);
     innovation_.setZero(channels_);
+    last_innovation_.setZero(channels_);
     if (config_.type == DifferentiatorType::kAdaptive) buildModels();
     if (config_.type == DifferentiatorType::kAdaptive && config_.lag > 0.0) buildSmoother();
     if (autoBandwidth()) chooseBandwidthFrom(channels_);
@@ -80,6 +81,7 @@ void DifferentiatorBank::reset() {
   recent_count_ = 0;
   spacing_ = 0.0;
   for (DifferentiatorBank& s : smoother_) s.reset();
+  endMissedMotion();
   if (autoBandwidth() && spectra_used_) {
     spectra_used_ = false;
     auto_bandwidth_ = 0.0;
@@ -107,6 +109,7 @@ void DifferentiatorBank::resetFilter() {
   selection_.reset();
   spectral_.endBlock();
   probe_.endBlock();
+  endMissedMotion();
 }
 
 void DifferentiatorBank::restart() {
@@ -266,8 +269,34 @@ void DifferentiatorBank::setBandwidth(double f, double dt) {
   const double r = config_.measurement_noise;
   const double q = r * r * h * std::pow(2.0 * M_PI * f, 2 * n_);
   // The causal filter only ever raises its bandwidth: lowered, its lag grows with it.
-  setProcessNoise(raise_only_ || !smoothing() ? std::max(q, default_q_) : q);
-  auto_bandwidth_ = bandwidthOf(config_.process_noise, h);
+  chosen_q_ = raise_only_ || !smoothing() ? std::max(q, default_q_) : q;
+  setProcessNoise(boosted_ ? chosen_q_ * std::pow(kMissedMotionBoost, 2 * n_) : chosen_q_);
+  auto_bandwidth_ = bandwidthOf(chosen_q_, h);
+}
+
+void DifferentiatorBank::followMotion(double dt) {
+  const double floor = spectral_.floorLevel();  // 0: no floor (data without noise), none yet
+  if (!(floor > 0.0) || !(auto_bandwidth_ > 0.0)) return;
+  const int channels = std::min(spectral_channels_, channels_);
+  double correlated = 0.0;
+  for (int c = 0; c < channels; ++c) {
+    correlated += innovation_[c] * last_innovation_[c];
+    last_innovation_[c] = innovation_[c];
+  }
+  const double a = std::min(1.0, dt / kMissedMotionSeconds);
+  missed_motion_ += a * (correlated / (floor * innovation_variance_) - missed_motion_);
+  const bool boost = missed_motion_ > 1.0;
+  if (boost == boosted_) return;
+  boosted_ = boost;
+  setProcessNoise(boost ? chosen_q_ * std::pow(kMissedMotionBoost, 2 * n_) : chosen_q_);
+}
+
+void DifferentiatorBank::endMissedMotion() {
+  missed_motion_ = 0.0;
+  last_innovation_.setZero();
+  if (!boosted_) return;
+  boosted_ = false;
+  setProcessNoise(chosen_q_);
 }
 
 void DifferentiatorBank::startAtLagFloor(double dt) {
@@ -506,6 +535,7 @@ bool DifferentiatorBank::updateKalman(double t, const double* x) {
   stamp_ = t;
   if (count_ < n) ++count_;
   if (autoBandwidth() && count_ >= n) addSpectra(t, x, dt);
+  if (autoBandwidth() && raise_only_ && smoothing() && count_ >= n) followMotion(dt);
   if (smoothing()) return smoothStep(t, dt);
   return count_ >= n;
 }

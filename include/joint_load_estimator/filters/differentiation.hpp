@@ -43,6 +43,15 @@ class DifferentiatorBank {
   /// 4.6x the best at the delay, now 1.1x; from its second block on, 1.7x); any other
   /// choice from so short a block (the motion's leakage hides a floor) is not taken.
   static constexpr double kProbeSeconds = 0.5;
+  /// auto_bandwidth, the measured velocities' smoother (raiseOnly with a lag): a move
+  /// faster than the spectrum so far shows (its 2 s blocks see it once it is over) leaves
+  /// its trace in the innovations, which are then correlated from sample to sample; white
+  /// noise, however loud, leaves none. Where the correlated part of the innovations
+  /// (sum over the channels of e_k e_(k-1), averaged over kMissedMotionSeconds) exceeds
+  /// the innovation variance that the spectrum's noise floor predicts, the filter runs at
+  /// kMissedMotionBoost times its bandwidth, until it no longer does.
+  static constexpr double kMissedMotionSeconds = 0.05;
+  static constexpr double kMissedMotionBoost = 1.5;
   using SmallMatrix =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxOrder + 1, kMaxOrder + 1>;
 
@@ -189,6 +198,15 @@ class DifferentiatorBank {
 
   // auto_bandwidth: the process noise of bandwidth f [Hz], at least kLagFloor / lag.
   void setBandwidth(double f, double dt);
+
+  // The measured velocities' smoother (raise_only_ with a lag), after a sample's update
+  // (dt: its interval): the innovations' correlated part against the noise floor, and the
+  // bandwidth kMissedMotionBoost times the chosen one while it exceeds it
+  // (kMissedMotionSeconds).
+  void followMotion(double dt);
+
+  // The chosen process noise again, the innovations' memory cleared (a reset, a gap).
+  void endMissedMotion();
 
   // auto_bandwidth: the sample (t, x) to the spectrum, and until its first choice to the
   // probe's (dt: the last interval).
@@ -366,6 +384,13 @@ class DifferentiatorBank {
   int spectral_channels_ = 0;                 // auto_bandwidth: chooseBandwidthFrom's
   bool spectra_used_ = false;                 // auto_bandwidth: a sample since the last reset
   bool raise_only_ = false;  // auto_bandwidth: never below process_noise's (raiseOnly)
+  // followMotion: the chosen process noise (without the boost), the last innovations
+  // (channels), the correlated part's running mean per unit predicted innovation
+  // variance, and whether the bandwidth is boosted.
+  double chosen_q_ = 0.0;
+  Eigen::VectorXd last_innovation_;
+  double missed_motion_ = 0.0;
+  bool boosted_ = false;
   SmallMatrix backward_gain_;
   // Per remembered sample (column: slot index % ring_size_): the filtered state
   // (n x channels, channel-major), the prediction before its measurement, the backward

@@ -355,6 +355,20 @@ struct StampSettings {
 /// (its backward pass over blocks from the newest sample) was prototyped against it: at 6 Hz it
 /// needs about 0.45 s of delay to come within 1.1x of the offline result, where this smoother
 /// (whose response with a long lag is the same |H|^2) needs about 0.25 s.
+/// With the joint states' velocities, their filter (the same, raised only:
+/// DifferentiatorBank::raiseOnly) also runs at 1.5 times its bandwidth while its innovations
+/// are correlated from sample to sample beyond what the noise floor predicts
+/// (DifferentiatorBank::kMissedMotionBoost): a move faster than the 2 s blocks so far show. On
+/// arm_noise_1e-3 the velocities' spectrum chose 8.8 Hz from the slow moves of 2-4 s, and a
+/// fast move at 5.6 s, before the 4-6 s block raised it to 12.5 Hz, cost 0.068 N m RMS over
+/// 5.5-6 s (0.032 at 12 Hz); with the boost the scene's error is 0.0194 -> 0.0165 N m, 1.56x ->
+/// 1.33x the best at its delay (KS-CJ q=1e4 + velocities, 12 Hz), arm_jitter_1khz 1.14x ->
+/// 1.00x, arm_noise_1e-4 1.07x -> 1.02x, arm_jitter_100hz 1.27x -> 1.32x, the coloured and gait
+/// scenes unchanged. The positions' bandwidth is not the cause there (7 to 12 Hz with the
+/// velocities' at 12 Hz: 0.0122 to 0.0124 N m); a fixed floor for the velocities' filter (1e4:
+/// 12 Hz at 1 kHz) gave arm_noise_1e-3 0.97x but arm_coloured_200hz 2.12x and panda_4khz 1.58x,
+/// and the same boost from the innovations' energy instead of their correlation (which stamp
+/// jitter raises during moves) arm_jitter_100hz 1.43x and arm_coloured_200hz 1.47x.
 inline DifferentiatorConfig defaultSmoother() {
   DifferentiatorConfig c;
   c.type = DifferentiatorType::kKalman;

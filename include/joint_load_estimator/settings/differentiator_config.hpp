@@ -70,8 +70,9 @@ struct DifferentiatorConfig {
   /// choice (a smoother: raised to kLagFloor / lag where its bandwidth is below). Without a lag
   /// (the causal filter) alike, but the bandwidth only ever raised above process_noise's, never
   /// lowered (its lag would grow with it), no lag floor, and for positions only where the spectrum
-  /// shows no floor (DifferentiatorBank::raiseOnly: a rate's filter takes the crossing too). false:
-  /// process_noise throughout.
+  /// shows no floor (DifferentiatorBank::raiseOnly: a rate's filter takes the crossing too). A
+  /// smoother of rates (raiseOnly) runs at a higher bandwidth while its innovations show motion
+  /// that it misses (DifferentiatorBank::kMissedMotionBoost). false: process_noise throughout.
   bool auto_bandwidth = false;
   /// Adaptive: the bandwidths [Hz] its filters span (the crossover of signal and noise
   /// spectra; log-spaced by kBandwidthRatio), and the standard deviation of the position
