@@ -119,11 +119,12 @@ class DifferentiatorBank {
   /// lowered (true), or set from the data both ways (false, the default). The measured
   /// velocities' filter raises only: a rate's spectrum falls more slowly than a
   /// position's, and its crossing of the floor from a block or two lies below the rate's
-  /// bandwidth (accuracy study: arm_noise_1e-3, 1.46x -> 1.57x of the best when lowered).
-  /// A causal filter (lag 0) raises only in any case; with raiseOnly (a rate's filter) to
-  /// where the spectrum meets its floor, without it (positions) only where it shows none
-  /// (accuracy study, the immediate default: lowered by its own spectrum, the velocities'
-  /// filter cost panda 0.049 -> 0.107 N m).
+  /// bandwidth (accuracy study, the smoothed default set both ways, so without its boost
+  /// (followMotion) either: arm_noise_1e-3 0.0165 -> 0.0194 N m, 1.33x -> 1.56x the best at its
+  /// delay; arm_noise_1e-4 0.0080 -> 0.0096; arm_coloured_1khz 0.0231 -> 0.0226). A causal filter
+  /// (lag 0) raises only in any case; with raiseOnly (a rate's filter) to where the spectrum meets
+  /// its floor, without it (positions) only where it shows none (accuracy study, the immediate
+  /// default: lowered by its own spectrum, the velocities' filter cost panda 0.049 -> 0.107 N m).
   void raiseOnly(bool raise_only) { raise_only_ = raise_only; }
   /// Adaptive with a lag: only the first `channels` channels (e.g. the joint positions,
   /// not the wrenches filtered alike) choose the smoother's bandwidth. All by default.
