@@ -32,8 +32,8 @@ using jle_test::kStart;
 using jle_test::ur5;
 using jle_test::withToolSensor;
 
-// Joint i: 0.5 sin(w_i t + i), 0.3-1.0 Hz, within the UR5's limits and speeds.
-double q(int i, double t) { return 0.5 * std::sin(2.0 * M_PI * (0.3 + 0.14 * i) * t + i); }
+// Joint i's position at t [s].
+const auto q = &jle_test::ur5Sine;
 
 std::vector<double> positions(double t) {
   std::vector<double> p(6);
