@@ -9,16 +9,8 @@
 set -euo pipefail
 [ "${1:-}" = --page ] || { echo "usage: bench/external_effort.sh --page" >&2; exit 2; }
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
-export JLE_WS=$ws
-mkdir -p "$ws"
-log="$ws/external_effort_build.log"
-if ! bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" -DJLE_UNIT_TESTS=ON bench_external_effort \
-  test_external_effort >"$log" 2>&1; then
-  tail -40 "$log"
-  echo "external_effort: build failed (log: $log)" >&2
-  exit 1
-fi
+source "$repo/tools/study_build.sh"
+study_build external_effort -DJLE_UNIT_TESTS=ON bench_external_effort test_external_effort
 page=$repo/docs/studies/external_effort.md
 study="/usr/bin/python3 $repo/tools/study_page.py"
 tables="/usr/bin/python3 $repo/bench/external_effort_page.py"

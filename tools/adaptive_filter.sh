@@ -7,16 +7,8 @@
 # load. JLE_WS as for tools/build.sh; JLE_JOBS build jobs (default 2).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
-export JLE_WS=$ws
-mkdir -p "$ws"
-log="$ws/adaptive_filter_build.log"
-if ! bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" -DJLE_UNIT_TESTS=ON bench_adaptive_filter \
-  test_adaptive_differentiator >"$log" 2>&1; then
-  tail -40 "$log"
-  echo "adaptive_filter: build failed (log: $log)" >&2
-  exit 1
-fi
+source "$repo/tools/study_build.sh"
+study_build adaptive_filter -DJLE_UNIT_TESTS=ON bench_adaptive_filter test_adaptive_differentiator
 page=$repo/docs/studies/differentiators.md
 study="/usr/bin/python3 $repo/tools/study_page.py"
 before=$($study load)

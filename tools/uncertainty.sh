@@ -8,20 +8,13 @@
 # About 5 min of machine time after the build. JLE_WS as for tools/build.sh; JLE_JOBS build jobs.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
-export JLE_WS=$ws
 case "${1:-}" in
   "") ;;
   *) echo "usage: tools/uncertainty.sh" >&2; exit 2 ;;
 esac
-mkdir -p "$ws"
-log="$ws/uncertainty_build.log"
-if ! bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" -DJLE_UNIT_TESTS=ON test_covariance \
-  test_covariance_pipeline bench_speed_core process_bag make_example_bag >"$log" 2>&1; then
-  tail -40 "$log"
-  echo "uncertainty: build failed (log: $log)" >&2
-  exit 1
-fi
+source "$repo/tools/study_build.sh"
+study_build uncertainty -DJLE_UNIT_TESTS=ON test_covariance test_covariance_pipeline \
+  bench_speed_core process_bag make_example_bag
 bin=$ws/devel/lib/joint_load_estimator
 out=$ws/uncertainty_study
 mkdir -p "$out"

@@ -5,16 +5,10 @@
 # on 2 cores after the build. JLE_WS as for tools/build.sh.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
-mkdir -p "$ws"
+source "$repo/tools/study_build.sh"
 page_py=$repo/tools/study_page.py
 before=$(/usr/bin/python3 "$page_py" load)
-log="$ws/zero_phase_build.log"
-if ! bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" accuracy zero_phase_study >"$log" 2>&1; then
-  tail -40 "$log"
-  echo "zero_phase: build failed (log: $log)" >&2
-  exit 1
-fi
+study_build zero_phase accuracy zero_phase_study
 bin=$ws/devel/lib/joint_load_estimator
 out=$ws/zero_phase
 mkdir -p "$out"
