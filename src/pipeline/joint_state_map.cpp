@@ -29,17 +29,17 @@ JointStateMap::JointStateMap(const Model<double>& model, const std::vector<int>&
     published_joint_names_.push_back(model.joint_name[static_cast<std::size_t>(s)]);
 }
 
-const JointStateMap::Binding& JointStateMap::binding(const std::vector<std::string>& names) {
+int JointStateMap::bind(const std::vector<std::string>& names) {
   ++binds_;
   if (bindings_[current_].used >= 0 && bindings_[current_].layout == names) {
     bindings_[current_].used = binds_;  // the common case: the last message's layout
-    return bindings_[current_];
+    return bindings_[current_].duplicate;
   }
   for (std::size_t b = 0; b < bindings_.size(); ++b) {
     if (bindings_[b].used < 0 || bindings_[b].layout != names) continue;
     bindings_[b].used = binds_;
     current_ = b;
-    return bindings_[b];
+    return bindings_[b].duplicate;
   }
   current_ = 0;  // a new layout: in the slot used least recently (or never)
   for (std::size_t b = 1; b < bindings_.size(); ++b)
@@ -67,16 +67,15 @@ const JointStateMap::Binding& JointStateMap::binding(const std::vector<std::stri
       }
     if (m.coordinate_of[i] >= 0 || m.published_of[i] >= 0) m.known[i] = 1;
   }
-  return m;
+  return m.duplicate;
 }
 
-int JointStateMap::update(const std::vector<std::string>& names,
-                          const std::vector<double>& position, const std::vector<double>& velocity,
+int JointStateMap::update(const std::vector<double>& position, const std::vector<double>& velocity,
                           const std::vector<double>& effort) {
   constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
-  const Binding& m = binding(names);
+  const Binding& m = bindings_[current_];
   int unknown = -1;
-  for (std::size_t i = 0; i < names.size(); ++i) {
+  for (std::size_t i = 0; i < m.known.size(); ++i) {
     if (!m.known[i]) {
       if (unknown < 0) unknown = static_cast<int>(i);
       continue;
@@ -116,10 +115,6 @@ void JointStateMap::checkMimics(const std::vector<double>& position) {
     mimic_contradiction_ = static_cast<int>(i);
     mimic_expected_ = expected;
   }
-}
-
-int JointStateMap::duplicate(const std::vector<std::string>& names) {
-  return binding(names).duplicate;
 }
 
 int JointStateMap::firstMissing() const {

@@ -124,6 +124,9 @@ Pipeline::Pipeline(const Model<double>& model, const Settings& settings, FrameSo
       plates_(settings_.estimator.plates.size()) {
   const Model<double>& m = estimator_.model();
   coordinate_segment_ = coordinateSegments(m);
+  for (int s : coordinate_segment_)
+    coordinate_range_.push_back(
+        plausibleRange(m, settings_.plausibility, static_cast<std::size_t>(s)));
   for (int i = 0; i < m.nq; ++i)
     any_needed_ = any_needed_ || estimator_.layout().coordinateNeeded(i);
   if (settings_.smoothed.enabled) {
@@ -259,7 +262,7 @@ bool Pipeline::checkJointState(const std::vector<std::string>& names,
                std::to_string(position[bad]) + ": message dropped";
     return false;
   }
-  const int twice = joints_.duplicate(names);
+  const int twice = joints_.bind(names);
   if (twice >= 0) {
     problem_ = topic + ": joint '" + names[static_cast<std::size_t>(twice)] +
                "' is named twice: message dropped";
@@ -279,7 +282,7 @@ void Pipeline::mapJointState(const std::vector<std::string>& names,
                              const std::vector<double>& position,
                              const std::vector<double>& velocity,
                              const std::vector<double>& effort) {
-  const int unknown = joints_.update(names, position, velocity, effort);
+  const int unknown = joints_.update(position, velocity, effort);  // names bound by checkJointState
   std::size_t bad = 0;
   if (!allFinite(effort, bad)) {
     nonfinite_effort_ = names[bad];
@@ -485,8 +488,7 @@ Outcome Pipeline::sample(Stamp stamp, bool has_effort, const BasePose* base) {
   if (status != SampleStatus::kPublished) return count(kind, Outcome::kUsed);
   if (estimator_.last().reused() && !settings_.estimator.savings.republish_unchanged)
     return count(kind, Outcome::kUnchanged);
-  fillRecord(estimator_, record_);
-  if (!RecordBuilder::finiteLoads(record_)) {
+  if (!fillRecord(estimator_, record_)) {
     restartFilters(false);  // what made them not finite is in the filters' state
     return fail(kind, Outcome::kNonFinite,
                 settings_.joint_states_topic + ": the loads at " + secondsText(stamp) +
@@ -504,9 +506,7 @@ void Pipeline::sampleSmoothed(double t, const BasePose* base) {
   noteStart(stream.settle, status, t);
   smoothed_published_ = status == SampleStatus::kPublished &&
                         !(e.last().reused() && !settings_.estimator.savings.republish_unchanged);
-  if (smoothed_published_) fillRecord(e, stream.record);
-  if (smoothed_published_ &&
-      !RecordBuilder::finiteLoads(stream.record)) {  // counted by the immediate stream
+  if (smoothed_published_ && !fillRecord(e, stream.record)) {  // counted by the immediate stream
     e.reset();
     stream.settle.restarted = true;
     smoothed_published_ = false;
@@ -567,8 +567,7 @@ bool Pipeline::nextRecord(Estimator& estimator, LoadsRecord& record, bool end) {
   while (end ? estimator.flush(status) : estimator.takeDue(status)) {
     if (status != SampleStatus::kPublished) continue;
     if (estimator.last().reused() && !settings_.estimator.savings.republish_unchanged) continue;
-    fillRecord(estimator, record);
-    if (!RecordBuilder::finiteLoads(record)) continue;  // never published
+    if (!fillRecord(estimator, record)) continue;  // never published
     return true;
   }
   return false;
@@ -622,10 +621,11 @@ void Pipeline::remember(double t, Stamp stamp, bool has_effort) {
   builder_.remember(t, stamp, has_effort ? &joints_.effort() : nullptr, delay);
 }
 
-void Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
+bool Pipeline::fillRecord(const Estimator& estimator, LoadsRecord& rec) {
   const Settle& settle = &estimator == &estimator_ ? settle_ : smoothed_->settle;
-  builder_.fill(estimator, settle.from, rec);
+  const bool finite = builder_.fill(estimator, settle.from, rec);
   if (external_ && &rec == &record_) fillExternal();
+  return finite;
 }
 
 void Pipeline::countHeld(double t) {
@@ -690,19 +690,20 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   for (std::size_t i = 0; i < names.size(); ++i) {
     const int c = coordinate[i];
     if (c < 0) continue;
+    const PlausibleRange& range = coordinate_range_[static_cast<std::size_t>(c)];
     const std::size_t s =
         static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(c)]);
-    const std::string beyond = implausiblePosition(m, p, s, position[i]);
-    if (!beyond.empty()) {
-      problem_ = settings_.joint_states_topic + ": " + beyond + ": message dropped";
+    if (!plausiblePosition(range, position[i])) {
+      problem_ = settings_.joint_states_topic + ": " + positionProblem(m, p, s, position[i]) +
+                 ": message dropped";
       return false;
     }
     if (dt <= 0.0 || !joints_.received(c) || too_fast) continue;
-    const std::string fast =
-        implausibleStep(m, p, s, position[i] - joints_.q()[static_cast<std::size_t>(c)], dt);
-    if (fast.empty()) continue;
+    const double step = position[i] - joints_.q()[static_cast<std::size_t>(c)];
+    if (plausibleStep(range, p, step, dt)) continue;
     too_fast = true;
-    problem_ = settings_.joint_states_topic + ": " + fast + ": message dropped";
+    problem_ =
+        settings_.joint_states_topic + ": " + stepProblem(m, p, s, step, dt) + ": message dropped";
   }
   if (!too_fast) {
     implausible_run_ = 0;

@@ -124,11 +124,29 @@ void RecordBuilder::growRing(std::size_t size) {
 
 const RecordBuilder::Sample* RecordBuilder::sampleAt(double t) const {
   // The estimate's time is one of the samples' own times (the filter's delay is a whole
-  // number of samples); half a nanosecond separates it from any other.
-  for (std::size_t i = 0; i < ring_count_; ++i) {
-    const Sample& s = ring_[(ring_head_ + ring_.size() - 1 - i) % ring_.size()];
-    if (std::abs(s.t - t) < 0.5e-9) return &s;
+  // number of samples); half a nanosecond separates it from any other. The newest first
+  // (the immediate stream's); the times increase from the oldest (the filters take samples
+  // in order, and forget() goes with every restart): a bisection for a smoother's, a
+  // hundred samples back; should that find none, every sample.
+  if (ring_count_ == 0) return nullptr;
+  const std::size_t size = ring_.size();
+  const std::size_t first = (ring_head_ + size - ring_count_) % size;
+  const auto oldest = [&](std::size_t i) -> const Sample& {
+    return ring_[first + i < size ? first + i : first + i - size];
+  };
+  const auto at = [&](std::size_t i) { return std::abs(oldest(i).t - t) < 0.5e-9; };
+  if (at(ring_count_ - 1)) return &oldest(ring_count_ - 1);
+  std::size_t lo = 0, hi = ring_count_ - 1;
+  while (lo < hi) {
+    const std::size_t mid = (lo + hi) / 2;
+    if (oldest(mid).t < t - 0.5e-9)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
+  if (at(lo)) return &oldest(lo);
+  for (std::size_t i = 0; i < ring_count_; ++i)
+    if (at(i)) return &oldest(i);
   return nullptr;
 }
 
@@ -137,7 +155,7 @@ Stamp RecordBuilder::stampAt(double t) const {
   return s ? s->stamp : timeline_.absolute(t);
 }
 
-void RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRecord& rec) const {
+bool RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRecord& rec) const {
   const Estimator::LastSample last = estimator.last();
   const Data<double>& data = last.data();
   const Sample* s = sampleAt(last.stamp());
@@ -167,6 +185,17 @@ void RecordBuilder::fill(const Estimator& estimator, double settle_from, LoadsRe
   }
   fillSideOutputs(estimator, rec);
   rec.status = status(estimator, settle_from, rec);
+  return finiteLoads(rec);
+}
+
+bool RecordBuilder::finiteLoads(const LoadsRecord& rec) {
+  // x - x is 0 for a finite x and NaN for an infinite or NaN one: one sum, no branch a
+  // value.
+  double zero = (rec.base_force - rec.base_force).sum() + (rec.base_moment - rec.base_moment).sum();
+  for (std::size_t i = 0; i < rec.effort.size(); ++i)
+    zero += (rec.effort[i] - rec.effort[i]) + (rec.force[i] - rec.force[i]).sum() +
+            (rec.moment[i] - rec.moment[i]).sum();
+  return zero == 0.0;
 }
 
 std::uint8_t RecordBuilder::status(const Estimator& estimator, double settle_from,
@@ -184,13 +213,6 @@ std::uint8_t RecordBuilder::status(const Estimator& estimator, double settle_fro
     if (implausibleEffort(model_, p, static_cast<std::size_t>(rec.segment[i]), rec.effort[i]))
       status |= kImplausibleLoad;
   return status;
-}
-
-bool RecordBuilder::finiteLoads(const LoadsRecord& rec) {
-  for (std::size_t i = 0; i < rec.effort.size(); ++i)
-    if (!std::isfinite(rec.effort[i]) || !rec.force[i].allFinite() || !rec.moment[i].allFinite())
-      return false;
-  return rec.base_force.allFinite() && rec.base_moment.allFinite();
 }
 
 void RecordBuilder::fillSideOutputs(const Estimator& estimator, LoadsRecord& rec) const {

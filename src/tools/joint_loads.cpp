@@ -430,11 +430,12 @@ void checkPlausible(const jle::CsvReader& reader, const jle::Model<double>& mode
   for (std::size_t k = 0; k < columns.q.size(); ++k) {
     const std::size_t s = static_cast<std::size_t>(segment[k]);
     const double q = cells[columns.q[k]];
-    const std::string beyond = jle::implausiblePosition(model, p, s, q);
-    if (!beyond.empty()) reader.failAt(columns.q[k], beyond + kWhy);
-    const std::string fast =
-        dt > 0.0 ? jle::implausibleStep(model, p, s, q - (*previous)[columns.q[k]], dt) : "";
-    if (!fast.empty()) reader.failAt(columns.q[k], fast + kWhy);
+    const jle::PlausibleRange range = jle::plausibleRange(model, p, s);
+    if (!jle::plausiblePosition(range, q))
+      reader.failAt(columns.q[k], jle::positionProblem(model, p, s, q) + kWhy);
+    const double step = dt > 0.0 ? q - (*previous)[columns.q[k]] : 0.0;
+    if (dt > 0.0 && !jle::plausibleStep(range, p, step, dt))
+      reader.failAt(columns.q[k], jle::stepProblem(model, p, s, step, dt) + kWhy);
     if (columns.qd[k] < 0 || !jle::implausibleVelocity(model, p, s, cells[columns.qd[k]])) continue;
     reader.failAt(columns.qd[k], "velocity of joint '" + model.joint_name[s] + "' is " +
                                      shortest(cells[columns.qd[k]]) +

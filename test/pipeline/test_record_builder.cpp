@@ -56,7 +56,7 @@ struct Stream {
       if (status == jle::SampleStatus::kPublished) take(out);
   }
   void take(std::vector<jle::LoadsRecord>& out) {
-    builder.fill(estimator, -1.0, record);
+    EXPECT_TRUE(builder.fill(estimator, -1.0, record));  // finite loads
     out.push_back(record);
   }
 

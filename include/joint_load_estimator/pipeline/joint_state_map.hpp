@@ -23,25 +23,26 @@ class JointStateMap {
   JointStateMap(const Model<double>& model, const std::vector<int>& published_segments,
                 double mimic_tolerance = 0.01);
 
-  /// Takes a message's names and positions (same size, checked by the caller), its
-  /// velocities and its efforts (each empty, or the same size; a non-finite one is taken
-  /// as none: NaN). Mimic joints are ignored (a mimic follows its leader); one whose
-  /// position contradicts its leader's in the same message is noted (mimicContradiction).
-  /// Returns the index in `names` of the first joint the model does not have, or -1 if
-  /// there is none (the others are still taken).
-  int update(const std::vector<std::string>& names, const std::vector<double>& position,
-             const std::vector<double>& velocity, const std::vector<double>& effort);
-  /// The index in the last update()'s `names` of the first mimic joint whose position is
+  /// Binds the layout of a message's names (no cost but string comparisons for a layout
+  /// among the last few): update() takes that message's values. Returns the index in
+  /// `names` of the first name that an earlier entry has too, or -1 if every name is there
+  /// once.
+  int bind(const std::vector<std::string>& names);
+  /// Takes the positions of the message whose names were bound last (same size, checked
+  /// by the caller), its velocities and its efforts (each empty, or the same size; a
+  /// non-finite one is taken as none: NaN). Mimic joints are ignored (a mimic follows its
+  /// leader); one whose position contradicts its leader's in the same message is noted
+  /// (mimicContradiction). Returns the index in the names of the first joint the model
+  /// does not have, or -1 if there is none (the others are still taken).
+  int update(const std::vector<double>& position, const std::vector<double>& velocity,
+             const std::vector<double>& effort);
+  /// The index in the last update()'s names of the first mimic joint whose position is
   /// more than mimic_tolerance from what its leader's gives (mimicExpected()), or -1.
   int mimicContradiction() const { return mimic_contradiction_; }
   /// What the model gives that mimic joint: multiplier times its leader's plus offset.
   double mimicExpected() const { return mimic_expected_; }
 
-  /// The index in `names` of the first name that an earlier entry of `names` has too,
-  /// or -1 if every name is there once. Binds the layout (no cost for the same layout
-  /// as the last message's).
-  int duplicate(const std::vector<std::string>& names);
-  /// Per entry of the last layout bound (update(), duplicate()): the coordinate it
+  /// Per entry of the last layout bound: the coordinate it
   /// sets (model.coordinate_names index), or -1 (a mimic, a fixed or unknown joint).
   const std::vector<int>& coordinates() const { return bindings_[current_].coordinate_of; }
 
@@ -93,7 +94,6 @@ class JointStateMap {
     long used = -1;  // when last bound (-1: never)
   };
   static constexpr std::size_t kLayouts = 4;
-  const Binding& binding(const std::vector<std::string>& names);
   std::vector<Binding> bindings_ = std::vector<Binding>(kLayouts);
   std::size_t current_ = 0;
   long binds_ = 0;

@@ -18,6 +18,7 @@
 #include <joint_load_estimator/model/urdf_reader.hpp>
 #include <joint_load_estimator/pipeline/frame_resolver.hpp>
 #include <joint_load_estimator/pipeline/joint_state_map.hpp>
+#include <joint_load_estimator/pipeline/plausibility.hpp>
 #include <joint_load_estimator/pipeline/record_builder.hpp>
 #include <joint_load_estimator/pipeline/timeline.hpp>
 #include <joint_load_estimator/settings/config.hpp>
@@ -340,8 +341,8 @@ class Pipeline {
   void remember(double t, Stamp stamp, bool has_effort);
   bool resolvePlatePose(int k, const std::string& frame);
   // The record of the loads `estimator` (either stream's) published last, with the
-  // external outputs in the immediate stream's record_.
-  void fillRecord(const Estimator& estimator, LoadsRecord& rec);
+  // external outputs in the immediate stream's record_; whether its loads are finite.
+  bool fillRecord(const Estimator& estimator, LoadsRecord& rec);
   static void noteStart(Settle& settle, SampleStatus status, double t);
   void countHeld(double t);
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
@@ -394,9 +395,10 @@ class Pipeline {
   std::string problem_, unknown_joint_, nonfinite_effort_, nonfinite_velocity_;
   std::string mimic_contradiction_;
   bool any_needed_ = false;  // the loads need at least one coordinate
-  // Plausibility: per coordinate its joint's segment (limits), the joint states refused
+  // Plausibility: per coordinate its joint's segment and range, the joint states refused
   // in a row for moving too fast, and the velocities with the implausible ones as NaN.
   std::vector<int> coordinate_segment_;
+  std::vector<PlausibleRange> coordinate_range_;
   int implausible_run_ = 0;
   std::vector<double> velocity_checked_;
   Settle settle_;  // the immediate stream's

@@ -33,13 +33,28 @@ inline double velocityLimit(const Model<double>& model, const PlausibilityConfig
   return std::isfinite(model.velocity_limit[s]) ? model.velocity_limit[s] : p.max_velocity;
 }
 
-/// Why position q of segment s's joint is not plausible (beyond its URDF limits by more
-/// than position_margin), naming joint, value and bound; empty when it is.
-inline std::string implausiblePosition(const Model<double>& model, const PlausibilityConfig& p,
-                                       std::size_t s, double q) {
-  if (q >= model.lower_limit[s] - p.position_margin &&
-      q <= model.upper_limit[s] + p.position_margin)
-    return {};
+/// What the rules allow a joint (segment s's): positions within [low, high], its URDF limits
+/// widened by position_margin; a step of at most rate dt + step_margin in dt [s], rate the
+/// velocity_factor times its velocity limit. Computed once per coordinate by a front end
+/// that checks every message.
+struct PlausibleRange {
+  double low = 0.0, high = 0.0, rate = 0.0;
+};
+
+inline PlausibleRange plausibleRange(const Model<double>& model, const PlausibilityConfig& p,
+                                     std::size_t s) {
+  return {model.lower_limit[s] - p.position_margin, model.upper_limit[s] + p.position_margin,
+          p.velocity_factor * velocityLimit(model, p, s)};
+}
+
+/// Whether position q is plausible for a joint of range r.
+inline bool plausiblePosition(const PlausibleRange& r, double q) {
+  return q >= r.low && q <= r.high;
+}
+
+/// Why position q of segment s's joint is not plausible, naming joint, value and bound.
+inline std::string positionProblem(const Model<double>& model, const PlausibilityConfig& p,
+                                   std::size_t s, double q) {
   char text[256];
   std::snprintf(text, sizeof text,
                 "position of joint '%s' is %.6g, beyond its URDF limits [%.6g, %.6g] by more "
@@ -49,18 +64,22 @@ inline std::string implausiblePosition(const Model<double>& model, const Plausib
   return text;
 }
 
-/// Why a step of segment s's joint's position by `step` in dt [s] > 0 is not plausible
-/// (beyond step_margin plus velocity_factor times its velocity limit times dt); empty
-/// when it is.
-inline std::string implausibleStep(const Model<double>& model, const PlausibilityConfig& p,
-                                   std::size_t s, double step, double dt) {
-  const double limit = velocityLimit(model, p, s);
-  if (std::abs(step) <= p.velocity_factor * limit * dt + p.step_margin) return {};
+/// Whether a step of a joint's position by `step` in dt [s] > 0 is plausible for a joint of
+/// range r.
+inline bool plausibleStep(const PlausibleRange& r, const PlausibilityConfig& p, double step,
+                          double dt) {
+  return std::abs(step) <= r.rate * dt + p.step_margin;
+}
+
+/// Why that step is not plausible, naming joint, step and limit.
+inline std::string stepProblem(const Model<double>& model, const PlausibilityConfig& p,
+                               std::size_t s, double step, double dt) {
   char text[256];
   std::snprintf(text, sizeof text,
                 "position of joint '%s' moved %.6g in %.6g s, beyond plausibility/"
                 "velocity_factor %.3g times its velocity limit %.6g",
-                model.joint_name[s].c_str(), std::abs(step), dt, p.velocity_factor, limit);
+                model.joint_name[s].c_str(), std::abs(step), dt, p.velocity_factor,
+                velocityLimit(model, p, s));
   return text;
 }
 

@@ -164,13 +164,16 @@ class RecordBuilder {
   /// `rec` (as sizedRecord() made it) for the loads `estimator` published last, in a stream
   /// whose filters last (re)started at estimator time `settle_from` [s]: stamp and measured
   /// efforts of their own sample, loads, coordinates, uncertainty, side outputs, status.
-  void fill(const Estimator& estimator, double settle_from, LoadsRecord& rec) const;
+  /// Returns whether every force, moment and effort of `rec` (and its base residual) is
+  /// finite: a record that may be published.
+  bool fill(const Estimator& estimator, double settle_from, LoadsRecord& rec) const;
   /// The LoadsStatus bits of `rec`, filled from `estimator`'s last published loads.
   std::uint8_t status(const Estimator& estimator, double settle_from, const LoadsRecord& rec) const;
-  /// Whether every force, moment and effort of `rec` (and its base residual) is finite.
-  static bool finiteLoads(const LoadsRecord& rec);
 
  private:
+  // Whether every force, moment and effort of `rec` (and its base residual) is finite.
+  static bool finiteLoads(const LoadsRecord& rec);
+
   // One joint sample taken: its time, stamp and measured efforts.
   struct Sample {
     double t = 0.0;
