@@ -13,15 +13,82 @@
 
 namespace {
 
+// Every size up to the capacity: the first stages (len 2, 4) alone or with stages in
+// pairs, and one stage left over where their count is odd (n = 8, 32, 128). Errors of
+// about 1e-16 sqrt(n) log2(n) |x| (|x| ~ 1): 1e-12 leaves a margin.
 TEST(Fft, EqualsTheDirectSum) {
-  const int n = 64;
   jle::PortableRandom random(3);
-  std::vector<std::complex<double>> x(n), direct(n);
-  for (auto& v : x) v = {random.uniform(-1.0, 1.0), random.uniform(-1.0, 1.0)};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j) direct[k] += x[j] * std::polar(1.0, -2.0 * M_PI * j * k / n);
-  jle::Fft(256).transform(x.data(), n);
-  for (int k = 0; k < n; ++k) EXPECT_LT(std::abs(x[k] - direct[k]), 1e-12) << k;
+  const jle::Fft fft(256);
+  for (int n = 1; n <= 256; n *= 2) {
+    std::vector<std::complex<double>> x(n), direct(n);
+    for (auto& v : x) v = {random.uniform(-1.0, 1.0), random.uniform(-1.0, 1.0)};
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < n; ++j)  // the angle reduced: exp(-2 pi i (jk mod n) / n)
+        direct[k] += x[j] * std::polar(1.0, -2.0 * M_PI * ((j * k) % n) / n);
+    fft.transform(x.data(), n);
+    for (int k = 0; k < n; ++k) EXPECT_LT(std::abs(x[k] - direct[k]), 1e-12) << n << ": " << k;
+  }
+}
+
+// The positions' spectrum by the direct O(n^2) sum, one channel at a time: grid sample g
+// the mean of samples first + d g .. first + d g + d - 1 (d: the decimation); block b's
+// first differences e_j = g_{bn+j+1} - g_{bn+j}, Hann window w_j = (1 - cos(2 pi (j + 1/2)
+// / n)) / 2, E_k = sum_j w_j e_j exp(-2 pi i j k / n); the level |E_k|^2 / (4 sin^2(pi k
+// / n)) / sum_j w_j^2 (white noise of variance s^2 has level s^2), summed over the
+// channels, averaged over the blocks.
+std::vector<double> directSpectrum(const Eigen::MatrixXd& x, int first, int d, int n, int blocks) {
+  std::vector<std::complex<double>> root(n);  // exp(-2 pi i m / n)
+  for (int m = 0; m < n; ++m) root[m] = std::polar(1.0, -2.0 * M_PI * m / n);
+  std::vector<double> window(n), level(n / 2 + 1, 0.0);
+  double energy = 0.0;
+  for (int j = 0; j < n; ++j) {
+    window[j] = 0.5 - 0.5 * std::cos(2.0 * M_PI * (j + 0.5) / n);
+    energy += window[j] * window[j];
+  }
+  const auto grid = [&](int g, int c) { return x.col(c).segment(first + d * g, d).sum() / d; };
+  for (Eigen::Index c = 0; c < x.cols(); ++c)
+    for (int b = 0; b < blocks; ++b) {
+      std::vector<double> e(n);
+      for (int j = 0; j < n; ++j) e[j] = window[j] * (grid(b * n + j + 1, c) - grid(b * n + j, c));
+      for (int k = 1; k <= n / 2; ++k) {
+        std::complex<double> sum = 0.0;
+        for (int j = 0; j < n; ++j) sum += e[j] * root[(j * k) % n];
+        const double s = std::sin(M_PI * k / n);
+        level[k] += std::norm(sum) / (4.0 * s * s) / energy / blocks;
+      }
+    }
+  return level;
+}
+
+// The running spectrum, whose transforms take the channels two at a time (z = a + i b),
+// against directSpectrum: random data of unequal scales, regular stamps (no shift along
+// the rates), two blocks of 1024 grid samples (the first kept), at 500 Hz and at 1 kHz
+// (averaged in pairs); an even and an odd count of channels (one left alone), and one.
+TEST(SpectralCutoff, PairedSpectrumEqualsTheDirectSumChannelByChannel) {
+  const int n = 1024, first = jle::SpectralCutoff::kFirstIntervals;
+  for (const int d : {1, 2})
+    for (const int channels : {1, 4, 5}) {
+      jle::SpectralCutoff cutoff(channels, 0.5, 50.0, jle::SpectralCutoff::Rule::kNoiseFloor,
+                                 jle::SpectralCutoff::kBlockSeconds, true);
+      const int samples = first + d * (2 * n + 50);
+      jle::PortableRandom random(17);
+      Eigen::MatrixXd x(samples, channels);
+      for (int i = 0; i < samples; ++i)
+        for (int c = 0; c < channels; ++c) x(i, c) = (1.0 + 0.7 * c) * random.uniform(-1.0, 1.0);
+      const std::vector<double> zero(static_cast<std::size_t>(channels), 0.0);
+      for (int i = 0; i < samples; ++i) {
+        const Eigen::VectorXd row = x.row(i).transpose();
+        cutoff.add(i / (500.0 * d), row.data(), zero.data(), 1);
+      }
+      ASSERT_EQ(cutoff.decimation(), d);
+      ASSERT_EQ(cutoff.blockSamples(), n);
+      ASSERT_EQ(cutoff.blocks(), 2);
+      ASSERT_EQ(cutoff.pendingSteps(), 0);
+      const std::vector<double> expected = directSpectrum(x, first, d, n, 2);
+      for (int k = 1; k <= n / 2; ++k)  // the rounding: within 1e-12 here (the bound: 1e-9)
+        EXPECT_NEAR(cutoff.spectrum()[k] / expected[k], 1.0, 1e-9)
+            << d << ", " << channels << " channels, bin " << k;
+    }
 }
 
 // Three joints, smooth motion (sines 0.5..2.3 Hz), white noise, stamps jittered by

@@ -18,8 +18,10 @@
 namespace jle {
 
 /// In place radix-2 discrete Fourier transform of n = 2^k <= capacity points (forward,
-/// no scaling: X_k = sum_j x_j exp(-2 pi i j k / n)); the twiddles of the capacity are
-/// computed once, and every smaller size uses every (capacity / n)-th of them.
+/// no scaling: X_k = sum_j x_j exp(-2 pi i j k / n)). Everything a transform reads is made
+/// by the constructor, for every size up to the capacity: the bit-reversal swaps of each
+/// size, and the twiddles of each stage, contiguous (stage len's exp(-2 pi i k / len),
+/// k < len / 2, the same numbers as the capacity's every (capacity / len)-th).
 class Fft {
  public:
   Fft() = default;
@@ -29,8 +31,20 @@ class Fft {
   void transform(std::complex<double>* x, int n) const;
 
  private:
+  // x in bit-reversed order (the swaps of size n = 2^log2n).
+  void permute(std::complex<double>* x, int log2n) const;
+  // The stages len = 2 and 4 together (twiddles 1 and -i: no multiply), n >= 4.
+  static void firstStages(double* x, int n);
+  // The stages len and 2 len together (n >= 2 len), the butterflies of radix 2 in the
+  // order of a radix-4 pass: each element loaded and stored once for both.
+  void stagePair(double* x, int n, int len) const;
+  // The stage len alone (the last of an odd count).
+  void stage(double* x, int n, int len) const;
+
   int capacity_ = 0;
-  std::vector<std::complex<double>> twiddle_;
+  std::vector<std::complex<double>> twiddle_;  // stage len's from index len / 2 - 1
+  std::vector<int> swaps_;       // pairs i < j of each size, the sizes one after the other
+  std::vector<int> swap_begin_;  // size 2^m's pairs: swaps_[swap_begin_[m] .. [m + 1])
 };
 
 /// The GCV cutoff of the record so far, from its spectrum. Each sample is moved along
@@ -51,9 +65,10 @@ class Fft {
 /// zero_phase.cpp's gcvScore evaluates in the time domain (the circulant approximation
 /// of the same smoother); it is searched on a grid of ratio kGridRatio, and the narrowest
 /// cutoff within kTolerance of the minimum is chosen.
-/// The work of a completed block (a transform per channel, the spectrum, the scores) is
-/// spread over the grid samples that follow it, one step per sample (a channel's
-/// transform, or kScoresPerStep scores), so that no sample's call carries the whole of it:
+/// The work of a completed block (the transforms, the spectrum, the scores) is spread over
+/// the grid samples that follow it, one step per sample (a step per channel: two channels'
+/// transform in one, z = a + i b, then its unpacking; the spectrum; kScoresPerStep
+/// scores), so that no sample's call carries the whole of it:
 /// the choice takes effect pendingSteps() samples after the block, the same choice at the
 /// same sample on every run (the node and process_bag agree).
 class SpectralCutoff {
@@ -135,22 +150,38 @@ class SpectralCutoff {
   /// Blocks in the spectrum so far.
   int blocks() const { return blocks_; }
   int decimation() const { return decimation_; }
+  /// The running spectrum of the positions [unit^2]: bin k = 0 .. blockSamples() / 2 holds
+  /// the variance of white noise that would give its level, summed over the channels that
+  /// choose and averaged over the blocks (bin 0: 0); the bins above are 0.
+  const Eigen::VectorXd& spectrum() const { return spectrum_; }
 
  private:
   // The grid's interval h [s] and the block layout, once.
   void start(double h);
 
-  // One grid sample: a step of the last block's work, then the sample; a completed
-  // block is handed to the work (what is left of the one before done first: rare, the
-  // steps are far fewer than a block's samples).
-  bool accumulate(const double* x);
+  // One grid sample, channel c's value sample(c): a step of the last block's work, then
+  // the sample into the row being averaged (completeRow once it holds decimation_).
+  template <class Sample>
+  bool accumulate(Sample sample);
 
-  // The next step of the work on block_samples_: channel step_'s transform (steps 0 ..
+  // The row's average; a completed block is handed to the work (what is left of the one
+  // before done first: rare, the steps are far fewer than a block's samples). True when
+  // that finished a choice.
+  bool completeRow();
+
+  // The next step of the work on block_samples_: the channels' transforms (steps 0 ..
   // channels - 1), the spectrum (channels), kScoresPerStep scores (then); true when the
   // choice is made.
   bool step();
 
-  void transformChannel(int c);
+  // Step s < channels of the transforms: even s, channels s and s + 1 in one complex
+  // transform (z = a + i b; channel s alone, the last of an odd count, its power into
+  // part_ at once); odd s, that pair's powers into part_ (unpackPair).
+  void transformStep(int s);
+
+  // The pair's power |A_k|^2 + |B_k|^2 (|A_k|^2 = |Z_k + conj(Z_{n-k})|^2 / 4, |B_k|^2 =
+  // |Z_k - conj(Z_{n-k})|^2 / 4) from its transform Z in buffer_, whitened, into part_.
+  void unpackPair();
 
   void addSpectrum();
 
@@ -200,9 +231,11 @@ class SpectralCutoff {
   double lowest_score_ = 0.0;
   Fft fft_;
   std::vector<std::complex<double>> buffer_;
-  Eigen::MatrixXd samples_;        // (block + 1) x channels, decimated
-  Eigen::MatrixXd block_samples_;  // the completed block the work is on, alike
-  Eigen::VectorXd sum_, last_, fill_, gap_;
+  // (block + 1) x channels, decimated, row-major (sample j's channels from j * channels; a
+  // row in the making holds the sum of its in_sum_ samples).
+  std::vector<double> samples_;
+  std::vector<double> block_samples_;  // the completed block the work is on, alike
+  Eigen::VectorXd last_, fill_;        // the last sample moved to the grid; this one, where a gap
   Eigen::VectorXd spectrum_, part_, window_, whitening_, tan_k_;
 };
 
