@@ -12,21 +12,15 @@
 # JLE_WS as for tools/build.sh; JLE_JOBS build jobs (default 2).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${JLE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/joint_load_estimator/ws}
-export JLE_WS=$ws
+source "$repo/tools/study_build.sh"
 quick=()
 case "${1:-}" in
   "") out="$repo/docs/studies" ;;
   --quick) quick=(--quick); out="$ws/accuracy_quick" ;;
   *) echo "usage: tools/accuracy.sh [--quick]" >&2; exit 2 ;;
 esac
-mkdir -p "$ws" "$out"
-log="$ws/accuracy_build.log"
-if ! bash "$repo/tools/build.sh" -j"${JLE_JOBS:-2}" accuracy >"$log" 2>&1; then
-  tail -40 "$log"
-  echo "accuracy: build failed (log: $log)" >&2
-  exit 1
-fi
+mkdir -p "$out"
+study_build accuracy accuracy
 "$ws/devel/lib/joint_load_estimator/accuracy" "${quick[@]}" --csv "$out/accuracy.csv"
 /usr/bin/python3 "$repo/bench/plot_accuracy.py" "$out/accuracy.csv" --md "$out/accuracy.md" \
   --png-prefix "$out/accuracy" --command "tools/accuracy.sh${quick:+ --quick}"
