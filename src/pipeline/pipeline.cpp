@@ -193,8 +193,6 @@ std::string Pipeline::smoothedBandwidthBound() const {
   return text;
 }
 
-Stamp Pipeline::absolute(double t) const { return builder_.stampAt(t); }
-
 Outcome Pipeline::count(InputKind kind, Outcome outcome) {
   ++counters_.outcomes[static_cast<int>(kind)][static_cast<int>(outcome)];
   return outcome;
@@ -348,7 +346,7 @@ Outcome Pipeline::onJointState(Stamp stamp, Stamp clock, const std::vector<std::
                     "): message dropped");
   if (!plausibleJointState(stamp, names, position)) return count(kind, Outcome::kImplausible);
   if (group_.open && !joins) closeGroup();  // a later instant: the open one is complete as is
-  mapJointState(names, position, plausibleVelocities(names, velocity), effort);
+  mapJointState(names, position, plausibleVelocities(velocity), effort);
   timeline_.anchor(stamp);
   group_.oldest = group_.open ? std::min(group_.oldest, stamp) : stamp;
   group_.newest = group_.open ? std::max(group_.newest, stamp) : stamp;
@@ -718,22 +716,17 @@ bool Pipeline::plausibleJointState(Stamp stamp, const std::vector<std::string>& 
   return true;
 }
 
-const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<std::string>& names,
-                                                         const std::vector<double>& velocity) {
-  const PlausibilityConfig& p = settings_.plausibility;
-  const Model<double>& m = model();
+const std::vector<double>& Pipeline::plausibleVelocities(const std::vector<double>& velocity) {
   const std::vector<int>& coordinate = joints_.coordinates();
   bool any = false;
   for (std::size_t i = 0; i < velocity.size() && i < coordinate.size(); ++i) {
     if (coordinate[i] < 0 || !std::isfinite(velocity[i])) continue;
-    const std::size_t s =
-        static_cast<std::size_t>(coordinate_segment_[static_cast<std::size_t>(coordinate[i])]);
-    if (!implausibleVelocity(m, p, s, velocity[i])) continue;
+    const PlausibleRange& range = coordinate_range_[static_cast<std::size_t>(coordinate[i])];
+    if (!implausibleVelocity(range, velocity[i])) continue;
     if (!any) velocity_checked_ = velocity;  // same size after the first: no allocation
     velocity_checked_[i] = kNaN;             // counted and named as a non-finite one
     any = true;
   }
-  (void)names;
   return any ? velocity_checked_ : velocity;
 }
 

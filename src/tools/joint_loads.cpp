@@ -436,7 +436,7 @@ void checkPlausible(const jle::CsvReader& reader, const jle::Model<double>& mode
     const double step = dt > 0.0 ? q - (*previous)[columns.q[k]] : 0.0;
     if (dt > 0.0 && !jle::plausibleStep(range, p, step, dt))
       reader.failAt(columns.q[k], jle::stepProblem(model, p, s, step, dt) + kWhy);
-    if (columns.qd[k] < 0 || !jle::implausibleVelocity(model, p, s, cells[columns.qd[k]])) continue;
+    if (columns.qd[k] < 0 || !jle::implausibleVelocity(range, cells[columns.qd[k]])) continue;
     reader.failAt(columns.qd[k], "velocity of joint '" + model.joint_name[s] + "' is " +
                                      shortest(cells[columns.qd[k]]) +
                                      ", beyond plausibility/"

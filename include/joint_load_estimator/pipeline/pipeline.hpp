@@ -262,8 +262,6 @@ class Pipeline {
   /// The joint-state stream's sample clock (stamps/regularize).
   const SampleClock& sampleClock() const { return timeline_.sampleClock(); }
   const Model<double>& model() const { return estimator_.model(); }
-  /// The stamp [ns] of the estimator's time t [s].
-  Stamp absolute(double t) const;
   /// The origin of the estimator's time axis [ns]: the first stamp after the start, after
   /// a reset, or after a stamp more than 2^52 ns (52 days) away from the previous origin.
   /// None until a message has been taken.
@@ -348,8 +346,7 @@ class Pipeline {
   // Plausibility at the door (Settings::plausibility); false with problem_ set.
   bool plausibleJointState(Stamp stamp, const std::vector<std::string>& names,
                            const std::vector<double>& position);
-  const std::vector<double>& plausibleVelocities(const std::vector<std::string>& names,
-                                                 const std::vector<double>& velocity);
+  const std::vector<double>& plausibleVelocities(const std::vector<double>& velocity);
   bool plausibleWrench(InputKind kind, const std::string& topic, const Eigen::Vector3d& force,
                        const Eigen::Vector3d& moment);
   // What a wrench or plate reading (`what`: "wrench 'topic'", "force plate 'name'") passes

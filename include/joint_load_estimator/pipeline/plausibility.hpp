@@ -83,11 +83,10 @@ inline std::string stepProblem(const Model<double>& model, const PlausibilityCon
   return text;
 }
 
-/// Whether a measured velocity of segment s's joint is beyond velocity_factor times its
-/// velocity limit.
-inline bool implausibleVelocity(const Model<double>& model, const PlausibilityConfig& p,
-                                std::size_t s, double velocity) {
-  return std::abs(velocity) > p.velocity_factor * velocityLimit(model, p, s);
+/// Whether a measured velocity is beyond what a joint of range r does (velocity_factor
+/// times its velocity limit).
+inline bool implausibleVelocity(const PlausibleRange& r, double velocity) {
+  return std::abs(velocity) > r.rate;
 }
 
 /// Whether an effort of segment s's joint is beyond effort_factor times its URDF effort
